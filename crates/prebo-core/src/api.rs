@@ -1,0 +1,113 @@
+//! Flat-slice entry points: row-major arrays in, row-major arrays out, the
+//! coordinate dimension `n` dispatched once to the const-generic kernels.
+use crate::build::{self, Matrices, Symmetrised};
+use crate::ecg::{Element, Gaussian, Mat, Operators, Vector};
+use crate::error::{CoreError, Result};
+
+/// Largest number of coordinates compiled (laboratory frame: particles).
+pub const MAX_DIM: usize = 8;
+
+/// The operators and the symmetry of a system, in one coordinate representation.
+pub struct Setup<'a> {
+    /// number of coordinates `n` (particles in the laboratory frame)
+    pub n: usize,
+    /// `n x n` kinetic matrix `Λ`
+    pub lambda: &'a [f64],
+    /// `n_pairs x n` Coulomb vectors `w`
+    pub pair_w: &'a [f64],
+    /// `n_pairs` charge products
+    pub pair_q: &'a [f64],
+    /// `n_ops x n x n` symmetry transformations `T` (`A -> T^T A T`)
+    pub sym_t: &'a [f64],
+    /// `n_ops` Young-operator coefficients
+    pub sym_c: &'a [f64],
+    /// total mass for the CM elimination, or `None`
+    pub cm_mass: Option<f64>,
+}
+
+/// A set of functions: `k x n x n` exponent matrices and `k` values of `c_A`.
+pub struct Functions<'a> {
+    pub a: &'a [f64],
+    pub c_a: &'a [f64],
+}
+
+fn check(len: usize, want: usize, what: &str) -> Result<()> {
+    if len == want {
+        Ok(())
+    } else {
+        Err(CoreError::ShapeMismatch(format!("{what}: {len} values, expected {want}")))
+    }
+}
+
+impl Setup<'_> {
+    fn operators<const D: usize>(&self) -> Result<(Operators<D>, Vec<(Mat<D>, f64)>)> {
+        check(self.lambda.len(), D * D, "kinetic matrix")?;
+        check(self.pair_w.len(), self.pair_q.len() * D, "Coulomb vectors")?;
+        check(self.sym_t.len(), self.sym_c.len() * D * D, "symmetry transformations")?;
+        if self.sym_c.is_empty() {
+            return Err(CoreError::ShapeMismatch("no symmetry operations (need at least the identity)".into()));
+        }
+        let pairs = self
+            .pair_q
+            .iter()
+            .enumerate()
+            .map(|(p, q)| (Vector::<D>::from_row_slice(&self.pair_w[p * D..(p + 1) * D]), *q))
+            .collect();
+        let ops = Operators { lambda: Mat::<D>::from_row_slice(self.lambda), pairs, cm_mass: self.cm_mass };
+        let sym = self
+            .sym_c
+            .iter()
+            .enumerate()
+            .map(|(p, c)| (Mat::<D>::from_row_slice(&self.sym_t[p * D * D..(p + 1) * D * D]), *c))
+            .collect();
+        Ok((ops, sym))
+    }
+}
+
+fn gaussians<const D: usize>(f: &Functions) -> Result<Vec<Gaussian<D>>> {
+    check(f.a.len(), f.c_a.len() * D * D, "exponent matrices")?;
+    f.c_a
+        .iter()
+        .enumerate()
+        .map(|(i, c)| Gaussian::new(Mat::<D>::from_row_slice(&f.a[i * D * D..(i + 1) * D * D]), *c, i))
+        .collect()
+}
+
+macro_rules! dispatch {
+    ($n:expr, $f:ident ( $($arg:expr),* )) => {
+        match $n {
+            1 => $f::<1>($($arg),*),
+            2 => $f::<2>($($arg),*),
+            3 => $f::<3>($($arg),*),
+            4 => $f::<4>($($arg),*),
+            5 => $f::<5>($($arg),*),
+            6 => $f::<6>($($arg),*),
+            7 => $f::<7>($($arg),*),
+            8 => $f::<8>($($arg),*),
+            n => Err(CoreError::Unsupported(format!("{n} coordinates (at most {MAX_DIM})"))),
+        }
+    };
+}
+
+fn matrices_d<const D: usize>(setup: &Setup, basis: &Functions) -> Result<Matrices> {
+    let (ops, sym) = setup.operators::<D>()?;
+    let basis = Symmetrised::new(gaussians::<D>(basis)?, &sym)?;
+    Ok(build::matrices(&basis, &ops))
+}
+
+fn rows_d<const D: usize>(setup: &Setup, trials: &Functions, basis: &Functions) -> Result<(Matrices, Vec<Element>)> {
+    let (ops, sym) = setup.operators::<D>()?;
+    let trials = Symmetrised::new(gaussians::<D>(trials)?, &sym)?;
+    let basis = Symmetrised::new(gaussians::<D>(basis)?, &sym)?;
+    Ok(build::rows(&trials, &basis, &ops))
+}
+
+/// Overlap, kinetic (lab and translation-free) and Coulomb matrices of a basis.
+pub fn matrices(setup: &Setup, basis: &Functions) -> Result<Matrices> {
+    dispatch!(setup.n, matrices_d(setup, basis))
+}
+
+/// Rows of trial functions against a basis, with the trials' diagonal elements.
+pub fn rows(setup: &Setup, trials: &Functions, basis: &Functions) -> Result<(Matrices, Vec<Element>)> {
+    dispatch!(setup.n, rows_d(setup, trials, basis))
+}

@@ -1,0 +1,82 @@
+//! Plain explicitly correlated Gaussians and the operators they are integrated with.
+//!
+//! Convention (docs/conventions.md): a plain ECG in `D` coordinates is
+//! `phi(r) = exp(-r^T (A ⊗ I_3) r)` — no factor 1/2 in the exponent — so that
+//! `<phi|phi> = (pi^D / |2A|)^{3/2}`. Every function is used normalised.
+use nalgebra::{Cholesky, SMatrix, SVector};
+
+use crate::error::{CoreError, Result};
+
+pub type Mat<const D: usize> = SMatrix<f64, D, D>;
+pub type Vector<const D: usize> = SVector<f64, D>;
+
+/// One basis function: exponent matrix `A`, `ln|A|`, and its centre-of-mass exponent `c_A`.
+#[derive(Clone, Debug)]
+pub struct Gaussian<const D: usize> {
+    pub a: Mat<D>,
+    pub log_det: f64,
+    pub c_a: f64,
+}
+
+impl<const D: usize> Gaussian<D> {
+    /// Checks positive definiteness (Cholesky) and stores `ln|A|`; `index` names the function in errors.
+    pub fn new(a: Mat<D>, c_a: f64, index: usize) -> Result<Self> {
+        let log_det = log_det_pd(&a).ok_or(CoreError::NotPositiveDefinite { function: index })?;
+        Ok(Self { a, log_det, c_a })
+    }
+
+    /// The permuted (or otherwise linearly transformed) function `phi(T r)`: `A -> T^T A T`.
+    pub fn transformed(&self, t: &Mat<D>, index: usize) -> Result<Self> {
+        Self::new(t.transpose() * self.a * t, self.c_a, index)
+    }
+}
+
+/// `ln|A|` from the Cholesky factor, `None` if `A` is not positive definite.
+pub fn log_det_pd<const D: usize>(a: &Mat<D>) -> Option<f64> {
+    let chol = Cholesky::new(*a)?;
+    let l = chol.l_dirty();
+    let mut ld = 0.0;
+    for k in 0..D {
+        let d = l[(k, k)];
+        if !(d > 0.0) || !d.is_finite() {
+            return None;
+        }
+        ld += 2.0 * d.ln();
+    }
+    Some(ld)
+}
+
+/// The operators integrated together: kinetic `-∇^T Λ ∇` and Coulomb `Σ q / |w^T r|`.
+///
+/// In laboratory-frame coordinates `Λ = M = diag(1/(2 m_i))` and `w = e_i - e_j`;
+/// in a translationally invariant set `Λ = μ` and `w = U_x^{-T}(e_i - e_j)` (first D rows).
+#[derive(Clone, Debug)]
+pub struct Operators<const D: usize> {
+    pub lambda: Mat<D>,
+    pub pairs: Vec<(Vector<D>, f64)>,
+    /// Total mass for the c_A elimination of the CM kinetic energy (paper eq. ecg-transl);
+    /// `None` when the coordinates carry no CM part.
+    pub cm_mass: Option<f64>,
+}
+
+/// One (normalised, un-symmetrised) matrix element of every operator.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Element {
+    /// overlap `<I|J>`
+    pub s: f64,
+    /// kinetic energy with the full `Λ` (laboratory frame: includes CM motion)
+    pub t: f64,
+    /// kinetic energy with the CM part eliminated (equal to `t` without `cm_mass`)
+    pub t_ti: f64,
+    /// Coulomb potential energy
+    pub v: f64,
+}
+
+impl std::ops::AddAssign<(f64, Element)> for Element {
+    fn add_assign(&mut self, (c, e): (f64, Element)) {
+        self.s += c * e.s;
+        self.t += c * e.t;
+        self.t_ti += c * e.t_ti;
+        self.v += c * e.v;
+    }
+}

@@ -1,0 +1,12 @@
+//! prebo-core: explicitly correlated Gaussian integrals, symmetrised matrix and
+//! row builds for pre-Born–Oppenheimer calculations. Pure Rust, no Python.
+//!
+//! Pipeline position: integrals (`pecg`) → symmetrised builds (`build`) → flat
+//! array entry points (`api`) used by the `prebo._core` binding.
+pub mod api;
+pub mod build;
+pub mod ecg;
+pub mod error;
+pub mod pecg;
+
+pub use error::{CoreError, Result};

@@ -1,0 +1,158 @@
+//! `prebo._core`: the thin PyO3 binding of prebo-core.
+//! Converts numpy arrays, maps `CoreError` to `prebo.errors`, releases the GIL.
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
+use prebo_core::api::{self, Functions, Setup};
+use prebo_core::build::Matrices;
+use prebo_core::CoreError;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+pyo3::import_exception!(prebo.errors, NotPositiveDefiniteError);
+pyo3::import_exception!(prebo.errors, ShapeError);
+pyo3::import_exception!(prebo.errors, UnsupportedError);
+
+fn to_py(e: CoreError) -> PyErr {
+    let msg = e.to_string();
+    match e {
+        CoreError::NotPositiveDefinite { .. } => NotPositiveDefiniteError::new_err(msg),
+        CoreError::ShapeMismatch(_) => ShapeError::new_err(msg),
+        CoreError::Unsupported(_) => UnsupportedError::new_err(msg),
+    }
+}
+
+fn slice<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(
+    a: &'a numpy::PyReadonlyArray<'_, T, D>,
+    what: &str,
+) -> PyResult<&'a [T]> {
+    a.as_slice().map_err(|_| PyValueError::new_err(format!("{what} must be a C-contiguous array")))
+}
+
+type Arr2<'py> = Bound<'py, PyArray2<f64>>;
+
+fn matrix<'py>(py: Python<'py>, rows: usize, cols: usize, v: Vec<f64>) -> Arr2<'py> {
+    Array2::from_shape_vec((rows, cols), v).expect("rows x cols values").into_pyarray(py)
+}
+
+fn dict<'py>(py: Python<'py>, m: Matrices) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let d = pyo3::types::PyDict::new(py);
+    d.set_item("S", matrix(py, m.rows, m.cols, m.s))?;
+    d.set_item("T", matrix(py, m.rows, m.cols, m.t))?;
+    d.set_item("T_ti", matrix(py, m.rows, m.cols, m.t_ti))?;
+    d.set_item("V", matrix(py, m.rows, m.cols, m.v))?;
+    Ok(d)
+}
+
+/// Owned copies of the setup arrays, so that the GIL can be released.
+struct SetupData {
+    n: usize,
+    lambda: Vec<f64>,
+    pair_w: Vec<f64>,
+    pair_q: Vec<f64>,
+    sym_t: Vec<f64>,
+    sym_c: Vec<f64>,
+    cm_mass: Option<f64>,
+}
+
+impl SetupData {
+    fn view(&self) -> Setup<'_> {
+        Setup {
+            n: self.n,
+            lambda: &self.lambda,
+            pair_w: &self.pair_w,
+            pair_q: &self.pair_q,
+            sym_t: &self.sym_t,
+            sym_c: &self.sym_c,
+            cm_mass: self.cm_mass,
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn setup_data(
+    lambda: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+    cm_mass: Option<f64>,
+) -> PyResult<SetupData> {
+    Ok(SetupData {
+        n: lambda.as_array().nrows(),
+        lambda: slice(&lambda, "lambda")?.to_vec(),
+        pair_w: slice(&pair_w, "pair_w")?.to_vec(),
+        pair_q: slice(&pair_q, "pair_q")?.to_vec(),
+        sym_t: slice(&sym_t, "sym_t")?.to_vec(),
+        sym_c: slice(&sym_c, "sym_c")?.to_vec(),
+        cm_mass,
+    })
+}
+
+/// Symmetrised matrices `{"S", "T", "T_ti", "V"}` of a plain-ECG basis.
+#[pyfunction]
+#[pyo3(signature = (a, c_a, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None))]
+#[allow(clippy::too_many_arguments)]
+fn matrices<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray3<f64>,
+    c_a: PyReadonlyArray1<f64>,
+    lambda_: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+    cm_mass: Option<f64>,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
+    let (a, c_a) = (slice(&a, "a")?.to_vec(), slice(&c_a, "c_a")?.to_vec());
+    let m = py
+        .allow_threads(|| api::matrices(&setup.view(), &Functions { a: &a, c_a: &c_a }))
+        .map_err(to_py)?;
+    dict(py, m)
+}
+
+/// Rows `{"S", "T", "T_ti", "V"}` (k x nb) of trial functions against a basis,
+/// and the trials' diagonal elements as a k x 4 array (S, T, T_ti, V).
+#[pyfunction]
+#[pyo3(signature = (trial_a, trial_c_a, a, c_a, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None))]
+#[allow(clippy::too_many_arguments)]
+fn rows<'py>(
+    py: Python<'py>,
+    trial_a: PyReadonlyArray3<f64>,
+    trial_c_a: PyReadonlyArray1<f64>,
+    a: PyReadonlyArray3<f64>,
+    c_a: PyReadonlyArray1<f64>,
+    lambda_: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+    cm_mass: Option<f64>,
+) -> PyResult<(Bound<'py, pyo3::types::PyDict>, Arr2<'py>)> {
+    let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
+    let (ta, tc) = (slice(&trial_a, "trial_a")?.to_vec(), slice(&trial_c_a, "trial_c_a")?.to_vec());
+    let (a, c_a) = (slice(&a, "a")?.to_vec(), slice(&c_a, "c_a")?.to_vec());
+    let (m, diag) = py
+        .allow_threads(|| {
+            api::rows(&setup.view(), &Functions { a: &ta, c_a: &tc }, &Functions { a: &a, c_a: &c_a })
+        })
+        .map_err(to_py)?;
+    let k = diag.len();
+    let d: Vec<f64> = diag.iter().flat_map(|e| [e.s, e.t, e.t_ti, e.v]).collect();
+    Ok((dict(py, m)?, matrix(py, k, 4, d)))
+}
+
+/// Number of rayon worker threads in use.
+#[pyfunction]
+fn num_threads() -> usize {
+    rayon::current_num_threads()
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(matrices, m)?)?;
+    m.add_function(wrap_pyfunction!(rows, m)?)?;
+    m.add_function(wrap_pyfunction!(num_threads, m)?)?;
+    m.add("MAX_DIM", api::MAX_DIM)?;
+    Ok(())
+}

@@ -1,0 +1,171 @@
+"""Plain-ECG basis sets in laboratory-frame Cartesian coordinates, and the basis.json format.
+
+Each function is phi_I(r) = exp(-r^T (A_I ⊗ I_3) r) (docs/conventions.md) with
+A_I = U_x^T blockdiag(𝒜_I, c_A) U_x for the coordinate set ("channel") x it was
+generated in. basis.json (format "prebo-basis", version 1; docs/basis-format.md)
+stores the system, the state, the symmetry, the conventions and, per function,
+the full A^(r), c_A and the channel, plus the linear coefficients of the state.
+"""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import BasisFileError, InputError, NotPositiveDefiniteError, PreboError, SeparabilityError
+from .system import System
+
+FORMAT = "prebo-basis"
+VERSION = 1
+CONVENTIONS = {
+    "gaussian": "exp(-r^T (A ⊗ I_3) r), no 1/2 in the exponent",
+    "coordinates": "laboratory-frame Cartesian, particles in the order listed",
+    "units": "hartree atomic units; masses in electron masses",
+    "cm": "A^(r) 1 = c_A m / m_tot (CM-separable); energy has the CM kinetic energy eliminated",
+}
+
+
+@dataclass
+class Basis:
+    """A plain-ECG basis of a system: exponents `A` (nb, n, n) in LFCC, `c_A` (nb), channels (nb)."""
+
+    system: System
+    A: np.ndarray
+    c_A: np.ndarray
+    channels: list[str] = field(default_factory=list)
+    coefficients: np.ndarray | None = None
+    kind: str = "pecg"
+
+    def __post_init__(self):
+        n = self.system.n
+        self.A = np.ascontiguousarray(np.asarray(self.A, dtype=float).reshape(-1, n, n))
+        self.c_A = np.ascontiguousarray(np.asarray(self.c_A, dtype=float).reshape(-1))
+        if len(self.c_A) != len(self.A):
+            raise InputError(f"basis: {len(self.A)} exponent matrices but {len(self.c_A)} values of c_A")
+        if not self.channels:
+            self.channels = ["unknown"] * len(self.A)
+
+    @classmethod
+    def empty(cls, system: System) -> "Basis":
+        n = system.n
+        return cls(system, np.zeros((0, n, n)), np.zeros(0), [])
+
+    def __len__(self) -> int:
+        return len(self.A)
+
+    def append(self, A: np.ndarray, c_A: float, channel: str) -> None:
+        self.A = np.concatenate([self.A, A[None]])
+        self.c_A = np.append(self.c_A, c_A)
+        self.channels.append(channel)
+        self.coefficients = None
+
+    def replace(self, i: int, A: np.ndarray, c_A: float, channel: str) -> None:
+        self.A[i] = A
+        self.c_A[i] = c_A
+        self.channels[i] = channel
+        self.coefficients = None
+
+    def validate(self) -> None:
+        """Every A symmetric, positive definite and CM-separable (A 1 = c_A m/m_tot, c_A > 0)."""
+        m = self.system.cm_vector
+        for i, (A, c) in enumerate(zip(self.A, self.c_A)):
+            if not np.all(np.isfinite(A)) or not np.isfinite(c):
+                raise BasisFileError(f"function {i}: non-finite parameters")
+            if np.max(np.abs(A - A.T)) > 1e-12 * max(1.0, np.max(np.abs(A))):
+                raise InputError(f"function {i}: exponent matrix A is not symmetric")
+            if not c > 0:
+                raise NotPositiveDefiniteError(f"function {i}: c_A = {c} must be positive")
+            if np.max(np.abs(A.sum(axis=1) - c * m)) > 1e-9 * max(1.0, np.max(np.abs(A))):
+                raise SeparabilityError(f"function {i}: A^(r) 1 != c_A m/m_tot, the CM does not separate")
+            try:
+                np.linalg.cholesky(A)
+            except np.linalg.LinAlgError:
+                raise NotPositiveDefiniteError(f"function {i}: exponent matrix A is not positive definite") from None
+
+    # --- basis.json ------------------------------------------------------------
+    def to_dict(self, extra: dict | None = None) -> dict:
+        d = {
+            "format": FORMAT,
+            "version": VERSION,
+            "conventions": CONVENTIONS,
+            "system": self.system.to_dict(),
+            "symmetry": self.system.symmetriser.as_dict(),
+            "basis_type": self.kind,
+            "functions": [
+                {"A": A.tolist(), "c_A": float(c), "channel": ch}
+                for A, c, ch in zip(self.A, self.c_A, self.channels)
+            ],
+        }
+        if self.coefficients is not None:
+            d["coefficients"] = np.asarray(self.coefficients).tolist()
+        if extra:
+            d.update(extra)
+        return d
+
+    def save(self, path, extra: dict | None = None) -> None:
+        """Write atomically: a killed run leaves either the old or the new file, never half of one."""
+        write_json_atomic(path, self.to_dict(extra))
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "basis") -> "Basis":
+        if not isinstance(d, dict) or d.get("format") != FORMAT:
+            raise BasisFileError(f"{where}: not a prebo basis file (format must be {FORMAT!r})")
+        if d.get("version") != VERSION:
+            raise BasisFileError(f"{where}: unsupported version {d.get('version')!r} (this prebo reads {VERSION})")
+        if d.get("basis_type") != "pecg":
+            raise BasisFileError(f"{where}: basis type {d.get('basis_type')!r} is not supported by this version")
+        try:
+            system = System.from_dict(d["system"])
+            funcs = d["functions"]
+            n = system.n
+            A = np.array([f["A"] for f in funcs], dtype=float).reshape(len(funcs), n, n)
+            c_A = np.array([f["c_A"] for f in funcs], dtype=float)
+            channels = [str(f.get("channel", "unknown")) for f in funcs]
+            coef = d.get("coefficients")
+            coef = None if coef is None else np.asarray(coef, dtype=float)
+        except PreboError as exc:
+            raise BasisFileError(f"{where}: {exc}") from exc
+        except (KeyError, TypeError, ValueError) as exc:
+            raise BasisFileError(f"{where}: malformed basis data ({type(exc).__name__}: {exc})") from exc
+        basis = cls(system, A, c_A, channels, coef)
+        if coef is not None and coef.shape != (len(A),):
+            raise BasisFileError(f"{where}: {coef.size} coefficients for {len(A)} functions")
+        try:
+            basis.validate()
+        except PreboError as exc:
+            raise BasisFileError(f"{where}: {exc}") from exc
+        return basis
+
+    @classmethod
+    def load(cls, path) -> "Basis":
+        path = Path(path)
+        try:
+            text = path.read_text()
+        except OSError as exc:
+            raise BasisFileError(f"{path}: cannot read ({exc.strerror})") from exc
+        try:
+            d = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise BasisFileError(f"{path}: corrupt or truncated JSON (line {exc.lineno}: {exc.msg})") from exc
+        return cls.from_dict(d, str(path))
+
+
+def write_json_atomic(path, obj) -> None:
+    """json.dump to a temporary file in the same folder, fsync, then os.replace."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as f:
+            json.dump(obj, f, indent=1)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise

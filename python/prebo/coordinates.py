@@ -1,0 +1,137 @@
+"""Coordinate sets x = U_x r (paper section "The Schrödinger Hamiltonian and coordinate sets").
+
+Every U_x is N_p x N_p: rows 1..N_p-1 are translationally invariant (each sums to
+zero, paper eq. Uconstraint1), the last row is m_j / m_tot (eq. Uconstraint2).
+Exponents transform as A^(x) = U^-T A^(r) U^-1 = blockdiag(𝒜, c_A) and global
+vectors as u^(x) = U^-T u^(r) = (u', c_U) (eqs. backandforthtransfonA/u). The
+kinetic matrix in x is U M U^T = blockdiag(μ, 1/(2 m_tot)).
+"""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError, SeparabilityError
+
+
+@dataclass(frozen=True)
+class CoordinateSet:
+    """A named coordinate set ("channel") and its matrix U_x."""
+
+    name: str
+    U: np.ndarray
+
+    def check(self, masses: np.ndarray, tol: float = 1e-12) -> None:
+        """Raise InputError unless U satisfies paper eqs. Uconstraint1 and Uconstraint2 and is invertible."""
+        n = len(masses)
+        if self.U.shape != (n, n):
+            raise InputError(f"{self.name}: U has shape {self.U.shape}, expected {(n, n)}")
+        if np.max(np.abs(self.U[:-1].sum(axis=1))) > tol:
+            raise InputError(f"{self.name}: a translationally invariant row does not sum to zero")
+        if np.max(np.abs(self.U[-1] - masses / masses.sum())) > tol:
+            raise InputError(f"{self.name}: last row is not m_j / m_tot")
+        if abs(np.linalg.det(self.U)) < 1e-12:
+            raise InputError(f"{self.name}: U is singular")
+
+    @property
+    def U_inv(self) -> np.ndarray:
+        return np.linalg.inv(self.U)
+
+    def mu(self, M: np.ndarray) -> np.ndarray:
+        """Internal kinetic matrix μ: the TI block of U M U^T (paper eq. nonrel-H-transf)."""
+        return (self.U @ M @ self.U.T)[:-1, :-1]
+
+    def to_lab(self, A_int: np.ndarray, c_A: float) -> np.ndarray:
+        """A^(r) = U^T blockdiag(𝒜, c_A) U."""
+        n = self.U.shape[0]
+        Ax = np.zeros((n, n))
+        Ax[:-1, :-1] = A_int
+        Ax[-1, -1] = c_A
+        return self.U.T @ Ax @ self.U
+
+    def from_lab(self, A_r: np.ndarray, tol: float = 1e-9) -> tuple[np.ndarray, float]:
+        """(𝒜, c_A) from A^(r); SeparabilityError if A^(x) has a CM-internal coupling."""
+        Ui = self.U_inv
+        Ax = Ui.T @ A_r @ Ui
+        scale = max(np.max(np.abs(Ax)), 1e-300)
+        if np.max(np.abs(Ax[-1, :-1])) > tol * scale:
+            raise SeparabilityError(f"{self.name}: exponent couples the CM to internal coordinates")
+        return Ax[:-1, :-1], float(Ax[-1, -1])
+
+    def transform_vectors_to_x(self, w: np.ndarray) -> np.ndarray:
+        """Coulomb / global vectors w^(x) = U^-T w^(r), one per row."""
+        return w @ self.U_inv
+
+    def transform_operation(self, Pi: np.ndarray) -> np.ndarray:
+        """A permutation matrix of LFCC in x: U Π U^-1 (block-diagonal for equal-mass permutations)."""
+        return self.U @ Pi @ self.U_inv
+
+
+def jacobi(masses: np.ndarray, order=None) -> CoordinateSet:
+    """Jacobi set (paper eq. Jac-TICC) for a particle order: x_i = Σ_{j<=i} m_j r_j / m_{1..i} - r_{i+1}."""
+    n = len(masses)
+    order = list(range(n)) if order is None else list(order)
+    if sorted(order) != list(range(n)):
+        raise InputError(f"Jacobi order {order} is not a permutation of 0..{n - 1}")
+    U = np.zeros((n, n))
+    for i in range(n - 1):
+        cluster = order[: i + 1]
+        mc = masses[cluster].sum()
+        for j in cluster:
+            U[i, j] = masses[j] / mc
+        U[i, order[i + 1]] -= 1.0
+    U[-1] = masses / masses.sum()
+    return CoordinateSet("jacobi:" + "-".join(map(str, order)), U)
+
+
+def heavy_particle_centred(masses: np.ndarray, centre: int) -> CoordinateSet:
+    """Heavy-particle-centred set (paper eq. HPC-TICC): x_i = r_i - r_centre for i != centre."""
+    n = len(masses)
+    U = np.zeros((n, n))
+    for row, i in enumerate(k for k in range(n) if k != centre):
+        U[row, i], U[row, centre] = 1.0, -1.0
+    U[-1] = masses / masses.sum()
+    return CoordinateSet(f"hpc:{centre}", U)
+
+
+def cm_centred(masses: np.ndarray, dropped: int | None = None) -> CoordinateSet:
+    """CM-centred set: x_i = r_i - X_CM for every particle but `dropped` (default: the last).
+
+    (Paper eq. CMC-TICC divides by m_{i..N}, which violates eq. Uconstraint1; this is
+    the set its figure describes.)
+    """
+    n = len(masses)
+    dropped = n - 1 if dropped is None else dropped
+    U = np.zeros((n, n))
+    for row, i in enumerate(k for k in range(n) if k != dropped):
+        U[row] = -masses / masses.sum()
+        U[row, i] += 1.0
+    U[-1] = masses / masses.sum()
+    return CoordinateSet(f"cmc:{dropped}", U)
+
+
+def all_sets(masses: np.ndarray) -> list[CoordinateSet]:
+    """Every Jacobi set (orders equal up to swapping the first two particles counted once),
+    every heavy-particle-centred set and the CM-centred set."""
+    n = len(masses)
+    sets = [jacobi(masses, order) for order in itertools.permutations(range(n)) if order[0] < order[1]]
+    sets += [heavy_particle_centred(masses, c) for c in range(n)]
+    sets.append(cm_centred(masses))
+    return sets
+
+
+def by_name(masses: np.ndarray, name: str) -> CoordinateSet:
+    """The set named as in `CoordinateSet.name` ("jacobi:0-1-2", "hpc:0", "cmc:2")."""
+    kind, _, arg = name.partition(":")
+    try:
+        if kind == "jacobi":
+            return jacobi(masses, [int(k) for k in arg.split("-")] if arg else None)
+        if kind == "hpc":
+            return heavy_particle_centred(masses, int(arg))
+        if kind == "cmc":
+            return cm_centred(masses, int(arg) if arg else None)
+    except ValueError as exc:
+        raise InputError(f"malformed coordinate set name {name!r}") from exc
+    raise InputError(f"unknown coordinate set {name!r} (jacobi:ORDER, hpc:I or cmc:I)")

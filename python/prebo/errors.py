@@ -1,0 +1,37 @@
+"""Exceptions users can catch. Every error prebo raises on bad input is a `PreboError`."""
+
+
+class PreboError(Exception):
+    """Base class of all prebo errors."""
+
+
+class InputError(PreboError, ValueError):
+    """An input file, particle, state or option that prebo cannot accept."""
+
+
+class SpinError(InputError):
+    """A total spin the identical particles of a group cannot form."""
+
+
+class BasisFileError(PreboError):
+    """A basis file that is missing, corrupt, truncated or inconsistent."""
+
+
+class NotPositiveDefiniteError(PreboError):
+    """An exponent matrix A (or the overlap matrix) is not positive definite."""
+
+
+class LinearDependenceError(PreboError):
+    """The overlap matrix is numerically singular beyond the chosen threshold."""
+
+
+class ShapeError(PreboError):
+    """Arrays whose shapes do not fit together (raised by the Rust core)."""
+
+
+class UnsupportedError(PreboError):
+    """A request prebo does not implement (e.g. a basis type for a state)."""
+
+
+class SeparabilityError(PreboError):
+    """A basis that does not factor into CM x internal parts where that is required."""

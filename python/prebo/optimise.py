@@ -1,0 +1,263 @@
+"""Stochastic basis optimisation: competitive selection and replacement sweeps.
+
+Growth (Suzuki & Varga, Lect. Notes Phys. m54, ch. 4, "stochastic variational
+method"): draw `trials` random functions, get each one's row against the basis from
+the Rust core (O(N_b) integrals), the new lowest eigenvalue from the secular
+equation (O(N_b^2), eigen.lowest_with_added), keep the best. Sweeps: each function
+in turn competes with `trials` random replacements in the basis without it.
+
+Functions are drawn in a coordinate set ("channel") or in pair form:
+- "pairs": A = Σ_{i<j} α_ij w_ij w_ij^T + c_A (m/m_tot)(m/m_tot)^T, α_ij = 1/b_ij^2,
+  b_ij log-uniform in [lo, hi] × a_ij with a_ij = 1/(min(μ_ij, 1) max(|q_i q_j|, 1));
+- a coordinate set x (coordinates.all_sets): 𝒜 = diag(1/b_k^2) in x, b_k log-uniform
+  over the same range with the lengths of the particles the coordinate joins, then
+  A^(r) = U_x^T blockdiag(𝒜, c_A) U_x.
+The basis is written atomically after every accepted step (a killed run loses at
+most the step in flight).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import coordinates as coords
+from . import eigen
+from .basis import Basis
+from .errors import InputError
+from .integrals import laboratory
+from .system import System
+
+
+@dataclass
+class Optimiser:
+    """Settings of `optimise` (TOML table [optimiser]; `size` and `c_A` come from [basis])."""
+
+    size: int = 50
+    trials: int = 20
+    sweeps: int = 0
+    seed: int = 1
+    channels: str | list = "pairs"
+    length_range: tuple = (0.01, 15.0)
+    c_A: float = 1.0
+    min_norm: float = 1e-8
+    threshold: float = 1e-13
+
+    def __post_init__(self):
+        if not (isinstance(self.size, int) and self.size >= 1):
+            raise InputError(f"basis size must be a positive integer, got {self.size!r}")
+        if not (isinstance(self.trials, int) and self.trials >= 1):
+            raise InputError(f"optimiser.trials must be a positive integer, got {self.trials!r}")
+        if not (isinstance(self.sweeps, int) and self.sweeps >= 0):
+            raise InputError(f"optimiser.sweeps must be a non-negative integer, got {self.sweeps!r}")
+        lo, hi = self.length_range
+        if not 0 < lo < hi:
+            raise InputError(f"optimiser.length_range must be 0 < lo < hi, got {self.length_range!r}")
+        if not self.c_A > 0:
+            raise InputError(f"basis.c_A must be positive, got {self.c_A!r}")
+
+
+@dataclass
+class Sampler:
+    """Random plain ECGs of a system in pair form or in coordinate sets (module docstring)."""
+
+    system: System
+    opts: Optimiser
+    rng: np.random.Generator
+    sets: list = field(default_factory=list)
+
+    def __post_init__(self):
+        s, m, q = self.system, self.system.masses, self.system.charges
+        n = s.n
+        self.length = np.ones((n, n))
+        for i in range(n):
+            for j in range(n):
+                if i != j:
+                    mu = m[i] * m[j] / (m[i] + m[j])
+                    self.length[i, j] = 1.0 / (min(mu, 1.0) * max(abs(q[i] * q[j]), 1.0))
+        ch = self.opts.channels
+        if ch == "pairs":
+            self.sets = []
+        elif ch == "all":
+            self.sets = coords.all_sets(m)
+        elif isinstance(ch, (list, tuple)):
+            self.sets = [coords.by_name(m, name) for name in ch]
+        else:
+            raise InputError(f"optimiser.channels must be 'pairs', 'all' or a list of coordinate sets, not {ch!r}")
+        for x in self.sets:
+            x.check(m)
+
+    def _b(self, a, size=None):
+        lo, hi = self.opts.length_range
+        return a * np.exp(self.rng.uniform(np.log(lo), np.log(hi), size))
+
+    def draw(self) -> tuple[np.ndarray, str]:
+        s, c_A = self.system, self.opts.c_A
+        n = s.n
+        cm = s.cm_vector
+        if not self.sets:
+            A = c_A * np.outer(cm, cm)
+            for i in range(n):
+                for j in range(i + 1, n):
+                    w = np.zeros(n)
+                    w[i], w[j] = 1.0, -1.0
+                    A += np.outer(w, w) / self._b(self.length[i, j]) ** 2
+            return A, "pairs"
+        x = self.sets[self.rng.integers(len(self.sets))]
+        # the length of coordinate k: that of the two particles its row weighs most
+        lengths = []
+        for k in range(n - 1):
+            i, j = np.argsort(-np.abs(x.U[k]))[:2]
+            lengths.append(self.length[i, j])
+        A_int = np.diag(1.0 / self._b(np.array(lengths)) ** 2)
+        return x.to_lab(A_int, c_A), x.name
+
+
+class State:
+    """Current basis with its matrices (S, T, T_ti, V) and eigen-solution."""
+
+    def __init__(self, basis: Basis, rep, threshold: float):
+        self.basis, self.rep, self.threshold = basis, rep, threshold
+        if len(basis):
+            self.m = rep.matrices(basis.A, basis.c_A)
+        else:
+            self.m = {k: np.zeros((0, 0)) for k in ("S", "T", "T_ti", "V")}
+        self.solve()
+
+    def solve(self):
+        if len(self.basis) == 0:
+            self.eig = None
+            self.energy = np.inf
+            return
+        self.eig = eigen.solve(self.m["T_ti"] + self.m["V"], self.m["S"], self.threshold)
+        self.energy = float(self.eig.energies[0])
+
+    def virial(self) -> float:
+        c = self.eig.vectors[:, 0]
+        return abs(1.0 + (c @ self.m["V"] @ c) / (2.0 * (c @ self.m["T_ti"] @ c)))
+
+    def candidates(self, trials, exclude: int | None = None, eig=None):
+        """Lowest energy with each trial added (to the basis without `exclude`), and the rows."""
+        A = np.array([t[0] for t in trials])
+        c_A = np.full(len(trials), self.basis.c_A[0] if len(self.basis) else trials[0][2])
+        rows, diag = self.rep.rows(A, c_A, self.basis.A, self.basis.c_A)
+        H = rows["T_ti"] + rows["V"]
+        S = rows["S"]
+        keep = np.ones(len(self.basis), bool)
+        if exclude is not None:
+            keep[exclude] = False
+        E, C = (eig.energies, eig.vectors) if eig is not None else (
+            (self.eig.energies, self.eig.vectors) if self.eig is not None else (np.zeros(0), np.zeros((0, 0))))
+        energies = np.array([
+            eigen.lowest_with_added(E, C, H[t, keep], S[t, keep], diag[t, 2] + diag[t, 3], diag[t, 0])
+            for t in range(len(trials))
+        ])
+        return energies, rows, diag
+
+    def put(self, i: int, A, c_A, channel, row, d):
+        """Append (i == len) or replace function i, updating the matrices from its row."""
+        nb = len(self.basis)
+        values = {"S": d[0], "T": d[1], "T_ti": d[2], "V": d[3]}
+        if i == nb:
+            self.basis.append(A, c_A, channel)
+            for k in self.m:
+                M = np.zeros((nb + 1, nb + 1))
+                M[:nb, :nb] = self.m[k]
+                M[nb, :nb] = M[:nb, nb] = row[k]
+                M[nb, nb] = values[k]
+                self.m[k] = M
+        else:
+            self.basis.replace(i, A, c_A, channel)
+            for k in self.m:
+                r = row[k].copy()
+                r[i] = values[k]
+                self.m[k][i, :] = r
+                self.m[k][:, i] = r
+        self.solve()
+
+
+def optimise(system: System, opts: Optimiser, out: Path | None = None, basis: Basis | None = None,
+             progress: bool = True) -> Basis:
+    """Grow a basis to `opts.size` by competitive selection, then run `opts.sweeps` replacement sweeps."""
+    rng = np.random.default_rng(opts.seed)
+    sampler = Sampler(system, opts, rng)
+    rep = laboratory(system)
+    st = State(basis or Basis.empty(system), rep, opts.threshold)
+    report = Reporter(opts, progress)
+
+    def checkpoint():
+        if out is not None:
+            st.basis.coefficients = st.eig.vectors[:, 0]
+            st.basis.save(Path(out) / "basis.json", {"energy": st.energy, "optimiser": vars(opts) | {
+                "length_range": list(opts.length_range)}})
+
+    def draw(k):
+        return [(*sampler.draw(), opts.c_A) for _ in range(k)]
+
+    with report:
+        while len(st.basis) < opts.size:
+            trials = draw(opts.trials)
+            energies, rows, diag = st.candidates(trials)
+            best = int(np.argmin(energies))
+            report.trials(len(trials))
+            if np.isfinite(energies[best]) and energies[best] < st.energy:
+                old = st.energy
+                A, ch, c = trials[best]
+                st.put(len(st.basis), A, c, ch, {k: v[best] for k, v in rows.items()}, diag[best])
+                checkpoint()
+                report.step(st, old)
+        for sweep in range(opts.sweeps):
+            for i in range(len(st.basis)):
+                keep = np.arange(len(st.basis)) != i
+                sub = eigen.solve((st.m["T_ti"] + st.m["V"])[np.ix_(keep, keep)], st.m["S"][np.ix_(keep, keep)],
+                                  opts.threshold)
+                trials = draw(opts.trials)
+                energies, rows, diag = st.candidates(trials, exclude=i, eig=sub)
+                report.trials(len(trials))
+                best = int(np.argmin(energies))
+                if np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
+                    old = st.energy
+                    A, ch, c = trials[best]
+                    st.put(i, A, c, ch, {k: v[best] for k, v in rows.items()}, diag[best])
+                    checkpoint()
+                    report.step(st, old, sweep=sweep + 1)
+    st.basis.coefficients = st.eig.vectors[:, 0]
+    return st.basis
+
+
+class Reporter:
+    """A live line: basis size, energy, last improvement, virial, trials per second."""
+
+    def __init__(self, opts: Optimiser, enabled: bool):
+        self.opts, self.enabled = opts, enabled
+        self.n_trials, self.t0 = 0, time.perf_counter()
+        self.progress = None
+
+    def __enter__(self):
+        if self.enabled:
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+            self.progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                                     TimeElapsedColumn(), TextColumn("{task.fields[info]}"))
+            self.progress.__enter__()
+            self.task = self.progress.add_task("growing", total=self.opts.size, info="")
+        return self
+
+    def __exit__(self, *exc):
+        if self.progress is not None:
+            self.progress.__exit__(*exc)
+
+    def trials(self, k):
+        self.n_trials += k
+
+    def step(self, st: State, old: float, sweep: int = 0):
+        if self.progress is None:
+            return
+        rate = self.n_trials / max(time.perf_counter() - self.t0, 1e-9)
+        gain = old - st.energy if np.isfinite(old) else float("nan")
+        info = f"E = {st.energy:.12f}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.0f} trials/s"
+        if sweep:
+            self.progress.update(self.task, description=f"sweep {sweep}", info=info)
+        else:
+            self.progress.update(self.task, completed=len(st.basis), info=info)

@@ -1,0 +1,87 @@
+"""Named particles with CODATA 2018 masses (electron masses), charges (e) and spins (hbar).
+
+Source: E. Tiesinga et al., CODATA 2018, Rev. Mod. Phys. 93, 025010 (2021):
+m_p/m_e, m_d/m_e, m_t/m_e, m_mu/m_e, m_alpha/m_e, m_h/m_e (helion = 3He nucleus).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+from .errors import InputError
+
+
+@dataclass(frozen=True)
+class Particle:
+    """A point particle: `mass` in m_e, `charge` in e, `spin` in hbar (0, 1/2, 1, ...)."""
+
+    name: str
+    mass: float
+    charge: float
+    spin: Fraction
+
+    def __post_init__(self):
+        if not isinstance(self.mass, (int, float)) or not self.mass > 0 or self.mass == float("inf"):
+            raise InputError(f"particle {self.name!r}: mass must be a positive finite number, got {self.mass!r}")
+        spin = Fraction(self.spin).limit_denominator(2)
+        if spin < 0 or spin.denominator not in (1, 2) or abs(float(spin) - float(self.spin)) > 1e-12:
+            raise InputError(f"particle {self.name!r}: spin must be 0, 1/2, 1, 3/2, ..., got {self.spin!r}")
+        object.__setattr__(self, "spin", spin)
+        object.__setattr__(self, "mass", float(self.mass))
+        object.__setattr__(self, "charge", float(self.charge))
+
+    @property
+    def fermion(self) -> bool:
+        return self.spin.denominator == 2
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "mass": self.mass, "charge": self.charge, "spin": float(self.spin)}
+
+
+_h = Fraction(1, 2)
+#: name -> (mass / m_e, charge / e, spin / hbar), CODATA 2018.
+KNOWN = {
+    "e": (1.0, -1.0, _h),
+    "e+": (1.0, 1.0, _h),
+    "p": (1836.15267343, 1.0, _h),
+    "pbar": (1836.15267343, -1.0, _h),
+    "d": (3670.48296788, 1.0, Fraction(1)),
+    "t": (5496.92153573, 1.0, _h),
+    "mu": (206.7682830, -1.0, _h),
+    "mu+": (206.7682830, 1.0, _h),
+    "he3": (5495.88528007, 2.0, _h),
+    "alpha": (7294.29954142, 2.0, Fraction(0)),
+}
+ALIASES = {"e-": "e", "electron": "e", "positron": "e+", "proton": "p", "deuteron": "d",
+           "triton": "t", "muon": "mu", "mu-": "mu", "helion": "he3", "he4": "alpha"}
+
+
+def particle(spec) -> Particle:
+    """A particle from a name (`"p"`) or a mapping (`{name, mass?, charge?, spin?}`).
+
+    A known name supplies defaults that explicit keys override; an unknown name
+    must give mass, charge and spin explicitly.
+    """
+    if isinstance(spec, Particle):
+        return spec
+    if isinstance(spec, str):
+        spec = {"name": spec}
+    if not isinstance(spec, dict) or "name" not in spec:
+        raise InputError(f"a particle is a name or a table with a 'name' key, got {spec!r}")
+    unknown_keys = set(spec) - {"name", "mass", "charge", "spin"}
+    if unknown_keys:
+        raise InputError(f"particle {spec['name']!r}: unknown keys {sorted(unknown_keys)}")
+    name = str(spec["name"])
+    key = ALIASES.get(name, name)
+    if key in KNOWN:
+        mass, charge, spin = KNOWN[key]
+    else:
+        missing = [k for k in ("mass", "charge", "spin") if k not in spec]
+        if missing:
+            raise InputError(
+                f"unknown particle {name!r}: give {', '.join(missing)} explicitly "
+                f"or use one of {', '.join(sorted(KNOWN))}"
+            )
+        mass, charge, spin = spec["mass"], spec["charge"], spec["spin"]
+        key = name
+    return Particle(key, spec.get("mass", mass), spec.get("charge", charge), Fraction(spec.get("spin", spin)))

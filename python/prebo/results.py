@@ -1,0 +1,55 @@
+"""Energies of a basis: translation-free and laboratory-frame, with the virial coefficient.
+
+result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_lab
+(with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential, n_basis,
+basis_type, particles, state, symmetry, coordinates, overlap_condition, kept.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import eigen
+from .basis import Basis
+from .integrals import laboratory, require_shared_c_A, translationally_invariant
+
+
+def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -> dict:
+    """Evaluate a basis; `coordinates="ti"` uses TICC (only for one shared c_A)."""
+    system = basis.system
+    if coordinates == "lab":
+        m = laboratory(system).matrices(basis.A, basis.c_A)
+        lab = eigen.solve(m["T"] + m["V"], m["S"], threshold)
+        energy_lab = float(lab.energies[0])
+    elif coordinates == "ti":
+        c_A = require_shared_c_A(basis.c_A)
+        m = translationally_invariant(system).matrices(basis.A, basis.c_A)
+        energy_lab = None  # filled below: CM factor exp(-c_A X^2) common to all functions
+    else:
+        raise ValueError(f"coordinates must be 'lab' or 'ti', not {coordinates!r}")
+    ti = eigen.solve(m["T_ti"] + m["V"], m["S"], threshold)
+    c = ti.vectors[:, 0]
+    kinetic, potential = float(c @ m["T_ti"] @ c), float(c @ m["V"] @ c)
+    energy = float(ti.energies[0])
+    if energy_lab is None:
+        energy_lab = energy + 1.5 * c_A / system.m_total
+    return {
+        "energy": energy,
+        "energy_lab": energy_lab,
+        "virial": abs(1.0 + potential / (2.0 * kinetic)),
+        "kinetic": kinetic,
+        "potential": potential,
+        "n_basis": len(basis),
+        "basis_type": basis.kind,
+        "particles": [p.to_dict() for p in system.particles],
+        "state": system.to_dict()["state"],
+        "symmetry": system.symmetriser.as_dict(),
+        "coordinates": coordinates,
+        "overlap_condition": ti.overlap_condition,
+        "kept": ti.kept,
+        "coefficients": c,
+    }
+
+
+def public(result: dict) -> dict:
+    """The JSON-ready part of a result (no arrays)."""
+    return {k: v for k, v in result.items() if not isinstance(v, np.ndarray)}

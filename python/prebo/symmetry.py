@@ -1,0 +1,178 @@
+"""Permutational symmetry: spin-projected Young operators as coefficients over permutations.
+
+For each group of identical particles with spin s and total spin S we build one
+spin function chi_{S, M=S} by sequential angular-momentum coupling
+[[[s s]_{S_12} s]_{S_123} ...]_S, taking at each step the smallest intermediate
+spin from which S can still be reached. The (anti)symmetrised matrix element is
+(Suzuki & Varga, Lect. Notes Phys. m54, sec. 2.3)
+
+    <A phi_I chi | O | A phi_J chi> ∝ sum_P c_P <phi_I | O | P phi_J>,
+    c_P = sign(P)^(2s) <chi | P chi>,
+
+with sign(P) applied to fermions only. One spin function per group suffices
+because the spatial functions are not restricted. c_P = c_{P^-1}, so the
+matrices are symmetric. Groups multiply: the operations are the direct product
+of the groups' permutations.
+"""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from fractions import Fraction
+from math import factorial, sqrt
+
+import numpy as np
+
+from .errors import SpinError
+
+
+def clebsch_gordan(j1: Fraction, m1: Fraction, j2: Fraction, m2: Fraction, j: Fraction, m: Fraction) -> float:
+    """<j1 m1 j2 m2 | j m> by Racah's formula (Condon–Shortley phases)."""
+    if m1 + m2 != m or not abs(j1 - j2) <= j <= j1 + j2 or max(abs(m1), abs(m2), abs(m)) > max(j1, j2, j):
+        return 0.0
+    if abs(m1) > j1 or abs(m2) > j2 or abs(m) > j:
+        return 0.0
+    f = lambda x: factorial(int(x))  # noqa: E731  (all arguments are non-negative integers here)
+    pre = (2 * j + 1) * f(j1 + j2 - j) * f(j1 - j2 + j) * f(-j1 + j2 + j) / f(j1 + j2 + j + 1)
+    pre *= f(j + m) * f(j - m) * f(j1 - m1) * f(j1 + m1) * f(j2 - m2) * f(j2 + m2)
+    total = 0.0
+    for k in range(0, int(j1 + j2 - j) + 1):
+        args = [k, j1 + j2 - j - k, j1 - m1 - k, j2 + m2 - k, j - j2 + m1 + k, j - j1 - m2 + k]
+        if any(a < 0 for a in args):
+            continue
+        den = 1
+        for a in args:
+            den *= f(a)
+        total += (-1) ** k / den
+    return sqrt(pre) * total
+
+
+def coupling_path(s: Fraction, n: int, S: Fraction) -> list[Fraction]:
+    """Intermediate spins S_1 = s, S_2, ..., S_n = S, smallest first; SpinError if S is impossible."""
+
+    def search(path):
+        if len(path) == n:
+            return path if path[-1] == S else None
+        lo, hi = abs(path[-1] - s), path[-1] + s
+        k = lo
+        while k <= hi:
+            found = search(path + [k])
+            if found:
+                return found
+            k += 1
+        return None
+
+    path = search([s]) if n >= 1 else None
+    if path is None:
+        raise SpinError(f"{n} particles of spin {s} cannot couple to total spin {S}")
+    return path
+
+
+def lowest_total_spin(s: Fraction, n: int) -> Fraction:
+    """The smallest total spin n particles of spin s can form (0 or 1/2 for spin 1/2)."""
+    S = Fraction((n * s.numerator * (2 // s.denominator)) % 2, 2)
+    while True:
+        try:
+            coupling_path(s, n, S)
+            return S
+        except SpinError:
+            S += 1
+
+
+def spin_function(s: Fraction, n: int, S: Fraction) -> np.ndarray:
+    """chi_{S, M=S} of n spin-s particles as a tensor of shape (2s+1,)*n (index 0 is m = s)."""
+    path = coupling_path(s, n, S)
+    d = int(2 * s + 1)
+    ms = [s - k for k in range(d)]
+    # states[M] = vector over the first k particles with total spin path[k-1], projection M
+    states = {m: np.eye(d)[i] for i, m in enumerate(ms)}
+    for k in range(1, n):
+        J0, J = path[k - 1], path[k]
+        new = {}
+        M = -J
+        while M <= J:
+            v = np.zeros(d ** (k + 1))
+            for M0, vec in states.items():
+                for i, m in enumerate(ms):
+                    c = clebsch_gordan(J0, M0, s, m, J, M)
+                    if c:
+                        v += c * np.kron(vec, np.eye(d)[i])
+            new[M] = v
+            M += 1
+        states = new
+    return states[S].reshape((d,) * n)
+
+
+@dataclass(frozen=True)
+class Group:
+    """Identical particles: their indices in the system, spin s, fermion or boson, total spin S."""
+
+    name: str
+    indices: tuple[int, ...]
+    spin: Fraction
+    total_spin: Fraction
+
+    @property
+    def fermion(self) -> bool:
+        return self.spin.denominator == 2
+
+    def coefficients(self) -> dict[tuple[int, ...], float]:
+        """c_P for every permutation P of the group (as a tuple of positions 0..n-1)."""
+        n = len(self.indices)
+        chi = spin_function(self.spin, n, self.total_spin)
+        out = {}
+        for p in itertools.permutations(range(n)):
+            overlap = float(np.sum(chi * np.transpose(chi, p)))
+            sign = permutation_sign(p) if self.fermion else 1
+            c = sign * overlap
+            if abs(c) > 1e-14:
+                out[p] = c
+        return out
+
+
+def permutation_sign(p) -> int:
+    """(-1)^(number of inversions)."""
+    p = list(p)
+    sign = 1
+    for i in range(len(p)):
+        for j in range(i + 1, len(p)):
+            if p[i] > p[j]:
+                sign = -sign
+    return sign
+
+
+@dataclass(frozen=True)
+class Symmetriser:
+    """The Young operator of a system as LFCC permutation matrices and coefficients.
+
+    `matrices[k]` is Pi with (Pi r)_i = r_{p(i)}, so P phi(r) = phi(Pi r) and A -> Pi^T A Pi.
+    """
+
+    permutations: tuple[tuple[int, ...], ...]
+    coefficients: tuple[float, ...]
+
+    @classmethod
+    def from_groups(cls, n: int, groups: list[Group]) -> "Symmetriser":
+        perms, coefs = [tuple(range(n))], [1.0]
+        for g in groups:
+            new_p, new_c = [], []
+            for gp, gc in g.coefficients().items():
+                for p, c in zip(perms, coefs):
+                    q = list(p)
+                    for pos, src in enumerate(gp):
+                        q[g.indices[pos]] = p[g.indices[src]]
+                    new_p.append(tuple(q))
+                    new_c.append(c * gc)
+            perms, coefs = new_p, new_c
+        return cls(tuple(perms), tuple(coefs))
+
+    @property
+    def matrices(self) -> np.ndarray:
+        n = len(self.permutations[0])
+        out = np.zeros((len(self.permutations), n, n))
+        for k, p in enumerate(self.permutations):
+            out[k, np.arange(n), list(p)] = 1.0
+        return out
+
+    def as_dict(self) -> dict:
+        return {"permutations": [list(p) for p in self.permutations], "coefficients": list(self.coefficients)}
