@@ -1,0 +1,92 @@
+"""Command line: `prebo run`, `prebo energy`. Errors print one line and exit 2, never a traceback."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+from .errors import PreboError
+
+
+def _print_result(r: dict) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    t = Table(show_header=False, box=None)
+    t.add_row("energy (translation-free)", f"{r['energy']:.12f} Eh")
+    if r.get("energy_lab") is not None:
+        t.add_row("energy (laboratory frame)", f"{r['energy_lab']:.12f} Eh")
+    t.add_row("virial η_TI", f"{r['virial']:.2e}")
+    t.add_row("basis", f"{r['n_basis']} {r['basis_type']} functions")
+    t.add_row("particles", " ".join(p["name"] for p in r["particles"]))
+    t.add_row("overlap condition", f"{r['overlap_condition']:.2e} ({r['kept']} kept)")
+    Console().print(t)
+
+
+def cmd_run(args) -> int:
+    from . import inputs
+    from .basis import write_json_atomic
+    from .optimise import optimise
+    from .results import evaluate, public
+
+    job = inputs.load(args.input)
+    out = Path(args.out or Path("runs") / Path(args.input).stem)
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    basis = optimise(job.system, job.optimiser, out=out, progress=not args.quiet)
+    r = public(evaluate(basis))
+    r |= {"title": job.title, "wall_seconds": time.perf_counter() - t0, "input": str(args.input)}
+    basis.save(out / "basis.json", {"energy": r["energy"]})
+    write_json_atomic(out / "result.json", r)
+    if not args.quiet:
+        _print_result(r)
+        print(f"wrote {out / 'result.json'} and {out / 'basis.json'}")
+    return 0
+
+
+def cmd_energy(args) -> int:
+    from .basis import Basis
+    from .results import evaluate, public
+
+    basis = Basis.load(args.basis)
+    r = public(evaluate(basis, coordinates=args.coordinates))
+    if args.json:
+        print(json.dumps(r))
+    else:
+        _print_result(r)
+    return 0
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="prebo", description="pre-Born–Oppenheimer ECG solver")
+    sub = p.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="optimise a basis for the system of a TOML input")
+    run.add_argument("input", help="TOML input file")
+    run.add_argument("--out", help="output folder (default runs/INPUT-STEM)")
+    run.add_argument("--quiet", action="store_true", help="no progress display")
+    run.set_defaults(func=cmd_run)
+    en = sub.add_parser("energy", help="re-evaluate a stored basis")
+    en.add_argument("basis", help="basis.json")
+    en.add_argument("--coordinates", choices=["lab", "ti"], default="lab",
+                    help="lab: LFCC with CM elimination (default); ti: translationally invariant (shared c_A only)")
+    en.add_argument("--json", action="store_true", help="print one JSON object")
+    en.set_defaults(func=cmd_energy)
+    return p
+
+
+def main(argv=None) -> int:
+    args = parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except PreboError as exc:
+        print(f"prebo: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("prebo: interrupted (the last accepted step is saved)", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,123 @@
+"""The command line: a full run, re-evaluation, and clear one-line errors (exit 2, no traceback)."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+REQUIRED = {"energy", "energy_lab", "virial", "n_basis", "basis_type", "particles", "symmetry"}
+
+
+def prebo(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "prebo", *map(str, args)], capture_output=True, text=True, cwd=cwd)
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("run")
+    (d / "h.toml").write_text(
+        '[system]\nparticles = ["p", "e"]\n[basis]\nsize = 6\n[optimiser]\ntrials = 8\nseed = 3\n'
+    )
+    r = prebo("run", d / "h.toml", "--out", d / "out", "--quiet")
+    assert r.returncode == 0, r.stderr
+    return d / "out"
+
+
+def test_run_writes_result_and_basis(run_dir):
+    result = json.loads((run_dir / "result.json").read_text())
+    assert REQUIRED <= set(result)
+    assert result["n_basis"] == 6 and result["basis_type"] == "pecg"
+    assert [p["name"] for p in result["particles"]] == ["p", "e"]
+    m = 1836.15267343
+    assert -0.5 * m / (1 + m) < result["energy"] < -0.49  # variational, and a real optimisation
+    basis = json.loads((run_dir / "basis.json").read_text())
+    assert basis["format"] == "prebo-basis" and len(basis["functions"]) == 6
+    assert {"A", "c_A", "channel"} <= set(basis["functions"][0])
+
+
+@pytest.mark.parametrize("coordinates", ["lab", "ti"])
+def test_energy_json_reproduces_the_run(run_dir, coordinates):
+    r = prebo("energy", run_dir / "basis.json", "--coordinates", coordinates, "--json")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert REQUIRED <= set(out)
+    ref = json.loads((run_dir / "result.json").read_text())
+    assert out["energy"] == pytest.approx(ref["energy"], rel=1e-12)
+    assert out["energy_lab"] == pytest.approx(ref["energy_lab"], rel=1e-12)
+
+
+def test_same_seed_same_basis(run_dir, tmp_path):
+    r = prebo("run", run_dir.parent / "h.toml", "--out", tmp_path, "--quiet")
+    assert r.returncode == 0
+    a = json.loads((run_dir / "basis.json").read_text())["functions"]
+    b = json.loads((tmp_path / "basis.json").read_text())["functions"]
+    assert a == b
+
+
+def assert_clean_error(r, *words):
+    assert r.returncode == 2, (r.returncode, r.stdout, r.stderr)
+    assert "Traceback" not in r.stderr
+    assert r.stderr.startswith("prebo: error:")
+    for w in words:
+        assert w in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("particles, state, words", [
+    ('["p", "xyz"]', "", ["unknown particle 'xyz'"]),
+    ('[{name = "p", mass = -3.0}, "e"]', "", ["mass must be a positive"]),
+    ('[{name = "p", mass = 0}, "e"]', "", ["mass must be a positive"]),
+    ('["alpha", "e", "e", "e"]', "[state]\nspin = { e = 1 }\n", ["cannot couple to total spin 1"]),
+    ('["p", "e", "e"]', "[state]\nspin = { e = 0.3 }\n", ["cannot couple"]),
+    ('["p", "e"]', "[state]\nN = 1\n", ["N = 0"]),
+])
+def test_bad_input_gives_a_clear_error(tmp_path, particles, state, words):
+    f = tmp_path / "bad.toml"
+    f.write_text(f"[system]\nparticles = {particles}\n{state}[basis]\nsize = 2\n")
+    assert_clean_error(prebo("run", f, "--out", tmp_path / "o", "--quiet"), str(f), *words)
+
+
+def test_malformed_toml(tmp_path):
+    f = tmp_path / "bad.toml"
+    f.write_text("[system\nparticles = 3")
+    assert_clean_error(prebo("run", f, "--quiet"), "not valid TOML")
+
+
+def _edit_basis(run_dir, tmp_path, edit):
+    d = json.loads((run_dir / "basis.json").read_text())
+    edit(d)
+    f = tmp_path / "basis.json"
+    f.write_text(json.dumps(d))
+    return f
+
+
+def test_non_positive_definite_A(run_dir, tmp_path):
+    def edit(d):
+        # subtracting a large multiple of (e_1 - e_2)(e_1 - e_2)^T keeps A 1 = c_A m/m_tot but breaks definiteness
+        A = np.array(d["functions"][2]["A"])
+        d["functions"][2]["A"] = (A - 5.0 * abs(A).max() * np.array([[1, -1], [-1, 1]])).tolist()
+    assert_clean_error(prebo("energy", _edit_basis(run_dir, tmp_path, edit)), "function 2", "not positive definite")
+
+
+def test_truncated_and_corrupt_basis_files(run_dir, tmp_path):
+    text = (run_dir / "basis.json").read_text()
+    f = tmp_path / "trunc.json"
+    f.write_text(text[: len(text) // 2])
+    assert_clean_error(prebo("energy", f), "corrupt or truncated")
+    g = _edit_basis(run_dir, tmp_path, lambda d: d["functions"][1].pop("A"))
+    assert_clean_error(prebo("energy", g), "malformed")
+    h = _edit_basis(run_dir, tmp_path, lambda d: d.update(format="other"))
+    assert_clean_error(prebo("energy", h), "not a prebo basis file")
+    assert_clean_error(prebo("energy", tmp_path / "missing.json"), "cannot read")
+
+
+def test_ti_refuses_a_basis_with_unequal_c_A(run_dir, tmp_path):
+    def edit(d):
+        f = d["functions"][0]
+        m = np.array([p["mass"] for p in d["system"]["particles"]])
+        cm = m / m.sum()
+        f["A"] = (np.array(f["A"]) + 0.5 * np.outer(cm, cm)).tolist()
+        f["c_A"] += 0.5
+    f = _edit_basis(run_dir, tmp_path, edit)
+    assert prebo("energy", f).returncode == 0  # the laboratory-frame elimination takes it
+    assert_clean_error(prebo("energy", f, "--coordinates", "ti"), "not separable in the CM coordinate")

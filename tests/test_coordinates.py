@@ -1,0 +1,94 @@
+"""Coordinate sets: defining conditions (paper eqs. Uconstraint1-2), closure (eq. 1recasted),
+the mass-matrix block structure (eq. 2genconstr) and parameter transformations."""
+import numpy as np
+import pytest
+
+import prebo
+from prebo.coordinates import all_sets, by_name, cm_centred, heavy_particle_centred, jacobi
+from prebo.errors import InputError, SeparabilityError
+
+MASSES = {3: np.array([1836.15, 1.0, 1.0]), 4: np.array([1836.15, 1836.15, 1.0, 1.0]),
+          5: np.array([7294.3, 1.0, 1.0, 1.0, 206.77])}
+
+
+@pytest.mark.parametrize("n", sorted(MASSES))
+def test_every_set_satisfies_the_defining_conditions(n):
+    m = MASSES[n]
+    sets = all_sets(m)
+    from math import factorial
+    assert len(sets) == factorial(n) // 2 + n + 1
+    for x in sets:
+        x.check(m)
+        assert np.allclose(x.U[:-1].sum(axis=1), 0, atol=1e-14)
+        assert np.allclose(x.U[-1], m / m.sum(), atol=1e-15)
+        assert by_name(m, x.name).name == x.name
+
+
+@pytest.mark.parametrize("n", sorted(MASSES))
+def test_closure_and_mass_matrix_blocks(n):
+    """U_y U_x^-1 = blockdiag(𝒰, 1) and U_y M U_x^T = blockdiag(., 1/(2 m_tot))."""
+    m = MASSES[n]
+    M = np.diag(1 / (2 * m))
+    sets = all_sets(m)
+    for x, y in zip(sets, sets[::-1]):
+        W = y.U @ x.U_inv
+        assert np.allclose(W[-1, :-1], 0, atol=1e-12) and np.allclose(W[:-1, -1], 0, atol=1e-12)
+        assert W[-1, -1] == pytest.approx(1.0)
+        K = y.U @ M @ x.U.T
+        assert np.allclose(K[-1, :-1], 0, atol=1e-15) and np.allclose(K[:-1, -1], 0, atol=1e-15)
+        assert K[-1, -1] == pytest.approx(1 / (2 * m.sum()), rel=1e-13)
+
+
+def test_two_particle_mu_is_the_reduced_mass():
+    m = np.array([1836.15267343, 1.0])
+    mu = jacobi(m).mu(np.diag(1 / (2 * m)))
+    assert mu[0, 0] == pytest.approx(0.5 / (m[0] / (1 + m[0])), rel=1e-14)
+
+
+def test_jacobi_definition():
+    """x_i = Σ_{j<=i} m_j r_j / m_{1..i} - r_{i+1} (paper eq. Jac-TICC) for order (2, 0, 1)."""
+    m = np.array([2.0, 3.0, 5.0])
+    r = np.random.default_rng(0).normal(size=3)
+    x = jacobi(m, (2, 0, 1)).U @ r
+    assert x[0] == pytest.approx(r[2] - r[0])
+    assert x[1] == pytest.approx((m[2] * r[2] + m[0] * r[0]) / (m[2] + m[0]) - r[1])
+    assert x[2] == pytest.approx(m @ r / m.sum())
+
+
+def test_parameters_transform_both_ways():
+    m = MASSES[4]
+    rng = np.random.default_rng(1)
+    for x in all_sets(m):
+        L = np.tril(rng.normal(size=(3, 3)))
+        A_int = L @ L.T + np.eye(3)
+        A_r = x.to_lab(A_int, 0.8)
+        assert np.allclose(A_r.sum(axis=1), 0.8 * m / m.sum())  # A 1 = c_A m/m_tot
+        back, c = x.from_lab(A_r)
+        assert np.allclose(back, A_int, rtol=1e-10) and c == pytest.approx(0.8)
+        y = hpc = heavy_particle_centred(m, 0)
+        other, c2 = y.from_lab(A_r)  # same function seen in another set: same c_A
+        assert c2 == pytest.approx(0.8) and np.all(np.linalg.eigvalsh(other) > 0)
+        u_r = rng.normal(size=4)
+        u_x = x.transform_vectors_to_x(u_r)
+        assert np.allclose(x.U.T @ u_x, u_r)  # u^(r) = U^T u^(x)
+    del hpc
+
+
+def test_non_separable_exponent_is_detected():
+    m = MASSES[3]
+    x = cm_centred(m)
+    A = x.to_lab(np.eye(2), 1.0)
+    A[0, 0] += 0.1
+    with pytest.raises(SeparabilityError):
+        x.from_lab(A)
+
+
+def test_bad_sets_are_refused():
+    m = MASSES[3]
+    with pytest.raises(InputError):
+        jacobi(m, (0, 0, 1))
+    with pytest.raises(InputError):
+        by_name(m, "polar:1")
+    bad = prebo.CoordinateSet("bad", np.eye(3))
+    with pytest.raises(InputError, match="does not sum to zero"):
+        bad.check(m)
