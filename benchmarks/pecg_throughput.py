@@ -28,11 +28,11 @@ def measure(case: str) -> dict:
     system = prebo.System(particles, spin=spin)
     basis = random_basis(system, NB, np.random.default_rng(0), c_A=1.0)
     rep = laboratory(system)
-    rep.matrices(basis.A[:10], basis.c_A[:10])  # warm-up
+    rep.matrices(basis.subset(slice(0, 10)))  # warm-up
     best = float("inf")
     for _ in range(3):
         t0 = time.perf_counter()
-        rep.matrices(basis.A, basis.c_A)
+        rep.matrices(basis)
         best = min(best, time.perf_counter() - t0)
     terms = NB * (NB + 1) / 2 * len(rep.sym_c)
     return {"case": case, "nb": NB, "n_sym": len(rep.sym_c), "seconds": best, "M_terms_per_s": terms / best / 1e6}

@@ -16,7 +16,7 @@ def problem():
     system = prebo.System(["p", "e", "e"], spin={"e": 0})
     basis = random_basis(system, 10, np.random.default_rng(7), c_A=1.0)
     rep = laboratory(system)
-    m = rep.matrices(basis.A, basis.c_A)
+    m = rep.matrices(basis)
     return system, basis, rep, m
 
 
@@ -44,7 +44,7 @@ def test_secular_update_equals_full_solve(problem):
 
 def test_rows_from_core_agree_with_matrices(problem):
     _, basis, rep, m = problem
-    rows, diag = rep.rows(basis.A[3:5], basis.c_A[3:5], basis.A, basis.c_A)
+    rows, diag = rep.rows(basis.subset([3, 4]), basis)
     for k, name in enumerate(("S", "T", "T_ti", "V")):
         assert np.allclose(rows[name], m[name][3:5], rtol=1e-14, atol=1e-15)
         assert np.allclose(diag[:, k], np.diag(m[name])[3:5], rtol=1e-14)
@@ -56,7 +56,7 @@ def test_duplicate_function_is_handled_without_inverse(problem):
     _, basis, rep, m = problem
     A = np.concatenate([basis.A, basis.A[:1]])
     c = np.concatenate([basis.c_A, basis.c_A[:1]])
-    md = rep.matrices(A, c)
+    md = rep.matrices(prebo.Basis(basis.system, A, c))
     with pytest.raises(np.linalg.LinAlgError):
         scipy.linalg.eigh(md["T_ti"] + md["V"], md["S"])
     sol = eigen.solve(md["T_ti"] + md["V"], md["S"])

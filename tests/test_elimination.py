@@ -29,8 +29,8 @@ def test_eliminated_kinetic_equals_internal_mass_matrix(n):
     system = prebo.System(particles, spin=spin)
     basis = random_basis(system, 12, np.random.default_rng(n))  # mixed channels, unequal c_A
     assert len(set(basis.channels)) > 1 and np.ptp(basis.c_A) > 0.1
-    m = laboratory(system).matrices(basis.A, basis.c_A)
-    internal = laboratory(system, kinetic="internal").matrices(basis.A, basis.c_A)
+    m = laboratory(system).matrices(basis)
+    internal = laboratory(system, kinetic="internal").matrices(basis)
     assert rel(m["T_ti"], internal["T"]) < 1e-12
     # the CM part removed is real: the lab kinetic matrix differs
     assert rel(m["T"], internal["T"]) > 1e-6
@@ -44,9 +44,9 @@ def test_lfcc_equals_ticc_for_shared_c_A(n):
     system = prebo.System(particles, spin=spin)
     # few functions per coordinate keep S well conditioned, so energies compare at 1e-12
     basis = random_basis(system, 4 * (n - 1), np.random.default_rng(10 + n), c_A=0.7)
-    lab = laboratory(system).matrices(basis.A, basis.c_A)
+    lab = laboratory(system).matrices(basis)
     for coords in (jacobi(system.masses), heavy_particle_centred(system.masses, 0)):
-        ti = translationally_invariant(system, coords).matrices(basis.A, basis.c_A)
+        ti = translationally_invariant(system, coords).matrices(basis)
         for k_lab, k_ti in (("S", "S"), ("T_ti", "T"), ("V", "V")):
             assert rel(lab[k_lab], ti[k_ti]) < 1e-12, (coords.name, k_lab)
     sol = eigen.solve(lab["T_ti"] + lab["V"], lab["S"])

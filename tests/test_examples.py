@@ -47,7 +47,9 @@ def test_example_basis(name, references):
         assert masses[particle] == m, f"{name}: {particle} mass differs from the reference's"
     assert r["energy"] > e_exact, f"{name}: {r['energy']} below the exact {e_exact}: a bug"
     stored = json.loads((BASES / name / "result.json").read_text())
-    assert r["energy"] == pytest.approx(stored["energy"], rel=1e-10, abs=0)
+    # the stored energy is reproduced up to rounding amplified by the overlap condition
+    # (up to ~1e13 here): a kernel with another operation order moves it by ~1e-10
+    assert r["energy"] == pytest.approx(stored["energy"], rel=1e-9, abs=0)
     if isinstance(tol, str):
         assert (r["energy"] - e_exact) / abs(e_exact) < float(tol.split(":")[1])
     elif tol is not None:

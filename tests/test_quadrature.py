@@ -226,8 +226,8 @@ def computed(name):
     if name not in _CACHE:
         system = SYSTEMS[name]()
         A, c = make_basis(system, seed=sum(map(ord, name)))
-        lab = laboratory(system).matrices(A, c)
-        internal = laboratory(system, kinetic="internal").matrices(A, c)
+        lab = laboratory(system).matrices(prebo.Basis(system, A, c))
+        internal = laboratory(system, kinetic="internal").matrices(prebo.Basis(system, A, c))
         quadr = quadrature_matrices(system, A, lambdas(system))
         _CACHE[name] = (system, A, c, lab, internal, quadr)
     return _CACHE[name]
@@ -308,7 +308,7 @@ def test_full_six_dimensional_two_particles():
     """No Cartesian factorisation: φ(r) = exp(-Σ_ij A_ij r_i·r_j) integrated over R^6 directly."""
     system = prebo.System([_custom("a", 1.3, 1.0), _custom("b", 0.8, -1.0)])
     A, c = make_basis(system, nb=2, seed=7)
-    lab = laboratory(system).matrices(A, c)
+    lab = laboratory(system).matrices(prebo.Basis(system, A, c))
     I3 = np.eye(3)
     A6 = [np.kron(a, I3) for a in A]  # r = (x1, y1, z1, x2, y2, z2)
     lam6 = np.kron(np.diag(1.0 / (2.0 * system.masses)), I3)

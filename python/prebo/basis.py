@@ -1,6 +1,8 @@
-"""Plain-ECG basis sets in laboratory-frame Cartesian coordinates, and the basis.json format.
+"""ECG basis sets in laboratory-frame Cartesian coordinates, and the basis.json format.
 
-Each function is phi_I(r) = exp(-r^T (A_I ⊗ I_3) r) (docs/conventions.md) with
+A plain ECG ("pecg") is phi_I(r) = exp(-r^T (A_I ⊗ I_3) r) (docs/conventions.md); an
+ECG-GVR function ("ecg-gvr", paper eq. ecg-gvr) multiplies it by |v|^{2K} (v_x + i v_y)^N,
+v = u_I^T r, with the state's N. Exponents are
 A_I = U_x^T blockdiag(𝒜_I, c_A) U_x for the coordinate set ("channel") x it was
 generated in. basis.json (format "prebo-basis", version 1; docs/basis-format.md)
 stores the system, the state, the symmetry, the conventions and, per function,
@@ -29,9 +31,13 @@ CONVENTIONS = {
 }
 
 
+KINDS = ("pecg", "ecg-gvr")
+
+
 @dataclass
 class Basis:
-    """A plain-ECG basis of a system: exponents `A` (nb, n, n) in LFCC, `c_A` (nb), channels (nb)."""
+    """An ECG basis of a system in LFCC: exponents `A` (nb, n, n), `c_A` (nb), channels (nb);
+    for ECG-GVR also global vectors `u` (nb, n) and powers `K` (nb)."""
 
     system: System
     A: np.ndarray
@@ -39,6 +45,8 @@ class Basis:
     channels: list[str] = field(default_factory=list)
     coefficients: np.ndarray | None = None
     kind: str = "pecg"
+    u: np.ndarray | None = None
+    K: np.ndarray | None = None
 
     def __post_init__(self):
         n = self.system.n
@@ -46,27 +54,58 @@ class Basis:
         self.c_A = np.ascontiguousarray(np.asarray(self.c_A, dtype=float).reshape(-1))
         if len(self.c_A) != len(self.A):
             raise InputError(f"basis: {len(self.A)} exponent matrices but {len(self.c_A)} values of c_A")
+        if self.kind not in KINDS:
+            raise InputError(f"basis type {self.kind!r} is not one of {', '.join(KINDS)}")
+        if self.kind == "ecg-gvr":
+            if self.u is None or self.K is None:
+                raise InputError("an ECG-GVR basis needs global vectors u and powers K")
+            self.u = np.ascontiguousarray(np.asarray(self.u, dtype=float).reshape(-1, n))
+            K = np.asarray(self.K).reshape(-1)
+            if len(self.u) != len(self.A) or len(K) != len(self.A):
+                raise InputError(f"basis: {len(self.A)} functions but {len(self.u)} vectors u and {len(K)} powers K")
+            if np.any(K < 0) or np.any(K != np.round(K)):
+                raise InputError("basis: every K must be a non-negative integer")
+            self.K = np.ascontiguousarray(K.astype(np.uint32))
         if not self.channels:
             self.channels = ["unknown"] * len(self.A)
 
     @classmethod
-    def empty(cls, system: System) -> "Basis":
+    def empty(cls, system: System, kind: str = "pecg") -> "Basis":
         n = system.n
-        return cls(system, np.zeros((0, n, n)), np.zeros(0), [])
+        extra = {"u": np.zeros((0, n)), "K": np.zeros(0, np.uint32)} if kind == "ecg-gvr" else {}
+        return cls(system, np.zeros((0, n, n)), np.zeros(0), [], kind=kind, **extra)
 
     def __len__(self) -> int:
         return len(self.A)
 
-    def append(self, A: np.ndarray, c_A: float, channel: str) -> None:
-        self.A = np.concatenate([self.A, A[None]])
-        self.c_A = np.append(self.c_A, c_A)
-        self.channels.append(channel)
+    @property
+    def N(self) -> int:
+        return self.system.state.N
+
+    def subset(self, idx) -> "Basis":
+        """The functions `idx` (indices or mask) as a new basis."""
+        idx = np.arange(len(self))[idx]
+        extra = {"u": self.u[idx], "K": self.K[idx]} if self.kind == "ecg-gvr" else {}
+        return Basis(self.system, self.A[idx], self.c_A[idx], [self.channels[i] for i in idx], kind=self.kind, **extra)
+
+    def append(self, f: "Basis") -> None:
+        """Append the functions of `f` (same system and kind)."""
+        self.A = np.ascontiguousarray(np.concatenate([self.A, f.A]))
+        self.c_A = np.concatenate([self.c_A, f.c_A])
+        if self.kind == "ecg-gvr":
+            self.u = np.ascontiguousarray(np.concatenate([self.u, f.u]))
+            self.K = np.concatenate([self.K, f.K])
+        self.channels += list(f.channels)
         self.coefficients = None
 
-    def replace(self, i: int, A: np.ndarray, c_A: float, channel: str) -> None:
-        self.A[i] = A
-        self.c_A[i] = c_A
-        self.channels[i] = channel
+    def replace(self, i: int, f: "Basis") -> None:
+        """Replace function i by the single function of `f`."""
+        self.A[i] = f.A[0]
+        self.c_A[i] = f.c_A[0]
+        if self.kind == "ecg-gvr":
+            self.u[i] = f.u[0]
+            self.K[i] = f.K[0]
+        self.channels[i] = f.channels[0]
         self.coefficients = None
 
     def validate(self) -> None:
@@ -85,6 +124,8 @@ class Basis:
                 np.linalg.cholesky(A)
             except np.linalg.LinAlgError:
                 raise NotPositiveDefiniteError(f"function {i}: exponent matrix A is not positive definite") from None
+            if self.kind == "ecg-gvr" and not (np.all(np.isfinite(self.u[i])) and np.any(self.u[i] != 0)):
+                raise InputError(f"function {i}: the global vector u must be finite and non-zero")
 
     # --- basis.json ------------------------------------------------------------
     def to_dict(self, extra: dict | None = None) -> dict:
@@ -95,16 +136,19 @@ class Basis:
             "system": self.system.to_dict(),
             "symmetry": self.system.symmetriser.as_dict(),
             "basis_type": self.kind,
-            "functions": [
-                {"A": A.tolist(), "c_A": float(c), "channel": ch}
-                for A, c, ch in zip(self.A, self.c_A, self.channels)
-            ],
+            "functions": [self._function_dict(i) for i in range(len(self))],
         }
         if self.coefficients is not None:
             d["coefficients"] = np.asarray(self.coefficients).tolist()
         if extra:
             d.update(extra)
         return d
+
+    def _function_dict(self, i: int) -> dict:
+        f = {"A": self.A[i].tolist(), "c_A": float(self.c_A[i]), "channel": self.channels[i]}
+        if self.kind == "ecg-gvr":
+            f |= {"u": self.u[i].tolist(), "K": int(self.K[i])}
+        return f
 
     def save(self, path, extra: dict | None = None) -> None:
         """Write atomically: a killed run leaves either the old or the new file, never half of one."""
@@ -116,8 +160,9 @@ class Basis:
             raise BasisFileError(f"{where}: not a prebo basis file (format must be {FORMAT!r})")
         if d.get("version") != VERSION:
             raise BasisFileError(f"{where}: unsupported version {d.get('version')!r} (this prebo reads {VERSION})")
-        if d.get("basis_type") != "pecg":
-            raise BasisFileError(f"{where}: basis type {d.get('basis_type')!r} is not supported by this version")
+        kind = d.get("basis_type")
+        if kind not in KINDS:
+            raise BasisFileError(f"{where}: basis type {kind!r} is not supported by this version")
         try:
             system = System.from_dict(d["system"])
             funcs = d["functions"]
@@ -127,11 +172,15 @@ class Basis:
             channels = [str(f.get("channel", "unknown")) for f in funcs]
             coef = d.get("coefficients")
             coef = None if coef is None else np.asarray(coef, dtype=float)
+            extra = {}
+            if kind == "ecg-gvr":
+                extra = {"u": np.array([f["u"] for f in funcs], dtype=float).reshape(len(funcs), n),
+                         "K": np.array([f["K"] for f in funcs])}
+            basis = cls(system, A, c_A, channels, coef, kind, **extra)
         except PreboError as exc:
             raise BasisFileError(f"{where}: {exc}") from exc
         except (KeyError, TypeError, ValueError) as exc:
             raise BasisFileError(f"{where}: malformed basis data ({type(exc).__name__}: {exc})") from exc
-        basis = cls(system, A, c_A, channels, coef)
         if coef is not None and coef.shape != (len(A),):
             raise BasisFileError(f"{where}: {coef.size} coefficients for {len(A)} functions")
         try:

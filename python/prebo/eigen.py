@@ -72,13 +72,15 @@ def lowest_with_added(E, C, h, s, h_nn, s_nn, min_norm: float = 1e-10) -> float:
     x = lo
     for _ in range(200):
         fx = f(x)
+        if fx == 0.0 or hi - lo < 1e-15 * max(1.0, abs(x)):
+            break
         if fx > 0:
             lo = x
         else:
             hi = x
-        dfx = -1.0 - np.sum(gamma2 / (E - x) ** 2)
-        step = x - fx / dfx
+        # Newton (f is concave and decreasing below E_0), bisection when it leaves the bracket
+        step = x - fx / (-1.0 - np.sum(gamma2 / (E - x) ** 2))
         x = step if lo < step < hi else 0.5 * (lo + hi)
-        if hi - lo < 1e-15 * max(1.0, abs(x)) or abs(fx) < 1e-16:
+        if abs(step - x) == 0.0 and abs(fx) < 1e-15 * max(1.0, abs(x)):
             break
     return float(x)

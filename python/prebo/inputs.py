@@ -2,7 +2,7 @@
 
     [system]     particles = ["p", "e", {name = "x", mass = 3.0, charge = 1, spin = 0.5}]   -> System
     [state]      N = 0, parity = 1, spin = {e = 0}                                          -> State
-    [basis]      type = "pecg", size = 100, c_A = 1.0                                        -> Optimiser.size, .c_A
+    [basis]      type = "pecg" | "ecg-gvr", size = 100, c_A = 1.0, K_max = 20               -> Optimiser.kind, .size, .c_A, .K_max
     [optimiser]  trials = 20, sweeps = 1, seed = 1, channels = "pairs", length_range = [0.01, 15]
 """
 from __future__ import annotations
@@ -15,7 +15,7 @@ from .errors import InputError
 from .optimise import Optimiser
 from .system import State, System
 
-BASIS_TYPES = ("pecg",)
+BASIS_TYPES = ("pecg", "ecg-gvr")
 
 
 @dataclass
@@ -43,8 +43,9 @@ def from_dict(d: dict) -> Job:
         raise InputError(f"unknown tables {sorted(unknown)}")
     system_t = _table(d, "system", {"particles"})
     state_t = _table(d, "state", {"N", "parity", "spin"})
-    basis_t = _table(d, "basis", {"type", "size", "c_A"})
-    opt_t = _table(d, "optimiser", {"trials", "sweeps", "seed", "channels", "length_range"})
+    basis_t = _table(d, "basis", {"type", "size", "c_A", "K_max"})
+    opt_t = _table(d, "optimiser", {"trials", "sweeps", "refine", "refine_evaluations", "seed", "channels",
+                                    "length_range"})
     if "particles" not in system_t:
         raise InputError("[system] needs 'particles'")
     system = System(system_t["particles"], State(**state_t))
@@ -53,7 +54,10 @@ def from_dict(d: dict) -> Job:
         raise InputError(f"[basis] type {kind!r} is not available (available: {', '.join(BASIS_TYPES)})")
     if kind == "pecg" and (system.state.N != 0 or system.state.parity != 1):
         raise InputError("plain ECGs describe N = 0, parity +1 states only")
-    kw = {k: basis_t[k] for k in ("size", "c_A") if k in basis_t} | opt_t
+    if kind == "ecg-gvr" and system.state.parity != (-1) ** system.state.N:
+        raise InputError(f"ECG-GVR functions have natural parity (-1)^N = {(-1) ** system.state.N:+d}, "
+                         f"not {system.state.parity:+d}")
+    kw = {k: basis_t[k] for k in ("size", "c_A", "K_max") if k in basis_t} | opt_t | {"kind": kind}
     if "length_range" in kw:
         kw["length_range"] = tuple(kw["length_range"])
     try:

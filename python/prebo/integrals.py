@@ -7,7 +7,9 @@
 - `translationally_invariant(system, coords)`: TICC of a coordinate set x, kinetic
   matrix μ, exponents 𝒜 (possible only when every function shares one c_A).
 
-Each representation returns dict(S, T, T_ti, V) of normalised functions.
+Each representation returns dict(S, T, T_ti, V) of normalised functions, for plain ECGs
+(`_core.matrices`) or ECG-GVR functions (`_core.gvr_matrices`, the state's N), whichever the
+basis holds.
 """
 from __future__ import annotations
 
@@ -33,23 +35,40 @@ class Representation:
     cm_mass: float | None
     coords: CoordinateSet | None = None  # None: laboratory frame
 
-    def exponents(self, A: np.ndarray, c_A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(A, c_A) as the core needs them in this representation."""
-        if self.coords is None:
-            return np.ascontiguousarray(A), np.ascontiguousarray(c_A)
-        Ui = self.coords.U_inv
-        Ax = np.einsum("ki,nkl,lj->nij", Ui, A, Ui)
-        return np.ascontiguousarray(Ax[:, :-1, :-1]), np.ascontiguousarray(Ax[:, -1, -1])
+    def arrays(self, f) -> tuple:
+        """The core's arrays of a function set `f` (a Basis) in this representation:
+        (A, c_A) for plain ECGs, (A, u, K, c_A) for ECG-GVR."""
+        A, c_A = f.A, f.c_A
+        u = f.u if f.kind == "ecg-gvr" else None
+        if self.coords is not None:
+            Ui = self.coords.U_inv
+            Ax = np.einsum("ki,nkl,lj->nij", Ui, A, Ui)
+            A, c_A = Ax[:, :-1, :-1], Ax[:, -1, -1]
+            if u is not None:
+                ux = self.coords.transform_vectors_to_x(u)  # u^(x) = U^-T u^(r) = (u', c_U)
+                if np.any(np.abs(ux[:, -1]) > 1e-12 * np.max(np.abs(ux), axis=1)):
+                    raise SeparabilityError("a global vector has a CM component (c_U != 0): "
+                                            "no translationally invariant evaluation (use --coordinates lab)")
+                u = ux[:, :-1]
+        c = np.ascontiguousarray
+        if u is None:
+            return c(A), c(c_A)
+        return c(A), c(u), c(f.K, dtype=np.uint32), c(c_A)
 
-    def matrices(self, A: np.ndarray, c_A: np.ndarray) -> dict:
-        a, c = self.exponents(A, c_A)
-        return _core.matrices(a, c, self.lam, self.pair_w, self.pair_q, self.sym_t, self.sym_c, self.cm_mass)
+    def _ops(self):
+        return self.lam, self.pair_w, self.pair_q, self.sym_t, self.sym_c, self.cm_mass
 
-    def rows(self, trial_A, trial_c_A, A, c_A) -> tuple[dict, np.ndarray]:
-        """Rows (k x nb) of trials against the basis, and the trials' diagonals [S, T, T_ti, V]."""
-        ta, tc = self.exponents(np.asarray(trial_A, float).reshape(-1, *A.shape[1:]), np.atleast_1d(trial_c_A))
-        a, c = self.exponents(A, c_A)
-        return _core.rows(ta, tc, a, c, self.lam, self.pair_w, self.pair_q, self.sym_t, self.sym_c, self.cm_mass)
+    def matrices(self, f) -> dict:
+        """Symmetrised S, T, T_ti, V of the basis `f`."""
+        if f.kind == "ecg-gvr":
+            return _core.gvr_matrices(*self.arrays(f), f.N, *self._ops())
+        return _core.matrices(*self.arrays(f), *self._ops())
+
+    def rows(self, trials, f) -> tuple[dict, np.ndarray]:
+        """Rows (k x nb) of `trials` against the basis `f`, and the trials' diagonals [S, T, T_ti, V]."""
+        if f.kind == "ecg-gvr":
+            return _core.gvr_rows(*self.arrays(trials), *self.arrays(f), f.N, *self._ops())
+        return _core.rows(*self.arrays(trials), *self.arrays(f), *self._ops())
 
 
 def laboratory(system: System, kinetic: str = "M") -> Representation:

@@ -28,12 +28,13 @@ from . import eigen
 from .basis import Basis
 from .errors import InputError
 from .integrals import laboratory
+from .refine import refine_function
 from .system import System
 
 
 @dataclass
 class Optimiser:
-    """Settings of `optimise` (TOML table [optimiser]; `size` and `c_A` come from [basis])."""
+    """Settings of `optimise` (TOML table [optimiser]; `size`, `c_A`, `kind`, `K_max` come from [basis])."""
 
     size: int = 50
     trials: int = 20
@@ -42,6 +43,10 @@ class Optimiser:
     channels: str | list = "pairs"
     length_range: tuple = (0.01, 15.0)
     c_A: float = 1.0
+    kind: str = "pecg"
+    K_max: int = 0
+    refine: int = 0
+    refine_evaluations: int = 200
     min_norm: float = 1e-8
     threshold: float = 1e-13
 
@@ -57,11 +62,17 @@ class Optimiser:
             raise InputError(f"optimiser.length_range must be 0 < lo < hi, got {self.length_range!r}")
         if not self.c_A > 0:
             raise InputError(f"basis.c_A must be positive, got {self.c_A!r}")
+        if self.kind not in ("pecg", "ecg-gvr"):
+            raise InputError(f"basis.type must be 'pecg' or 'ecg-gvr', got {self.kind!r}")
+        if not (isinstance(self.refine, int) and self.refine >= 0):
+            raise InputError(f"optimiser.refine must be a non-negative integer, got {self.refine!r}")
+        if not (isinstance(self.K_max, int) and 0 <= self.K_max <= 60):
+            raise InputError(f"basis.K_max must be an integer in 0..60, got {self.K_max!r}")
 
 
 @dataclass
 class Sampler:
-    """Random plain ECGs of a system in pair form or in coordinate sets (module docstring)."""
+    """Random functions of a system in pair form or in coordinate sets (module docstring)."""
 
     system: System
     opts: Optimiser
@@ -88,31 +99,54 @@ class Sampler:
             raise InputError(f"optimiser.channels must be 'pairs', 'all' or a list of coordinate sets, not {ch!r}")
         for x in self.sets:
             x.check(m)
+        self.pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
 
     def _b(self, a, size=None):
         lo, hi = self.opts.length_range
         return a * np.exp(self.rng.uniform(np.log(lo), np.log(hi), size))
 
-    def draw(self) -> tuple[np.ndarray, str]:
+    def _pair_vector(self, i, j):
+        w = np.zeros(self.system.n)
+        w[i], w[j] = 1.0, -1.0
+        return w
+
+    def draw(self) -> Basis:
+        """One random function as a one-function Basis."""
         s, c_A = self.system, self.opts.c_A
         n = s.n
         cm = s.cm_vector
+        kind = self.opts.kind
+        K = int(self.rng.integers(self.opts.K_max + 1)) if kind == "ecg-gvr" else 0
+        # |v|^{2K+N} exp(-α v²) peaks at |v| = sqrt((K + N/2)/α): for the coordinate that carries
+        # the global vector, the drawn length b is that peak, α = (K + N/2)/b² (K + N/2 > 0)
+        power = K + 0.5 * s.state.N if kind == "ecg-gvr" else 0.0
         if not self.sets:
+            i0, j0 = self.pairs[self.rng.integers(len(self.pairs))]
             A = c_A * np.outer(cm, cm)
-            for i in range(n):
-                for j in range(i + 1, n):
-                    w = np.zeros(n)
-                    w[i], w[j] = 1.0, -1.0
-                    A += np.outer(w, w) / self._b(self.length[i, j]) ** 2
-            return A, "pairs"
-        x = self.sets[self.rng.integers(len(self.sets))]
-        # the length of coordinate k: that of the two particles its row weighs most
-        lengths = []
-        for k in range(n - 1):
-            i, j = np.argsort(-np.abs(x.U[k]))[:2]
-            lengths.append(self.length[i, j])
-        A_int = np.diag(1.0 / self._b(np.array(lengths)) ** 2)
-        return x.to_lab(A_int, c_A), x.name
+            for i, j in self.pairs:
+                w = self._pair_vector(i, j)
+                b = self._b(self.length[i, j])
+                A += np.outer(w, w) * (max(power, 1.0) if (i, j) == (i0, j0) else 1.0) / b**2
+            u = self._pair_vector(i0, j0)
+            channel = "pairs"
+        else:
+            x = self.sets[self.rng.integers(len(self.sets))]
+            # the length of coordinate k: that of the two particles its row weighs most
+            lengths = []
+            for k in range(n - 1):
+                i, j = np.argsort(-np.abs(x.U[k]))[:2]
+                lengths.append(self.length[i, j])
+            alpha = 1.0 / self._b(np.array(lengths)) ** 2
+            k0 = int(self.rng.integers(n - 1))
+            alpha[k0] *= max(power, 1.0)
+            A = x.to_lab(np.diag(alpha), c_A)
+            ux = np.zeros(n)
+            ux[k0] = 1.0  # one internal coordinate, c_U = 0
+            u = x.U.T @ ux
+            channel = x.name
+        if kind == "pecg":
+            return Basis(s, A[None], [c_A], [channel])
+        return Basis(s, A[None], [c_A], [channel], kind="ecg-gvr", u=u[None], K=[K])
 
 
 class State:
@@ -121,7 +155,7 @@ class State:
     def __init__(self, basis: Basis, rep, threshold: float):
         self.basis, self.rep, self.threshold = basis, rep, threshold
         if len(basis):
-            self.m = rep.matrices(basis.A, basis.c_A)
+            self.m = rep.matrices(basis)
         else:
             self.m = {k: np.zeros((0, 0)) for k in ("S", "T", "T_ti", "V")}
         self.solve()
@@ -138,30 +172,28 @@ class State:
         c = self.eig.vectors[:, 0]
         return abs(1.0 + (c @ self.m["V"] @ c) / (2.0 * (c @ self.m["T_ti"] @ c)))
 
-    def candidates(self, trials, exclude: int | None = None, eig=None):
+    def candidates(self, trials: Basis, exclude: int | None = None, eig=None):
         """Lowest energy with each trial added (to the basis without `exclude`), and the rows."""
-        A = np.array([t[0] for t in trials])
-        c_A = np.full(len(trials), self.basis.c_A[0] if len(self.basis) else trials[0][2])
-        rows, diag = self.rep.rows(A, c_A, self.basis.A, self.basis.c_A)
+        rows, diag = self.rep.rows(trials, self.basis)
         H = rows["T_ti"] + rows["V"]
         S = rows["S"]
         keep = np.ones(len(self.basis), bool)
         if exclude is not None:
             keep[exclude] = False
-        E, C = (eig.energies, eig.vectors) if eig is not None else (
-            (self.eig.energies, self.eig.vectors) if self.eig is not None else (np.zeros(0), np.zeros((0, 0))))
+        eig = eig if eig is not None else self.eig
+        E, C = (eig.energies, eig.vectors) if eig is not None else (np.zeros(0), np.zeros((0, 0)))
         energies = np.array([
             eigen.lowest_with_added(E, C, H[t, keep], S[t, keep], diag[t, 2] + diag[t, 3], diag[t, 0])
             for t in range(len(trials))
         ])
         return energies, rows, diag
 
-    def put(self, i: int, A, c_A, channel, row, d):
-        """Append (i == len) or replace function i, updating the matrices from its row."""
+    def put(self, i: int, f: Basis, row: dict, d):
+        """Append (i == len) or replace function i by `f`, updating the matrices from its row."""
         nb = len(self.basis)
         values = {"S": d[0], "T": d[1], "T_ti": d[2], "V": d[3]}
         if i == nb:
-            self.basis.append(A, c_A, channel)
+            self.basis.append(f)
             for k in self.m:
                 M = np.zeros((nb + 1, nb + 1))
                 M[:nb, :nb] = self.m[k]
@@ -169,7 +201,7 @@ class State:
                 M[nb, nb] = values[k]
                 self.m[k] = M
         else:
-            self.basis.replace(i, A, c_A, channel)
+            self.basis.replace(i, f)
             for k in self.m:
                 r = row[k].copy()
                 r[i] = values[k]
@@ -178,13 +210,20 @@ class State:
         self.solve()
 
 
+def _concat(fs: list[Basis]) -> Basis:
+    out = fs[0].subset(slice(0, 1))
+    for f in fs[1:]:
+        out.append(f)
+    return out
+
+
 def optimise(system: System, opts: Optimiser, out: Path | None = None, basis: Basis | None = None,
              progress: bool = True) -> Basis:
     """Grow a basis to `opts.size` by competitive selection, then run `opts.sweeps` replacement sweeps."""
     rng = np.random.default_rng(opts.seed)
     sampler = Sampler(system, opts, rng)
     rep = laboratory(system)
-    st = State(basis or Basis.empty(system), rep, opts.threshold)
+    st = State(basis or Basis.empty(system, opts.kind), rep, opts.threshold)
     report = Reporter(opts, progress)
 
     def checkpoint():
@@ -193,8 +232,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, basis: Ba
             st.basis.save(Path(out) / "basis.json", {"energy": st.energy, "optimiser": vars(opts) | {
                 "length_range": list(opts.length_range)}})
 
-    def draw(k):
-        return [(*sampler.draw(), opts.c_A) for _ in range(k)]
+    def draw(k) -> Basis:
+        return _concat([sampler.draw() for _ in range(k)])
 
     with report:
         while len(st.basis) < opts.size:
@@ -204,8 +243,9 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, basis: Ba
             report.trials(len(trials))
             if np.isfinite(energies[best]) and energies[best] < st.energy:
                 old = st.energy
-                A, ch, c = trials[best]
-                st.put(len(st.basis), A, c, ch, {k: v[best] for k, v in rows.items()}, diag[best])
+                st.put(len(st.basis), trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
+                if opts.refine:  # competitive selection, then Powell refinement of the winner
+                    refine_function(st, len(st.basis) - 1, opts.refine_evaluations)
                 checkpoint()
                 report.step(st, old)
         for sweep in range(opts.sweeps):
@@ -219,10 +259,16 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, basis: Ba
                 best = int(np.argmin(energies))
                 if np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
                     old = st.energy
-                    A, ch, c = trials[best]
-                    st.put(i, A, c, ch, {k: v[best] for k, v in rows.items()}, diag[best])
+                    st.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
                     checkpoint()
                     report.step(st, old, sweep=sweep + 1)
+        for sweep in range(opts.refine):
+            for i in range(len(st.basis)):
+                old = st.energy
+                report.trials(1)
+                if refine_function(st, i, opts.refine_evaluations):
+                    checkpoint()
+                    report.step(st, old, sweep=sweep + 1, label="refine")
     st.basis.coefficients = st.eig.vectors[:, 0]
     return st.basis
 
@@ -251,13 +297,13 @@ class Reporter:
     def trials(self, k):
         self.n_trials += k
 
-    def step(self, st: State, old: float, sweep: int = 0):
+    def step(self, st: State, old: float, sweep: int = 0, label: str = "sweep"):
         if self.progress is None:
             return
         rate = self.n_trials / max(time.perf_counter() - self.t0, 1e-9)
         gain = old - st.energy if np.isfinite(old) else float("nan")
         info = f"E = {st.energy:.12f}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.0f} trials/s"
         if sweep:
-            self.progress.update(self.task, description=f"sweep {sweep}", info=info)
+            self.progress.update(self.task, description=f"{label} {sweep}", info=info)
         else:
             self.progress.update(self.task, completed=len(st.basis), info=info)

@@ -1,6 +1,8 @@
 //! Flat-slice entry points: row-major arrays in, row-major arrays out, the
 //! coordinate dimension `n` dispatched once to the const-generic kernels.
+use crate::assemble;
 use crate::build::{self, Matrices, Symmetrised};
+use crate::gvr::{Gvr, GvrOps, SymmetrisedGvr};
 use crate::ecg::{Element, Gaussian, Mat, Operators, Vector};
 use crate::error::{CoreError, Result};
 
@@ -110,4 +112,66 @@ pub fn matrices(setup: &Setup, basis: &Functions) -> Result<Matrices> {
 /// Rows of trial functions against a basis, with the trials' diagonal elements.
 pub fn rows(setup: &Setup, trials: &Functions, basis: &Functions) -> Result<(Matrices, Vec<Element>)> {
     dispatch!(setup.n, rows_d(setup, trials, basis))
+}
+
+/// ECG-GVR functions: `k x n x n` exponents, `k x n` global vectors, `k` powers K, `k` values of c_A.
+pub struct GvrFunctions<'a> {
+    pub a: &'a [f64],
+    pub u: &'a [f64],
+    pub k: &'a [u32],
+    pub c_a: &'a [f64],
+}
+
+fn gvr_functions<const D: usize>(f: &GvrFunctions, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
+    let nb = f.c_a.len();
+    check(f.a.len(), nb * D * D, "exponent matrices")?;
+    check(f.u.len(), nb * D, "global vectors")?;
+    check(f.k.len(), nb, "powers K")?;
+    (0..nb)
+        .map(|i| {
+            let a = Mat::<D>::from_row_slice(&f.a[i * D * D..(i + 1) * D * D]);
+            let u = Vector::<D>::from_row_slice(&f.u[i * D..(i + 1) * D]);
+            Gvr::new(a, u, f.k[i], f.c_a[i], go, i)
+        })
+        .collect()
+}
+
+fn gvr_ops<const D: usize>(setup: &Setup, n_ang: u32, k_max: u32) -> Result<(GvrOps<D>, Vec<(Mat<D>, f64)>)> {
+    let (ops, sym) = setup.operators::<D>()?;
+    Ok((GvrOps::new(ops, n_ang, k_max), sym))
+}
+
+fn gvr_matrices_d<const D: usize>(setup: &Setup, n_ang: u32, basis: &GvrFunctions) -> Result<Matrices> {
+    let k_max = basis.k.iter().copied().max().unwrap_or(0);
+    let (go, sym) = gvr_ops::<D>(setup, n_ang, k_max)?;
+    let b = SymmetrisedGvr::new(gvr_functions(basis, &go)?, &sym, &go)?;
+    Ok(assemble::symmetric(b.functions.len(), |i, j| b.element(&b.functions[i], j, &go)))
+}
+
+fn gvr_rows_d<const D: usize>(
+    setup: &Setup,
+    n_ang: u32,
+    trials: &GvrFunctions,
+    basis: &GvrFunctions,
+) -> Result<(Matrices, Vec<Element>)> {
+    let k_max = basis.k.iter().chain(trials.k).copied().max().unwrap_or(0);
+    let (go, sym) = gvr_ops::<D>(setup, n_ang, k_max)?;
+    let t = SymmetrisedGvr::new(gvr_functions(trials, &go)?, &sym, &go)?;
+    let b = SymmetrisedGvr::new(gvr_functions(basis, &go)?, &sym, &go)?;
+    Ok(assemble::rows(
+        t.functions.len(),
+        b.functions.len(),
+        |i, j| b.element(&t.functions[i], j, &go),
+        |i| t.element(&t.functions[i], i, &go),
+    ))
+}
+
+/// Symmetrised matrices of an ECG-GVR basis with total angular momentum `n_ang` (M = N).
+pub fn gvr_matrices(setup: &Setup, n_ang: u32, basis: &GvrFunctions) -> Result<Matrices> {
+    dispatch!(setup.n, gvr_matrices_d(setup, n_ang, basis))
+}
+
+/// Rows of ECG-GVR trial functions against a basis, with the trials' diagonal elements.
+pub fn gvr_rows(setup: &Setup, n_ang: u32, trials: &GvrFunctions, basis: &GvrFunctions) -> Result<(Matrices, Vec<Element>)> {
+    dispatch!(setup.n, gvr_rows_d(setup, n_ang, trials, basis))
 }

@@ -4,9 +4,11 @@
 //! Pipeline position: integrals (`pecg`) → symmetrised builds (`build`) → flat
 //! array entry points (`api`) used by the `prebo._core` binding.
 pub mod api;
+pub mod assemble;
 pub mod build;
 pub mod ecg;
 pub mod error;
+pub mod gvr;
 pub mod pecg;
 
 pub use error::{CoreError, Result};

@@ -2,7 +2,8 @@
 //! Converts numpy arrays, maps `CoreError` to `prebo.errors`, releases the GIL.
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
-use prebo_core::api::{self, Functions, Setup};
+use prebo_core::ecg::Element;
+use prebo_core::api::{self, Functions, GvrFunctions, Setup};
 use prebo_core::build::Matrices;
 use prebo_core::CoreError;
 use pyo3::exceptions::PyValueError;
@@ -137,9 +138,96 @@ fn rows<'py>(
             api::rows(&setup.view(), &Functions { a: &ta, c_a: &tc }, &Functions { a: &a, c_a: &c_a })
         })
         .map_err(to_py)?;
-    let k = diag.len();
+    Ok((dict(py, m)?, diag_array(py, &diag)))
+}
+
+
+/// Owned ECG-GVR function arrays.
+struct GvrData {
+    a: Vec<f64>,
+    u: Vec<f64>,
+    k: Vec<u32>,
+    c_a: Vec<f64>,
+}
+
+impl GvrData {
+    fn new(
+        a: PyReadonlyArray3<f64>,
+        u: PyReadonlyArray2<f64>,
+        k: PyReadonlyArray1<u32>,
+        c_a: PyReadonlyArray1<f64>,
+    ) -> PyResult<Self> {
+        Ok(Self {
+            a: slice(&a, "a")?.to_vec(),
+            u: slice(&u, "u")?.to_vec(),
+            k: slice(&k, "K")?.to_vec(),
+            c_a: slice(&c_a, "c_a")?.to_vec(),
+        })
+    }
+
+    fn view(&self) -> GvrFunctions<'_> {
+        GvrFunctions { a: &self.a, u: &self.u, k: &self.k, c_a: &self.c_a }
+    }
+}
+
+fn diag_array<'py>(py: Python<'py>, diag: &[Element]) -> Arr2<'py> {
     let d: Vec<f64> = diag.iter().flat_map(|e| [e.s, e.t, e.t_ti, e.v]).collect();
-    Ok((dict(py, m)?, matrix(py, k, 4, d)))
+    matrix(py, diag.len(), 4, d)
+}
+
+/// Symmetrised matrices `{"S", "T", "T_ti", "V"}` of an ECG-GVR basis (angular momentum `n_ang`, M = N).
+#[pyfunction]
+#[pyo3(signature = (a, u, k, c_a, n_ang, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None))]
+#[allow(clippy::too_many_arguments)]
+fn gvr_matrices<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray3<f64>,
+    u: PyReadonlyArray2<f64>,
+    k: PyReadonlyArray1<u32>,
+    c_a: PyReadonlyArray1<f64>,
+    n_ang: u32,
+    lambda_: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+    cm_mass: Option<f64>,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
+    let basis = GvrData::new(a, u, k, c_a)?;
+    let m = py.allow_threads(|| api::gvr_matrices(&setup.view(), n_ang, &basis.view())).map_err(to_py)?;
+    dict(py, m)
+}
+
+/// Rows (k x nb) of ECG-GVR trial functions against a basis, and the trials' diagonals (k x 4).
+#[pyfunction]
+#[pyo3(signature = (trial_a, trial_u, trial_k, trial_c_a, a, u, k, c_a, n_ang, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None))]
+#[allow(clippy::too_many_arguments)]
+fn gvr_rows<'py>(
+    py: Python<'py>,
+    trial_a: PyReadonlyArray3<f64>,
+    trial_u: PyReadonlyArray2<f64>,
+    trial_k: PyReadonlyArray1<u32>,
+    trial_c_a: PyReadonlyArray1<f64>,
+    a: PyReadonlyArray3<f64>,
+    u: PyReadonlyArray2<f64>,
+    k: PyReadonlyArray1<u32>,
+    c_a: PyReadonlyArray1<f64>,
+    n_ang: u32,
+    lambda_: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+    cm_mass: Option<f64>,
+) -> PyResult<(Bound<'py, pyo3::types::PyDict>, Arr2<'py>)> {
+    let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
+    let trials = GvrData::new(trial_a, trial_u, trial_k, trial_c_a)?;
+    let basis = GvrData::new(a, u, k, c_a)?;
+    let (m, diag) = py
+        .allow_threads(|| api::gvr_rows(&setup.view(), n_ang, &trials.view(), &basis.view()))
+        .map_err(to_py)?;
+    Ok((dict(py, m)?, diag_array(py, &diag)))
 }
 
 /// Number of rayon worker threads in use.
@@ -152,6 +240,8 @@ fn num_threads() -> usize {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(matrices, m)?)?;
     m.add_function(wrap_pyfunction!(rows, m)?)?;
+    m.add_function(wrap_pyfunction!(gvr_matrices, m)?)?;
+    m.add_function(wrap_pyfunction!(gvr_rows, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add("MAX_DIM", api::MAX_DIM)?;
     Ok(())

@@ -1,0 +1,314 @@
+//! ECG-GVR matrix elements (paper eqs. globalvector, ecg-gvr; Suzuki & Varga, Lect. Notes
+//! Phys. m54, ch. 6–7) in prebo's convention (no 1/2 in the exponent, docs/conventions.md):
+//!
+//!     phi(r) = |v|^{2K} (v_x + i v_y)^N exp(-r^T A r),   v = u^T r,
+//!
+//! i.e. |v|^{2K+N} Y_NN(v̂) up to a constant of N alone (cancelled by normalisation).
+//!
+//! # Derivation (docs/gvr.md has the long form)
+//! Under the weight `exp(-r^T B r)`, `B = A_I + A_J`, the vectors `a = u_I^T r`, `b = u_J^T r`
+//! are jointly Gaussian, each Cartesian component with covariances
+//! `x = u_I^T C u_I`, `y = u_J^T C u_J`, `z = u_I^T C u_J`, `C = B^{-1}/2`. Expanding
+//! `|b|^{2K}(e·b)^N` in the Laguerre eigenfunctions of the Ornstein–Uhlenbeck semigroup gives
+//!
+//!     <phi_I|phi_J> = S_0(B) Ω,   Ω = Σ_k ĉ_k x^{K_I-k} y^{K_J-k} z^{N+2k},
+//!     ĉ_0 = 1,  ĉ_{k+1} = ĉ_k (K_I-k)(K_J-k) / ((k+1)(k+N+3/2)),   S_0 = (π^D/|B|)^{3/2},
+//!
+//! up to factors f(K_I) f(K_J) that normalisation removes. All terms have one sign, so
+//! the sum is stable for large K; it is evaluated as `x^{K_I+N/2} y^{K_J+N/2} ρ^N G(ρ²)`,
+//! `ρ = z/√(xy)` ∈ [-1, 1], with the powers in logarithms (no overflow up to K ≈ 170).
+//!
+//! Kinetic `<∇φ_I|Λ|∇φ_J>`: Stein's lemma and Price's theorem (`∂E/∂z = E[∇_a·∇_b]`,
+//! `∂E/∂x = E[Δ_a]/2`) turn every term into Ω or its first derivatives:
+//!
+//!     T/S_0 = λ Ω_z − 4⟨A_JΛu_I,u_I⟩Ω_x − 2⟨A_JΛu_I,u_J⟩Ω_z − 4⟨A_IΛu_J,u_J⟩Ω_y − 2⟨A_IΛu_J,u_I⟩Ω_z
+//!             + 12 Tr(A_IΛA_J C) Ω + 8 ũ_IWũ_I Ω_x + 4 (ũ_IWũ_J + ũ_JWũ_I) Ω_z + 8 ũ_JWũ_J Ω_y,
+//!
+//! `λ = u_I^T Λ u_J`, `⟨p,q⟩ = p^T C q`, `ũ = C u`, `W = A_I Λ A_J`. For K = N = 0 this is the
+//! plain-ECG `6 Tr(B^{-1} A_I Λ A_J) S`.
+//!
+//! CM elimination (paper eq. GENCONSTR:ecggvr, generalised to c_U ≠ 0 and unequal c_A):
+//! the same expression with `Λ = 1 1^T/(2 m_tot)`; with `A 1 = c_A m/m_tot`, `1^T u = c_U`,
+//! `s = c_I + c_J` it collapses to the closed form of [`cm_kinetic`].
+//!
+//! Coulomb `<1/|w^T r|>`: `1/r = (2/√π)∫exp(-t²r²)dt` and `τ² = t²c/(1+t²c)`, `c = w^T B^{-1} w`:
+//!
+//!     <1/|w^T r|> = (2/√(πc)) S_0 ∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ,
+//!     γ = (B^{-1}u)·w / √(2c),
+//!
+//! a polynomial of degree 2(K_I+K_J+N) in τ, integrated exactly by Gauss–Legendre with
+//! K_I+K_J+N+1 nodes.
+use std::f64::consts::PI;
+
+use nalgebra::Cholesky;
+
+use crate::ecg::{Element, Mat, Operators, Vector};
+use crate::error::{CoreError, Result};
+
+/// One ECG-GVR function: exponent `A`, global vector `u`, power `K`, and its CM parameters.
+#[derive(Clone, Debug)]
+pub struct Gvr<const D: usize> {
+    pub a: Mat<D>,
+    pub u: Vector<D>,
+    pub k: u32,
+    pub c_a: f64,
+    /// `c_U = 1^T u` (the CM component of `u^(x) = U^{-T} u^(r)`)
+    pub c_u: f64,
+    /// `ln <phi|phi>^{1/2}` in the scaling of this module
+    pub log_norm: f64,
+}
+
+/// Angular momentum and Gauss–Legendre nodes shared by all elements.
+#[derive(Clone, Debug)]
+pub struct GvrOps<const D: usize> {
+    pub ops: Operators<D>,
+    pub n_ang: u32,
+    /// `legendre[n]` = nodes and weights of the n-point rule on [0, 1]
+    legendre: Vec<Vec<(f64, f64)>>,
+}
+
+impl<const D: usize> GvrOps<D> {
+    pub fn new(ops: Operators<D>, n_ang: u32, k_max: u32) -> Self {
+        let n_max = (2 * k_max + n_ang + 1) as usize;
+        Self { ops, n_ang, legendre: (0..=n_max).map(gauss_legendre_01).collect() }
+    }
+
+    fn k_max(&self) -> u32 {
+        ((self.legendre.len() - 1) as u32 - self.n_ang - 1) / 2
+    }
+}
+
+impl<const D: usize> Gvr<D> {
+    /// Checks `A` (positive definite), `u` (non-zero) and `K` (within the prepared range).
+    pub fn new(a: Mat<D>, u: Vector<D>, k: u32, c_a: f64, go: &GvrOps<D>, index: usize) -> Result<Self> {
+        if k > go.k_max() {
+            return Err(CoreError::Unsupported(format!("function {index}: K = {k} above K_max = {}", go.k_max())));
+        }
+        let chol = Cholesky::new(a).ok_or(CoreError::NotPositiveDefinite { function: index })?;
+        let mut f = Self { a, u, k, c_a, c_u: u.sum(), log_norm: 0.0 };
+        // <phi|phi>: B = 2A, x = y = z = u^T (2A)^{-1} u / 2 = u^T A^{-1} u / 4
+        let x = 0.25 * u.dot(&chol.solve(&u));
+        if !(x > 0.0) || !x.is_finite() {
+            return Err(CoreError::Unsupported(format!("function {index}: global vector u is zero")));
+        }
+        let log_det_2a = (D as f64) * 2f64.ln() + 2.0 * chol.l_dirty().diagonal().iter().map(|d| d.ln()).sum::<f64>();
+        let n = go.n_ang as f64;
+        let (g, _, _, _) = series(k, k, go.n_ang, 1.0);
+        let log_s0 = 1.5 * (D as f64 * PI.ln() - log_det_2a);
+        f.log_norm = 0.5 * (log_s0 + (2.0 * k as f64 + n) * x.ln() + g.ln());
+        Ok(f)
+    }
+
+    /// `phi(T r)`: `A -> T^T A T`, `u -> T^T u`.
+    pub fn transformed(&self, t: &Mat<D>, go: &GvrOps<D>, index: usize) -> Result<Self> {
+        Self::new(t.transpose() * self.a * t, t.transpose() * self.u, self.k, self.c_a, go, index)
+    }
+}
+
+/// `G = Σ ĉ_k ρ^{2k}`, `G_x = Σ ĉ_k (K_I−k) ρ^{2k}`, `G_y = Σ ĉ_k (K_J−k) ρ^{2k}`,
+/// `G_z = Σ ĉ_k (N+2k) ρ^{2k}` at `r2 = ρ²`; all terms non-negative.
+#[inline]
+fn series(ki: u32, kj: u32, n: u32, r2: f64) -> (f64, f64, f64, f64) {
+    let alpha = n as f64 + 0.5;
+    let (mut c, mut p) = (1.0, 1.0);
+    let (mut g, mut gx, mut gy, mut gz) = (0.0, 0.0, 0.0, 0.0);
+    for k in 0..=ki.min(kj) {
+        let term = c * p;
+        g += term;
+        gx += term * (ki - k) as f64;
+        gy += term * (kj - k) as f64;
+        gz += term * (n + 2 * k) as f64;
+        c *= ((ki - k) as f64) * ((kj - k) as f64) / (((k + 1) as f64) * (k as f64 + 1.0 + alpha));
+        p *= r2;
+    }
+    (g, gx, gy, gz)
+}
+
+/// Ω and its derivatives divided by `e^L`, `L = (K_I+N/2) ln x + (K_J+N/2) ln y`:
+/// returns `(L, ω, ω_x, ω_y, ω_z)`.
+#[inline]
+fn omega(ki: u32, kj: u32, n: u32, x: f64, y: f64, z: f64) -> (f64, f64, f64, f64, f64) {
+    let nf = n as f64;
+    let rt = (x * y).sqrt();
+    let rho = (z / rt).clamp(-1.0, 1.0);
+    let (g, gx, gy, gz) = series(ki, kj, n, rho * rho);
+    let rho_n = rho.powi(n as i32);
+    let l = (ki as f64 + 0.5 * nf) * x.ln() + (kj as f64 + 0.5 * nf) * y.ln();
+    // Ω_z = x^{K_I} y^{K_J} Σ ĉ_k (N+2k) z^{N+2k-1} (xy)^{-k} = e^L Σ ĉ_k (N+2k) ρ^{N+2k-1} / √(xy);
+    // for N = 0 the k = 0 term vanishes, so divide G_z by ρ only when N = 0 (ρ^{2k-1} = ρ^{2k}/ρ).
+    let omega_z = if n == 0 {
+        let (_, _, _, gz1) = series_shifted(ki, kj, rho * rho);
+        rho * gz1 / rt
+    } else {
+        rho.powi(n as i32 - 1) * gz / rt
+    };
+    (l, rho_n * g, rho_n * gx / x, rho_n * gy / y, omega_z)
+}
+
+/// For N = 0: `Σ_{k>=1} ĉ_k 2k ρ^{2k-2}` (the z-derivative series divided by ρ), in slot 3.
+#[inline]
+fn series_shifted(ki: u32, kj: u32, r2: f64) -> (f64, f64, f64, f64) {
+    let alpha = 0.5;
+    let (mut c, mut p, mut gz) = (1.0, 1.0, 0.0);
+    for k in 0..ki.min(kj) {
+        c *= ((ki - k) as f64) * ((kj - k) as f64) / (((k + 1) as f64) * (k as f64 + 1.0 + alpha));
+        gz += c * p * (2 * (k + 1)) as f64;
+        p *= r2;
+    }
+    (0.0, 0.0, 0.0, gz)
+}
+
+/// Closed form of the kinetic element with `Λ = 1 1^T/(2 m_tot)` over `e^L S_0` (module docs).
+#[inline]
+fn cm_kinetic(ci: f64, cj: f64, ui: f64, uj: f64, m: f64, w: (f64, f64, f64, f64)) -> f64 {
+    let (om, ox, oy, oz) = w;
+    let s = ci + cj;
+    ui * uj / (2.0 * m) * oz - ui * ui * cj / (m * s) * ox - ui * uj * cj / (2.0 * m * s) * oz
+        - uj * uj * ci / (m * s) * oy
+        - ui * uj * ci / (2.0 * m * s) * oz
+        + 3.0 * ci * cj / (m * s) * om
+        + ci * cj * ui * ui / (m * s * s) * ox
+        + ci * cj * ui * uj / (m * s * s) * oz
+        + ci * cj * uj * uj / (m * s * s) * oy
+}
+
+/// `<phi_I| 1, T, V |phi_J>` for one pair of normalised ECG-GVR functions.
+pub fn element<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>) -> Element {
+    let ops = &go.ops;
+    let n = go.n_ang;
+    let b_mat = bra.a + ket.a;
+    let chol = Cholesky::new(b_mat).expect("A_I + A_J of positive-definite A_I, A_J");
+    let log_det: f64 = 2.0 * chol.l_dirty().diagonal().iter().map(|d| d.ln()).sum::<f64>();
+    let binv = chol.inverse();
+    let gi = binv * bra.u;
+    let gj = binv * ket.u;
+    let x = 0.5 * bra.u.dot(&gi);
+    let y = 0.5 * ket.u.dot(&gj);
+    let z = 0.5 * bra.u.dot(&gj);
+    let log_s0 = 1.5 * (D as f64 * PI.ln() - log_det);
+    let (l, om, ox, oy, oz) = omega(bra.k, ket.k, n, x, y, z);
+    let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
+    let s = scale * om;
+
+    // kinetic with Λ
+    let lam = &ops.lambda;
+    let lam_ui = lam * bra.u;
+    let lam_uj = lam * ket.u;
+    let zl = ket.a * lam_ui; // A_J Λ u_I
+    let zr = bra.a * lam_uj; // A_I Λ u_J
+    let w = bra.a * lam * ket.a; // A_I Λ A_J
+    let tr_wc = 0.5 * binv.component_mul(&w.transpose()).sum();
+    let (hi, hj) = (0.5 * gi, 0.5 * gj); // C u
+    let t = bra.u.dot(&lam_uj) * oz - 4.0 * zl.dot(&hi) * ox - 2.0 * zl.dot(&hj) * oz - 4.0 * zr.dot(&hj) * oy
+        - 2.0 * zr.dot(&hi) * oz
+        + 12.0 * tr_wc * om
+        + 8.0 * hi.dot(&(w * hi)) * ox
+        + 4.0 * (hi.dot(&(w * hj)) + hj.dot(&(w * hi))) * oz
+        + 8.0 * hj.dot(&(w * hj)) * oy;
+    let t = scale * t;
+    let t_ti = match ops.cm_mass {
+        Some(m) => t - scale * cm_kinetic(bra.c_a, ket.c_a, bra.c_u, ket.c_u, m, (om, ox, oy, oz)),
+        None => t,
+    };
+
+    // Coulomb by exact Gauss–Legendre quadrature in τ
+    let rule = &go.legendre[(bra.k + ket.k + n + 1) as usize];
+    let mut v = 0.0;
+    for (wv, q) in &ops.pairs {
+        let bw = binv * wv;
+        let c = wv.dot(&bw);
+        let gam_i = gi.dot(wv) / (2.0 * c).sqrt();
+        let gam_j = gj.dot(wv) / (2.0 * c).sqrt();
+        let mut integral = 0.0;
+        for &(tau, weight) in rule {
+            let t2 = tau * tau;
+            // x_τ, y_τ >= 0 analytically (covariances of B + t² w w^T); clamp rounding
+            let xt = (x - t2 * gam_i * gam_i).max(x * 1e-300);
+            let yt = (y - t2 * gam_j * gam_j).max(y * 1e-300);
+            let zt = z - t2 * gam_i * gam_j;
+            let (lt, omt, _, _, _) = omega(bra.k, ket.k, n, xt, yt, zt);
+            integral += weight * (lt - l).exp() * omt;
+        }
+        v += q * 2.0 / (PI * c).sqrt() * integral;
+    }
+    Element { s, t, t_ti, v: scale * v }
+}
+
+/// ECG-GVR functions with their images under every symmetry operation.
+pub struct SymmetrisedGvr<const D: usize> {
+    pub functions: Vec<Gvr<D>>,
+    pub images: Vec<Vec<Gvr<D>>>,
+    pub coef: Vec<f64>,
+}
+
+impl<const D: usize> SymmetrisedGvr<D> {
+    pub fn new(functions: Vec<Gvr<D>>, sym: &[(Mat<D>, f64)], go: &GvrOps<D>) -> Result<Self> {
+        let images = functions
+            .iter()
+            .enumerate()
+            .map(|(j, f)| sym.iter().map(|(t, _)| f.transformed(t, go, j)).collect())
+            .collect::<Result<Vec<Vec<_>>>>()?;
+        Ok(Self { functions, images, coef: sym.iter().map(|(_, c)| *c).collect() })
+    }
+
+    /// `Σ_P c_P <bra| O |P phi_j>`.
+    pub fn element(&self, bra: &Gvr<D>, j: usize, go: &GvrOps<D>) -> Element {
+        let mut e = Element::default();
+        for (ket, c) in self.images[j].iter().zip(&self.coef) {
+            e += (*c, element(bra, ket, go));
+        }
+        e
+    }
+}
+
+/// Gauss–Legendre nodes and weights on [0, 1] (Newton on P_n, Golub–Welsch-free).
+pub fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, x);
+            for k in 2..=n {
+                let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                p0 = p1;
+                p1 = p2;
+            }
+            let p = if n == 0 { 1.0 } else { p1 };
+            dp = n as f64 * (x * p - p0) / (x * x - 1.0);
+            let dx = p / dp;
+            x -= dx;
+            if dx.abs() < 1e-16 {
+                break;
+            }
+        }
+        let w = 2.0 / ((1.0 - x * x) * dp * dp);
+        out.push((0.5 * (1.0 - x), 0.5 * w));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn legendre_integrates_polynomials_exactly() {
+        for n in 1..60 {
+            let rule = gauss_legendre_01(n);
+            for deg in 0..(2 * n) {
+                let integral: f64 = rule.iter().map(|(x, w)| w * x.powi(deg as i32)).sum();
+                assert!((integral - 1.0 / (deg as f64 + 1.0)).abs() < 1e-13, "n={n} deg={deg}");
+            }
+        }
+    }
+
+    #[test]
+    fn series_matches_hand_values() {
+        // K_I = K_J = 1, N = 0: G = ĉ_0 + ĉ_1 ρ² with ĉ_1 = 1/(1·3/2) = 2/3
+        let (g, gx, gy, gz) = series(1, 1, 0, 0.25);
+        assert!((g - (1.0 + 0.25 * 2.0 / 3.0)).abs() < 1e-15);
+        assert!((gx - 1.0).abs() < 1e-15 && (gy - 1.0).abs() < 1e-15);
+        assert!((gz - 2.0 * 0.25 * 2.0 / 3.0).abs() < 1e-15);
+    }
+}
