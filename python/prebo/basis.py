@@ -2,7 +2,8 @@
 
 A plain ECG ("pecg") is phi_I(r) = exp(-r^T (A_I ⊗ I_3) r) (docs/conventions.md); an
 ECG-GVR function ("ecg-gvr", paper eq. ecg-gvr) multiplies it by |v|^{2K} (v_x + i v_y)^N,
-v = u_I^T r, with the state's N. Exponents are
+v = u_I^T r, with the state's N; a floating ECG ("fecg") is exp(-(r - s_I)^T (A_I ⊗ I_3)(r - s_I)).
+Exponents are
 A_I = U_x^T blockdiag(𝒜_I, c_A) U_x for the coordinate set ("channel") x it was
 generated in. basis.json (format "prebo-basis", version 1; docs/basis-format.md)
 stores the system, the state, the symmetry, the conventions and, per function,
@@ -31,13 +32,19 @@ CONVENTIONS = {
 }
 
 
-KINDS = ("pecg", "ecg-gvr")
+#: per basis type, its per-function parameters beyond A and c_A: name -> (shape after nb, dtype)
+PARAMETERS = {
+    "pecg": {},
+    "ecg-gvr": {"u": ("n",), "K": ()},
+    "fecg": {"s": ("n", 3)},
+}
+KINDS = tuple(PARAMETERS)
 
 
 @dataclass
 class Basis:
     """An ECG basis of a system in LFCC: exponents `A` (nb, n, n), `c_A` (nb), channels (nb);
-    for ECG-GVR also global vectors `u` (nb, n) and powers `K` (nb)."""
+    ECG-GVR adds global vectors `u` (nb, n) and powers `K` (nb); FECG adds centres `s` (nb, n, 3)."""
 
     system: System
     A: np.ndarray
@@ -47,32 +54,45 @@ class Basis:
     kind: str = "pecg"
     u: np.ndarray | None = None
     K: np.ndarray | None = None
+    s: np.ndarray | None = None
 
     def __post_init__(self):
         n = self.system.n
         self.A = np.ascontiguousarray(np.asarray(self.A, dtype=float).reshape(-1, n, n))
         self.c_A = np.ascontiguousarray(np.asarray(self.c_A, dtype=float).reshape(-1))
-        if len(self.c_A) != len(self.A):
-            raise InputError(f"basis: {len(self.A)} exponent matrices but {len(self.c_A)} values of c_A")
+        nb = len(self.A)
+        if len(self.c_A) != nb:
+            raise InputError(f"basis: {nb} exponent matrices but {len(self.c_A)} values of c_A")
         if self.kind not in KINDS:
             raise InputError(f"basis type {self.kind!r} is not one of {', '.join(KINDS)}")
-        if self.kind == "ecg-gvr":
-            if self.u is None or self.K is None:
-                raise InputError("an ECG-GVR basis needs global vectors u and powers K")
-            self.u = np.ascontiguousarray(np.asarray(self.u, dtype=float).reshape(-1, n))
-            K = np.asarray(self.K).reshape(-1)
-            if len(self.u) != len(self.A) or len(K) != len(self.A):
-                raise InputError(f"basis: {len(self.A)} functions but {len(self.u)} vectors u and {len(K)} powers K")
-            if np.any(K < 0) or np.any(K != np.round(K)):
-                raise InputError("basis: every K must be a non-negative integer")
-            self.K = np.ascontiguousarray(K.astype(np.uint32))
+        for name, shape in PARAMETERS[self.kind].items():
+            value = getattr(self, name)
+            if value is None:
+                raise InputError(f"a {self.kind} basis needs the parameters {name!r}")
+            value = np.asarray(value)
+            if name == "K":
+                if np.any(value < 0) or np.any(value != np.round(value)):
+                    raise InputError("basis: every K must be a non-negative integer")
+                value = value.astype(np.uint32)
+            else:
+                value = value.astype(float)
+            dims = tuple(n if d == "n" else d for d in shape)
+            if value.size != nb * int(np.prod(dims, dtype=int)):
+                raise InputError(f"basis: {nb} functions but {value.size} values of {name!r}")
+            setattr(self, name, np.ascontiguousarray(value.reshape((nb, *dims))))
         if not self.channels:
-            self.channels = ["unknown"] * len(self.A)
+            self.channels = ["unknown"] * nb
+
+    @property
+    def parameters(self) -> dict:
+        """The per-function arrays beyond A and c_A of this basis type."""
+        return {name: getattr(self, name) for name in PARAMETERS[self.kind]}
 
     @classmethod
     def empty(cls, system: System, kind: str = "pecg") -> "Basis":
         n = system.n
-        extra = {"u": np.zeros((0, n)), "K": np.zeros(0, np.uint32)} if kind == "ecg-gvr" else {}
+        extra = {name: np.zeros((0, *(n if d == "n" else d for d in shape)))
+                 for name, shape in PARAMETERS[kind].items()}
         return cls(system, np.zeros((0, n, n)), np.zeros(0), [], kind=kind, **extra)
 
     def __len__(self) -> int:
@@ -85,16 +105,15 @@ class Basis:
     def subset(self, idx) -> "Basis":
         """The functions `idx` (indices or mask) as a new basis."""
         idx = np.arange(len(self))[idx]
-        extra = {"u": self.u[idx], "K": self.K[idx]} if self.kind == "ecg-gvr" else {}
+        extra = {name: v[idx] for name, v in self.parameters.items()}
         return Basis(self.system, self.A[idx], self.c_A[idx], [self.channels[i] for i in idx], kind=self.kind, **extra)
 
     def append(self, f: "Basis") -> None:
         """Append the functions of `f` (same system and kind)."""
         self.A = np.ascontiguousarray(np.concatenate([self.A, f.A]))
         self.c_A = np.concatenate([self.c_A, f.c_A])
-        if self.kind == "ecg-gvr":
-            self.u = np.ascontiguousarray(np.concatenate([self.u, f.u]))
-            self.K = np.concatenate([self.K, f.K])
+        for name, v in self.parameters.items():
+            setattr(self, name, np.ascontiguousarray(np.concatenate([v, getattr(f, name)])))
         self.channels += list(f.channels)
         self.coefficients = None
 
@@ -102,9 +121,8 @@ class Basis:
         """Replace function i by the single function of `f`."""
         self.A[i] = f.A[0]
         self.c_A[i] = f.c_A[0]
-        if self.kind == "ecg-gvr":
-            self.u[i] = f.u[0]
-            self.K[i] = f.K[0]
+        for name, v in self.parameters.items():
+            v[i] = getattr(f, name)[0]
         self.channels[i] = f.channels[0]
         self.coefficients = None
 
@@ -126,6 +144,8 @@ class Basis:
                 raise NotPositiveDefiniteError(f"function {i}: exponent matrix A is not positive definite") from None
             if self.kind == "ecg-gvr" and not (np.all(np.isfinite(self.u[i])) and np.any(self.u[i] != 0)):
                 raise InputError(f"function {i}: the global vector u must be finite and non-zero")
+            if self.kind == "fecg" and not np.all(np.isfinite(self.s[i])):
+                raise BasisFileError(f"function {i}: non-finite centres s")
 
     # --- basis.json ------------------------------------------------------------
     def to_dict(self, extra: dict | None = None) -> dict:
@@ -146,8 +166,8 @@ class Basis:
 
     def _function_dict(self, i: int) -> dict:
         f = {"A": self.A[i].tolist(), "c_A": float(self.c_A[i]), "channel": self.channels[i]}
-        if self.kind == "ecg-gvr":
-            f |= {"u": self.u[i].tolist(), "K": int(self.K[i])}
+        for name, v in self.parameters.items():
+            f[name] = v[i].tolist()
         return f
 
     def save(self, path, extra: dict | None = None) -> None:
@@ -172,10 +192,7 @@ class Basis:
             channels = [str(f.get("channel", "unknown")) for f in funcs]
             coef = d.get("coefficients")
             coef = None if coef is None else np.asarray(coef, dtype=float)
-            extra = {}
-            if kind == "ecg-gvr":
-                extra = {"u": np.array([f["u"] for f in funcs], dtype=float).reshape(len(funcs), n),
-                         "K": np.array([f["K"] for f in funcs])}
+            extra = {name: np.array([f[name] for f in funcs]) for name in PARAMETERS[kind]}
             basis = cls(system, A, c_A, channels, coef, kind, **extra)
         except PreboError as exc:
             raise BasisFileError(f"{where}: {exc}") from exc

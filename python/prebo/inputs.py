@@ -2,7 +2,7 @@
 
     [system]     particles = ["p", "e", {name = "x", mass = 3.0, charge = 1, spin = 0.5}]   -> System
     [state]      N = 0, parity = 1, spin = {e = 0}                                          -> State
-    [basis]      type = "pecg" | "ecg-gvr", size = 100, c_A = 1.0, K_max = 20               -> Optimiser.kind, .size, .c_A, .K_max
+    [basis]      type = "pecg" | "ecg-gvr" | "fecg", size = 100, c_A = 1.0, K_max = 20               -> Optimiser.kind, .size, .c_A, .K_max
     [optimiser]  trials = 20, sweeps = 1, seed = 1, channels = "pairs", length_range = [0.01, 15]
 """
 from __future__ import annotations
@@ -15,7 +15,7 @@ from .errors import InputError
 from .optimise import Optimiser
 from .system import State, System
 
-BASIS_TYPES = ("pecg", "ecg-gvr")
+BASIS_TYPES = ("pecg", "ecg-gvr", "fecg")
 
 
 @dataclass

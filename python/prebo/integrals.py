@@ -37,9 +37,10 @@ class Representation:
 
     def arrays(self, f) -> tuple:
         """The core's arrays of a function set `f` (a Basis) in this representation:
-        (A, c_A) for plain ECGs, (A, u, K, c_A) for ECG-GVR."""
+        (A, c_A) for plain ECGs, (A, u, K, c_A) for ECG-GVR, (A, s, c_A) for floating ECGs."""
         A, c_A = f.A, f.c_A
         u = f.u if f.kind == "ecg-gvr" else None
+        s = f.s if f.kind == "fecg" else None
         if self.coords is not None:
             Ui = self.coords.U_inv
             Ax = np.einsum("ki,nkl,lj->nij", Ui, A, Ui)
@@ -50,10 +51,18 @@ class Representation:
                     raise SeparabilityError("a global vector has a CM component (c_U != 0): "
                                             "no translationally invariant evaluation (use --coordinates lab)")
                 u = ux[:, :-1]
+            if s is not None:
+                sx = np.einsum("ki,nij->nkj", self.coords.U, s)  # s^(x) = U s
+                if np.any(np.abs(sx[:, -1]) > 1e-12 * max(1.0, np.max(np.abs(sx)))):
+                    raise SeparabilityError("a centre set has a CM component (μ^T s != 0): "
+                                            "no translationally invariant evaluation (use --coordinates lab)")
+                s = sx[:, :-1]
         c = np.ascontiguousarray
-        if u is None:
-            return c(A), c(c_A)
-        return c(A), c(u), c(f.K, dtype=np.uint32), c(c_A)
+        if u is not None:
+            return c(A), c(u), c(f.K, dtype=np.uint32), c(c_A)
+        if s is not None:
+            return c(A), c(s), c(c_A)
+        return c(A), c(c_A)
 
     def _ops(self):
         return self.lam, self.pair_w, self.pair_q, self.sym_t, self.sym_c, self.cm_mass
@@ -62,13 +71,23 @@ class Representation:
         """Symmetrised S, T, T_ti, V of the basis `f`."""
         if f.kind == "ecg-gvr":
             return _core.gvr_matrices(*self.arrays(f), f.N, *self._ops())
+        if f.kind == "fecg":
+            return _core.fecg_matrices(*self.arrays(f), *self._ops())
         return _core.matrices(*self.arrays(f), *self._ops())
 
     def rows(self, trials, f) -> tuple[dict, np.ndarray]:
         """Rows (k x nb) of `trials` against the basis `f`, and the trials' diagonals [S, T, T_ti, V]."""
         if f.kind == "ecg-gvr":
             return _core.gvr_rows(*self.arrays(trials), *self.arrays(f), f.N, *self._ops())
+        if f.kind == "fecg":
+            return _core.fecg_rows(*self.arrays(trials), *self.arrays(f), *self._ops())
         return _core.rows(*self.arrays(trials), *self.arrays(f), *self._ops())
+
+    def angular(self, f, mu: np.ndarray) -> np.ndarray:
+        """The symmetrised translation-free <N²> matrix of a floating-ECG basis (laboratory frame)."""
+        if f.kind != "fecg" or self.coords is not None:
+            raise ValueError("<N²> matrices are computed for floating ECGs in the laboratory frame")
+        return _core.fecg_angular(*self.arrays(f), np.ascontiguousarray(mu), *self._ops()[:5])
 
 
 def laboratory(system: System, kinetic: str = "M") -> Representation:

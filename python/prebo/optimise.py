@@ -62,8 +62,8 @@ class Optimiser:
             raise InputError(f"optimiser.length_range must be 0 < lo < hi, got {self.length_range!r}")
         if not self.c_A > 0:
             raise InputError(f"basis.c_A must be positive, got {self.c_A!r}")
-        if self.kind not in ("pecg", "ecg-gvr"):
-            raise InputError(f"basis.type must be 'pecg' or 'ecg-gvr', got {self.kind!r}")
+        if self.kind not in ("pecg", "ecg-gvr", "fecg"):
+            raise InputError(f"basis.type must be 'pecg', 'ecg-gvr' or 'fecg', got {self.kind!r}")
         if not (isinstance(self.refine, int) and self.refine >= 0):
             raise InputError(f"optimiser.refine must be a non-negative integer, got {self.refine!r}")
         if not (isinstance(self.K_max, int) and 0 <= self.K_max <= 60):
@@ -128,6 +128,9 @@ class Sampler:
                 b = self._b(self.length[i, j])
                 A += np.outer(w, w) * (max(power, 1.0) if (i, j) == (i0, j0) else 1.0) / b**2
             u = self._pair_vector(i0, j0)
+            # centres: particle j displaced from particle i by a random vector of its pair length
+            centres = np.zeros((n, 3))
+            centres[j0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(self.length[i0, j0])
             channel = "pairs"
         else:
             x = self.sets[self.rng.integers(len(self.sets))]
@@ -136,16 +139,24 @@ class Sampler:
             for k in range(n - 1):
                 i, j = np.argsort(-np.abs(x.U[k]))[:2]
                 lengths.append(self.length[i, j])
-            alpha = 1.0 / self._b(np.array(lengths)) ** 2
+            b = self._b(np.array(lengths))
+            alpha = 1.0 / b**2
             k0 = int(self.rng.integers(n - 1))
             alpha[k0] *= max(power, 1.0)
             A = x.to_lab(np.diag(alpha), c_A)
             ux = np.zeros(n)
             ux[k0] = 1.0  # one internal coordinate, c_U = 0
             u = x.U.T @ ux
+            # centres in x: coordinate k0 displaced by a random vector of its drawn length, CM at rest
+            sx = np.zeros((n, 3))
+            sx[k0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(lengths[k0])
+            centres = x.U_inv @ sx
             channel = x.name
         if kind == "pecg":
             return Basis(s, A[None], [c_A], [channel])
+        if kind == "fecg":
+            centres = centres - cm @ centres  # no CM component: μ^T s = 0
+            return Basis(s, A[None], [c_A], [channel], kind="fecg", s=centres[None])
         return Basis(s, A[None], [c_A], [channel], kind="ecg-gvr", u=u[None], K=[K])
 
 

@@ -1,9 +1,9 @@
 """Local refinement of one basis function with all others fixed (the paper's Powell step).
 
 A function generated in coordinate set x is refined in x: its parameters are
-θ = (ln diag L, strict lower L, u') with 𝒜^(x) = L L^T (positive definite for every θ),
-A^(r) = U_x^T blockdiag(𝒜, c_A) U_x and, for ECG-GVR, u^(r) = U_x^T (u', c_U); c_A, c_U
-and K stay fixed. A function from the pair sampler is refined in the first Jacobi set.
+θ = (ln diag L, strict lower L, u' or s') with 𝒜^(x) = L L^T (positive definite for every θ),
+A^(r) = U_x^T blockdiag(𝒜, c_A) U_x; for ECG-GVR u^(r) = U_x^T (u', c_U), for floating ECGs
+s^(r) = U_x^-1 (s', μ^T s); c_A, c_U, the CM centre μ^T s and K stay fixed. A function from the pair sampler is refined in the first Jacobi set.
 The energy of a trial θ is the lowest root of the secular equation (eigen.lowest_with_added)
 against the basis without the function: one row of integrals and O(N_b^2) per evaluation.
 """
@@ -40,6 +40,8 @@ class Parametrisation:
         parts = [np.log(np.diag(L)), L[np.tril_indices(d, -1)]]
         if self.f.kind == "ecg-gvr":
             parts.append(self.x.transform_vectors_to_x(self.f.u[0])[:-1])
+        if self.f.kind == "fecg":
+            parts.append((self.x.U @ self.f.s[0])[:-1].ravel())
         return np.concatenate(parts)
 
     def function(self, theta: np.ndarray) -> Basis:
@@ -51,6 +53,10 @@ class Parametrisation:
         A = self.x.to_lab(L @ L.T, c_A)
         if self.f.kind == "pecg":
             return Basis(self.f.system, A[None], [c_A], [self.x.name])
+        if self.f.kind == "fecg":
+            sx = self.x.U @ self.f.s[0]
+            sx[:-1] = theta[d + nl:].reshape(d, 3)
+            return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="fecg", s=(self.x.U_inv @ sx)[None])
         c_U = float(self.f.u[0].sum())
         u = self.x.U.T @ np.append(theta[d + nl:], c_U)
         return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="ecg-gvr", u=u[None], K=self.f.K[:1])
@@ -61,7 +67,11 @@ def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
     basis = state.basis
     keep = np.arange(len(basis)) != i
     Hm = state.m["T_ti"] + state.m["V"]
-    sub = eigen.solve(Hm[np.ix_(keep, keep)], state.m["S"][np.ix_(keep, keep)], state.threshold)
+    if keep.any():
+        sub = eigen.solve(Hm[np.ix_(keep, keep)], state.m["S"][np.ix_(keep, keep)], state.threshold)
+        E, C = sub.energies, sub.vectors
+    else:
+        E, C = np.zeros(0), np.zeros((0, 0))
     p = Parametrisation.of(basis.subset([i]))
     best = {"E": state.energy, "f": None, "row": None, "diag": None}
 
@@ -71,7 +81,7 @@ def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
             rows, diag = state.rep.rows(f, basis)
         except Exception:  # a θ that leaves the valid region (e.g. overflow): reject
             return np.inf
-        e = eigen.lowest_with_added(sub.energies, sub.vectors, (rows["T_ti"] + rows["V"])[0, keep],
+        e = eigen.lowest_with_added(E, C, (rows["T_ti"] + rows["V"])[0, keep],
                                     rows["S"][0, keep], diag[0, 2] + diag[0, 3], diag[0, 0])
         if e < best["E"]:
             best.update(E=e, f=f, row={k: v[0] for k, v in rows.items()}, diag=diag[0])

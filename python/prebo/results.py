@@ -2,7 +2,8 @@
 
 result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_lab
 (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential, n_basis,
-basis_type, particles, state, symmetry, coordinates, overlap_condition, kept.
+basis_type, particles, state, symmetry, coordinates, overlap_condition, kept; for
+floating ECGs also n2 = <N²>_TI (their functions are not angular-momentum eigenfunctions).
 """
 from __future__ import annotations
 
@@ -17,12 +18,12 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
     """Evaluate a basis; `coordinates="ti"` uses TICC (only for one shared c_A)."""
     system = basis.system
     if coordinates == "lab":
-        m = laboratory(system).matrices(basis.A, basis.c_A)
+        m = laboratory(system).matrices(basis)
         lab = eigen.solve(m["T"] + m["V"], m["S"], threshold)
         energy_lab = float(lab.energies[0])
     elif coordinates == "ti":
         c_A = require_shared_c_A(basis.c_A)
-        m = translationally_invariant(system).matrices(basis.A, basis.c_A)
+        m = translationally_invariant(system).matrices(basis)
         energy_lab = None  # filled below: CM factor exp(-c_A X^2) common to all functions
     else:
         raise ValueError(f"coordinates must be 'lab' or 'ti', not {coordinates!r}")
@@ -32,7 +33,11 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
     energy = float(ti.energies[0])
     if energy_lab is None:
         energy_lab = energy + 1.5 * c_A / system.m_total
-    return {
+    extra = {}
+    if basis.kind == "fecg":  # not an angular-momentum eigenfunction: report <N²>_TI
+        n2 = laboratory(system).angular(basis, system.cm_vector)
+        extra["n2"] = float(c @ n2 @ c)
+    return extra | {
         "energy": energy,
         "energy_lab": energy_lab,
         "virial": abs(1.0 + potential / (2.0 * kinetic)),

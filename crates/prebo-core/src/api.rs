@@ -2,7 +2,9 @@
 //! coordinate dimension `n` dispatched once to the const-generic kernels.
 use crate::assemble;
 use crate::build::{self, Matrices, Symmetrised};
-use crate::gvr::{Gvr, GvrOps, SymmetrisedGvr};
+use crate::fecg::{self, Centres, Fecg};
+use crate::gvr::{self, Gvr, GvrOps};
+use crate::images::Images;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Vector};
 use crate::error::{CoreError, Result};
 
@@ -144,8 +146,8 @@ fn gvr_ops<const D: usize>(setup: &Setup, n_ang: u32, k_max: u32) -> Result<(Gvr
 fn gvr_matrices_d<const D: usize>(setup: &Setup, n_ang: u32, basis: &GvrFunctions) -> Result<Matrices> {
     let k_max = basis.k.iter().copied().max().unwrap_or(0);
     let (go, sym) = gvr_ops::<D>(setup, n_ang, k_max)?;
-    let b = SymmetrisedGvr::new(gvr_functions(basis, &go)?, &sym, &go)?;
-    Ok(assemble::symmetric(b.functions.len(), |i, j| b.element(&b.functions[i], j, &go)))
+    let b = Images::new(gvr_functions(basis, &go)?, &sym, &go)?;
+    Ok(assemble::symmetric(b.len(), |i, j| b.element(&b.functions[i], j, |x, y| gvr::element(x, y, &go))))
 }
 
 fn gvr_rows_d<const D: usize>(
@@ -156,14 +158,10 @@ fn gvr_rows_d<const D: usize>(
 ) -> Result<(Matrices, Vec<Element>)> {
     let k_max = basis.k.iter().chain(trials.k).copied().max().unwrap_or(0);
     let (go, sym) = gvr_ops::<D>(setup, n_ang, k_max)?;
-    let t = SymmetrisedGvr::new(gvr_functions(trials, &go)?, &sym, &go)?;
-    let b = SymmetrisedGvr::new(gvr_functions(basis, &go)?, &sym, &go)?;
-    Ok(assemble::rows(
-        t.functions.len(),
-        b.functions.len(),
-        |i, j| b.element(&t.functions[i], j, &go),
-        |i| t.element(&t.functions[i], i, &go),
-    ))
+    let t = Images::new(gvr_functions(trials, &go)?, &sym, &go)?;
+    let b = Images::new(gvr_functions(basis, &go)?, &sym, &go)?;
+    let el = |x: &Gvr<D>, y: &Gvr<D>| gvr::element(x, y, &go);
+    Ok(assemble::rows(t.len(), b.len(), |i, j| b.element(&t.functions[i], j, el), |i| t.element(&t.functions[i], i, el)))
 }
 
 /// Symmetrised matrices of an ECG-GVR basis with total angular momentum `n_ang` (M = N).
@@ -174,4 +172,69 @@ pub fn gvr_matrices(setup: &Setup, n_ang: u32, basis: &GvrFunctions) -> Result<M
 /// Rows of ECG-GVR trial functions against a basis, with the trials' diagonal elements.
 pub fn gvr_rows(setup: &Setup, n_ang: u32, trials: &GvrFunctions, basis: &GvrFunctions) -> Result<(Matrices, Vec<Element>)> {
     dispatch!(setup.n, gvr_rows_d(setup, n_ang, trials, basis))
+}
+
+/// Floating ECGs: `k x n x n` exponents, `k x n x 3` centres, `k` values of c_A.
+pub struct FecgFunctions<'a> {
+    pub a: &'a [f64],
+    pub s: &'a [f64],
+    pub c_a: &'a [f64],
+}
+
+fn fecg_functions<const D: usize>(f: &FecgFunctions) -> Result<Vec<Fecg<D>>> {
+    let nb = f.c_a.len();
+    check(f.a.len(), nb * D * D, "exponent matrices")?;
+    check(f.s.len(), nb * D * 3, "centres")?;
+    (0..nb)
+        .map(|i| {
+            let a = Mat::<D>::from_row_slice(&f.a[i * D * D..(i + 1) * D * D]);
+            let s = Centres::<D>::from_row_slice(&f.s[i * D * 3..(i + 1) * D * 3]);
+            Fecg::new(a, s, f.c_a[i], i)
+        })
+        .collect()
+}
+
+fn fecg_matrices_d<const D: usize>(setup: &Setup, basis: &FecgFunctions) -> Result<Matrices> {
+    let (ops, sym) = setup.operators::<D>()?;
+    let b = Images::new(fecg_functions::<D>(basis)?, &sym, &())?;
+    Ok(assemble::symmetric(b.len(), |i, j| b.element(&b.functions[i], j, |x, y| fecg::element(x, y, &ops))))
+}
+
+fn fecg_rows_d<const D: usize>(
+    setup: &Setup,
+    trials: &FecgFunctions,
+    basis: &FecgFunctions,
+) -> Result<(Matrices, Vec<Element>)> {
+    let (ops, sym) = setup.operators::<D>()?;
+    let t = Images::new(fecg_functions::<D>(trials)?, &sym, &())?;
+    let b = Images::new(fecg_functions::<D>(basis)?, &sym, &())?;
+    let el = |x: &Fecg<D>, y: &Fecg<D>| fecg::element(x, y, &ops);
+    Ok(assemble::rows(t.len(), b.len(), |i, j| b.element(&t.functions[i], j, el), |i| t.element(&t.functions[i], i, el)))
+}
+
+fn fecg_angular_d<const D: usize>(setup: &Setup, mu: &[f64], basis: &FecgFunctions) -> Result<Vec<f64>> {
+    let (_, sym) = setup.operators::<D>()?;
+    check(mu.len(), D, "mass fractions")?;
+    let mu = Vector::<D>::from_row_slice(mu);
+    let b = Images::new(fecg_functions::<D>(basis)?, &sym, &())?;
+    // the N² element travels in the `s` slot of an Element
+    let m = assemble::symmetric(b.len(), |i, j| {
+        b.element(&b.functions[i], j, |x, y| Element { s: fecg::angular(x, y, &mu), ..Default::default() })
+    });
+    Ok(m.s)
+}
+
+/// Symmetrised matrices of a floating-ECG basis.
+pub fn fecg_matrices(setup: &Setup, basis: &FecgFunctions) -> Result<Matrices> {
+    dispatch!(setup.n, fecg_matrices_d(setup, basis))
+}
+
+/// Rows of floating-ECG trial functions against a basis, with the trials' diagonal elements.
+pub fn fecg_rows(setup: &Setup, trials: &FecgFunctions, basis: &FecgFunctions) -> Result<(Matrices, Vec<Element>)> {
+    dispatch!(setup.n, fecg_rows_d(setup, trials, basis))
+}
+
+/// The symmetrised `<phi_I|N_TI²|phi_J>` matrix (row-major) of a floating-ECG basis (LFCC only).
+pub fn fecg_angular(setup: &Setup, mu: &[f64], basis: &FecgFunctions) -> Result<Vec<f64>> {
+    dispatch!(setup.n, fecg_angular_d(setup, mu, basis))
 }

@@ -44,6 +44,7 @@ use nalgebra::Cholesky;
 
 use crate::ecg::{Element, Mat, Operators, Vector};
 use crate::error::{CoreError, Result};
+use crate::images::Transform;
 
 /// One ECG-GVR function: exponent `A`, global vector `u`, power `K`, and its CM parameters.
 #[derive(Clone, Debug)]
@@ -97,11 +98,6 @@ impl<const D: usize> Gvr<D> {
         let log_s0 = 1.5 * (D as f64 * PI.ln() - log_det_2a);
         f.log_norm = 0.5 * (log_s0 + (2.0 * k as f64 + n) * x.ln() + g.ln());
         Ok(f)
-    }
-
-    /// `phi(T r)`: `A -> T^T A T`, `u -> T^T u`.
-    pub fn transformed(&self, t: &Mat<D>, go: &GvrOps<D>, index: usize) -> Result<Self> {
-        Self::new(t.transpose() * self.a * t, t.transpose() * self.u, self.k, self.c_a, go, index)
     }
 }
 
@@ -234,30 +230,10 @@ pub fn element<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>) -> El
     Element { s, t, t_ti, v: scale * v }
 }
 
-/// ECG-GVR functions with their images under every symmetry operation.
-pub struct SymmetrisedGvr<const D: usize> {
-    pub functions: Vec<Gvr<D>>,
-    pub images: Vec<Vec<Gvr<D>>>,
-    pub coef: Vec<f64>,
-}
-
-impl<const D: usize> SymmetrisedGvr<D> {
-    pub fn new(functions: Vec<Gvr<D>>, sym: &[(Mat<D>, f64)], go: &GvrOps<D>) -> Result<Self> {
-        let images = functions
-            .iter()
-            .enumerate()
-            .map(|(j, f)| sym.iter().map(|(t, _)| f.transformed(t, go, j)).collect())
-            .collect::<Result<Vec<Vec<_>>>>()?;
-        Ok(Self { functions, images, coef: sym.iter().map(|(_, c)| *c).collect() })
-    }
-
-    /// `Σ_P c_P <bra| O |P phi_j>`.
-    pub fn element(&self, bra: &Gvr<D>, j: usize, go: &GvrOps<D>) -> Element {
-        let mut e = Element::default();
-        for (ket, c) in self.images[j].iter().zip(&self.coef) {
-            e += (*c, element(bra, ket, go));
-        }
-        e
+impl<const D: usize> Transform<D, GvrOps<D>> for Gvr<D> {
+    /// `phi(T r)`: `A -> T^T A T`, `u -> T^T u`.
+    fn transformed(&self, t: &Mat<D>, go: &GvrOps<D>, index: usize) -> Result<Self> {
+        Self::new(t.transpose() * self.a * t, t.transpose() * self.u, self.k, self.c_a, go, index)
     }
 }
 

@@ -8,7 +8,9 @@ pub mod assemble;
 pub mod build;
 pub mod ecg;
 pub mod error;
+pub mod fecg;
 pub mod gvr;
+pub mod images;
 pub mod pecg;
 
 pub use error::{CoreError, Result};

@@ -3,7 +3,7 @@
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use prebo_core::ecg::Element;
-use prebo_core::api::{self, Functions, GvrFunctions, Setup};
+use prebo_core::api::{self, FecgFunctions, Functions, GvrFunctions, Setup};
 use prebo_core::build::Matrices;
 use prebo_core::CoreError;
 use pyo3::exceptions::PyValueError;
@@ -230,6 +230,97 @@ fn gvr_rows<'py>(
     Ok((dict(py, m)?, diag_array(py, &diag)))
 }
 
+
+/// Owned floating-ECG arrays.
+struct FecgData {
+    a: Vec<f64>,
+    s: Vec<f64>,
+    c_a: Vec<f64>,
+}
+
+impl FecgData {
+    fn new(a: PyReadonlyArray3<f64>, s: PyReadonlyArray3<f64>, c_a: PyReadonlyArray1<f64>) -> PyResult<Self> {
+        Ok(Self { a: slice(&a, "a")?.to_vec(), s: slice(&s, "s")?.to_vec(), c_a: slice(&c_a, "c_a")?.to_vec() })
+    }
+
+    fn view(&self) -> FecgFunctions<'_> {
+        FecgFunctions { a: &self.a, s: &self.s, c_a: &self.c_a }
+    }
+}
+
+/// Symmetrised matrices `{"S", "T", "T_ti", "V"}` of a floating-ECG basis.
+#[pyfunction]
+#[pyo3(signature = (a, s, c_a, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None))]
+#[allow(clippy::too_many_arguments)]
+fn fecg_matrices<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray3<f64>,
+    s: PyReadonlyArray3<f64>,
+    c_a: PyReadonlyArray1<f64>,
+    lambda_: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+    cm_mass: Option<f64>,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
+    let basis = FecgData::new(a, s, c_a)?;
+    let m = py.allow_threads(|| api::fecg_matrices(&setup.view(), &basis.view())).map_err(to_py)?;
+    dict(py, m)
+}
+
+/// Rows (k x nb) of floating-ECG trial functions against a basis, and the trials' diagonals (k x 4).
+#[pyfunction]
+#[pyo3(signature = (trial_a, trial_s, trial_c_a, a, s, c_a, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None))]
+#[allow(clippy::too_many_arguments)]
+fn fecg_rows<'py>(
+    py: Python<'py>,
+    trial_a: PyReadonlyArray3<f64>,
+    trial_s: PyReadonlyArray3<f64>,
+    trial_c_a: PyReadonlyArray1<f64>,
+    a: PyReadonlyArray3<f64>,
+    s: PyReadonlyArray3<f64>,
+    c_a: PyReadonlyArray1<f64>,
+    lambda_: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+    cm_mass: Option<f64>,
+) -> PyResult<(Bound<'py, pyo3::types::PyDict>, Arr2<'py>)> {
+    let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
+    let trials = FecgData::new(trial_a, trial_s, trial_c_a)?;
+    let basis = FecgData::new(a, s, c_a)?;
+    let (m, diag) =
+        py.allow_threads(|| api::fecg_rows(&setup.view(), &trials.view(), &basis.view())).map_err(to_py)?;
+    Ok((dict(py, m)?, diag_array(py, &diag)))
+}
+
+/// The symmetrised translation-free `<N²>` matrix of a floating-ECG basis; `mu` = m/m_tot.
+#[pyfunction]
+#[pyo3(signature = (a, s, c_a, mu, lambda_, pair_w, pair_q, sym_t, sym_c))]
+#[allow(clippy::too_many_arguments)]
+fn fecg_angular<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray3<f64>,
+    s: PyReadonlyArray3<f64>,
+    c_a: PyReadonlyArray1<f64>,
+    mu: PyReadonlyArray1<f64>,
+    lambda_: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+) -> PyResult<Arr2<'py>> {
+    let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, None)?;
+    let basis = FecgData::new(a, s, c_a)?;
+    let mu = slice(&mu, "mu")?.to_vec();
+    let nb = basis.c_a.len();
+    let m = py.allow_threads(|| api::fecg_angular(&setup.view(), &mu, &basis.view())).map_err(to_py)?;
+    Ok(matrix(py, nb, nb, m))
+}
+
 /// Number of rayon worker threads in use.
 #[pyfunction]
 fn num_threads() -> usize {
@@ -242,6 +333,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rows, m)?)?;
     m.add_function(wrap_pyfunction!(gvr_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(gvr_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(fecg_matrices, m)?)?;
+    m.add_function(wrap_pyfunction!(fecg_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(fecg_angular, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add("MAX_DIM", api::MAX_DIM)?;
     Ok(())
