@@ -92,3 +92,20 @@ def test_bad_sets_are_refused():
     bad = prebo.CoordinateSet("bad", np.eye(3))
     with pytest.raises(InputError, match="does not sum to zero"):
         bad.check(m)
+
+
+@pytest.mark.parametrize("names, jacobi_orders, centres", [
+    (["p", "p", "e"], {(0, 1, 2), (0, 2, 1)}, {0, 2}),
+    (["p", "e", "e"], {(0, 1, 2), (1, 2, 0)}, {0, 1}),
+    (["a", "b", "c"], {(0, 1, 2), (0, 2, 1), (1, 2, 0)}, {0, 1, 2}),
+    (["p", "p", "e", "e"], {(0, 1, 2, 3), (0, 2, 1, 3), (0, 2, 3, 1), (2, 3, 0, 1)}, {0, 2}),
+    (["alpha", "e", "e", "e"], {(0, 1, 2, 3), (1, 2, 0, 3), (1, 2, 3, 0)}, {0, 1}),
+])
+def test_channels_up_to_identical_particles(names, jacobi_orders, centres):
+    """One channel per class of sets related by relabelling identical particles (3 and 4 particles)."""
+    m = np.arange(1.0, len(names) + 1)
+    sets = all_sets(m, names)
+    orders = {tuple(int(k) for k in x.name.split(":")[1].split("-")) for x in sets if x.name.startswith("jacobi")}
+    hpc = {int(x.name.split(":")[1]) for x in sets if x.name.startswith("hpc")}
+    assert orders == jacobi_orders and hpc == centres
+    assert [x.name for x in sets if x.name.startswith("cmc")] == [f"cmc:{len(names) - 1}"]

@@ -12,6 +12,7 @@ BASES = ROOT / "examples" / "bases"
 #: example -> (reference key, tolerance in Eh or "rel:x" relative); None: variational check only
 ACCEPTANCE = {
     "h": ("H", "rel:1e-8"),
+    "h2p": ("H 2p", "rel:1e-8"),
     "ps-": ("Ps-", 1e-6),
     "he": ("He", 1e-5),
     "h-": ("H-", 1e-5),
@@ -29,10 +30,10 @@ def energy(path, *extra):
 
 def exact(references, key, basis_file):
     ref = references[key]
-    if ref["energy"] == "exact":  # hydrogen-like: -mu/2
+    if ref["energy"] == "exact":  # hydrogen-like: -mu/(2 n^2)
         particles = json.loads(basis_file.read_text())["system"]["particles"]
         m1, m2 = (p["mass"] for p in particles)
-        return -0.5 * m1 * m2 / (m1 + m2)
+        return -0.5 * m1 * m2 / (m1 + m2) / ref["n"] ** 2
     return ref["energy"]
 
 

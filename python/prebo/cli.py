@@ -1,4 +1,4 @@
-"""Command line: `prebo run`, `prebo energy`. Errors print one line and exit 2, never a traceback."""
+"""Command line: `prebo run`, `prebo energy`, `prebo plot`. Errors print one line and exit 2, never a traceback."""
 from __future__ import annotations
 
 import argparse
@@ -28,21 +28,37 @@ def _print_result(r: dict) -> None:
 def cmd_run(args) -> int:
     from . import inputs
     from .basis import write_json_atomic
-    from .optimise import optimise
+    from .errors import InputError
+    from .optimise import optimise, resume_from
     from .results import evaluate, public
 
-    job = inputs.load(args.input)
-    out = Path(args.out or Path("runs") / Path(args.input).stem)
-    out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    basis = optimise(job.system, job.optimiser, out=out, progress=not args.quiet)
+    if args.resume:
+        out = Path(args.resume)
+        basis, _ = resume_from(out, progress=not args.quiet)
+        title, source = basis.system.label(), str(out / "basis.json")
+    else:
+        if args.input is None:
+            raise InputError("give an input file, or --resume DIR")
+        job = inputs.load(args.input)
+        out = Path(args.out or Path("runs") / Path(args.input).stem)
+        out.mkdir(parents=True, exist_ok=True)
+        basis = optimise(job.system, job.optimiser, out=out, progress=not args.quiet)
+        title, source = job.title, str(args.input)
     r = public(evaluate(basis))
-    r |= {"title": job.title, "wall_seconds": time.perf_counter() - t0, "input": str(args.input)}
-    basis.save(out / "basis.json", {"energy": r["energy"]})
+    r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source}
     write_json_atomic(out / "result.json", r)
     if not args.quiet:
         _print_result(r)
         print(f"wrote {out / 'result.json'} and {out / 'basis.json'}")
+    return 0
+
+
+def cmd_plot(args) -> int:
+    from .plot import convergence
+
+    png = convergence(args.runs, args.out or Path(args.runs[0]) / "convergence.png", args.reference)
+    print(f"wrote {png}")
     return 0
 
 
@@ -63,8 +79,9 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="prebo", description="pre-Born–Oppenheimer ECG solver")
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="optimise a basis for the system of a TOML input")
-    run.add_argument("input", help="TOML input file")
+    run.add_argument("input", nargs="?", help="TOML input file")
     run.add_argument("--out", help="output folder (default runs/INPUT-STEM)")
+    run.add_argument("--resume", metavar="DIR", help="continue the run whose checkpoint is DIR/basis.json")
     run.add_argument("--quiet", action="store_true", help="no progress display")
     run.set_defaults(func=cmd_run)
     en = sub.add_parser("energy", help="re-evaluate a stored basis")
@@ -73,6 +90,11 @@ def parser() -> argparse.ArgumentParser:
                     help="lab: LFCC with CM elimination (default); ti: translationally invariant (shared c_A only)")
     en.add_argument("--json", action="store_true", help="print one JSON object")
     en.set_defaults(func=cmd_energy)
+    pl = sub.add_parser("plot", help="energy against basis size of one or more runs (PNG)")
+    pl.add_argument("runs", nargs="+", type=Path, help="run folders (with basis.json checkpoints)")
+    pl.add_argument("--reference", type=float, help="exact energy: plot E - E_ref on a log axis")
+    pl.add_argument("--out", type=Path, help="PNG file (default FIRST-RUN/convergence.png)")
+    pl.set_defaults(func=cmd_plot)
     return p
 
 

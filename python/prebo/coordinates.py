@@ -112,12 +112,27 @@ def cm_centred(masses: np.ndarray, dropped: int | None = None) -> CoordinateSet:
     return CoordinateSet(f"cmc:{dropped}", U)
 
 
-def all_sets(masses: np.ndarray) -> list[CoordinateSet]:
-    """Every Jacobi set (orders equal up to swapping the first two particles counted once),
-    every heavy-particle-centred set and the CM-centred set."""
+def all_sets(masses: np.ndarray, labels=None) -> list[CoordinateSet]:
+    """Every Jacobi set, every heavy-particle-centred set and the CM-centred set.
+
+    Sets that differ only by a relabelling of identical particles (equal `labels`, e.g. the
+    particle names) are counted once, as are Jacobi orders that differ only by swapping the
+    first two particles (x_1 changes sign). Without labels every particle is distinct."""
     n = len(masses)
-    sets = [jacobi(masses, order) for order in itertools.permutations(range(n)) if order[0] < order[1]]
-    sets += [heavy_particle_centred(masses, c) for c in range(n)]
+    labels = list(range(n)) if labels is None else list(labels)
+    sets, seen = [], set()
+
+    def add(key, make):
+        if key not in seen:
+            seen.add(key)
+            sets.append(make())
+
+    for order in itertools.permutations(range(n)):
+        names = [labels[i] for i in order]
+        first = tuple(sorted(map(str, names[:2])))
+        add(("jacobi", first, tuple(map(str, names[2:]))), lambda o=order: jacobi(masses, o))
+    for c in range(n):
+        add(("hpc", str(labels[c])), lambda c=c: heavy_particle_centred(masses, c))
     sets.append(cm_centred(masses))
     return sets
 

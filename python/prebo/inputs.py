@@ -45,7 +45,7 @@ def from_dict(d: dict) -> Job:
     state_t = _table(d, "state", {"N", "parity", "spin"})
     basis_t = _table(d, "basis", {"type", "size", "c_A", "K_max"})
     opt_t = _table(d, "optimiser", {"trials", "sweeps", "refine", "refine_evaluations", "seed", "channels",
-                                    "length_range"})
+                                    "length_range", "learned", "learn_after"})
     if "particles" not in system_t:
         raise InputError("[system] needs 'particles'")
     system = System(system_t["particles"], State(**state_t))
@@ -58,12 +58,7 @@ def from_dict(d: dict) -> Job:
         raise InputError(f"ECG-GVR functions have natural parity (-1)^N = {(-1) ** system.state.N:+d}, "
                          f"not {system.state.parity:+d}")
     kw = {k: basis_t[k] for k in ("size", "c_A", "K_max") if k in basis_t} | opt_t | {"kind": kind}
-    if "length_range" in kw:
-        kw["length_range"] = tuple(kw["length_range"])
-    try:
-        opts = Optimiser(**kw)
-    except TypeError as exc:
-        raise InputError(str(exc)) from exc
+    opts = Optimiser.from_dict(kw)
     return Job(str(d.get("title", system.label())), system, opts, kind)
 
 

@@ -28,7 +28,7 @@ from . import eigen
 from .basis import Basis
 from .errors import InputError
 from .integrals import laboratory
-from .refine import refine_function
+from .refine import Parametrisation, refine_function
 from .system import System
 
 
@@ -47,8 +47,22 @@ class Optimiser:
     K_max: int = 0
     refine: int = 0
     refine_evaluations: int = 200
+    learned: float = 0.5
+    learn_after: int = 5
     min_norm: float = 1e-8
     threshold: float = 1e-13
+
+    def to_dict(self) -> dict:
+        return vars(self) | {"length_range": list(self.length_range)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Optimiser":
+        d = dict(d)
+        d["length_range"] = tuple(d.get("length_range", cls.length_range))
+        try:
+            return cls(**d)
+        except TypeError as exc:
+            raise InputError(f"optimiser settings: {exc}") from exc
 
     def __post_init__(self):
         if not (isinstance(self.size, int) and self.size >= 1):
@@ -64,6 +78,8 @@ class Optimiser:
             raise InputError(f"basis.c_A must be positive, got {self.c_A!r}")
         if self.kind not in ("pecg", "ecg-gvr", "fecg"):
             raise InputError(f"basis.type must be 'pecg', 'ecg-gvr' or 'fecg', got {self.kind!r}")
+        if not 0.0 <= self.learned <= 1.0:
+            raise InputError(f"optimiser.learned must be a probability in [0, 1], got {self.learned!r}")
         if not (isinstance(self.refine, int) and self.refine >= 0):
             raise InputError(f"optimiser.refine must be a non-negative integer, got {self.refine!r}")
         if not (isinstance(self.K_max, int) and 0 <= self.K_max <= 60):
@@ -92,7 +108,7 @@ class Sampler:
         if ch == "pairs":
             self.sets = []
         elif ch == "all":
-            self.sets = coords.all_sets(m)
+            self.sets = coords.all_sets(m, [p.name for p in s.particles])
         elif isinstance(ch, (list, tuple)):
             self.sets = [coords.by_name(m, name) for name in ch]
         else:
@@ -110,8 +126,40 @@ class Sampler:
         w[i], w[j] = 1.0, -1.0
         return w
 
+    def learn(self, basis: Basis) -> None:
+        """Per channel: the mean and spread of the parameters θ (refine.Parametrisation) and the
+        powers K of the functions selected so far, for `draw`."""
+        self.learned = {}
+        if len(basis) == 0:
+            return
+        groups: dict[str, list[int]] = {}
+        for i, ch in enumerate(basis.channels):
+            groups.setdefault(ch, []).append(i)
+        for ch, idx in groups.items():
+            if len(idx) < self.opts.learn_after:
+                continue
+            ps = [Parametrisation.of(basis.subset([i])) for i in idx]
+            thetas = np.array([p.theta() for p in ps])
+            Ks = basis.K[idx] if basis.kind == "ecg-gvr" else None
+            self.learned[ch] = (ps[0], thetas.mean(axis=0), thetas.std(axis=0), Ks, len(idx))
+
     def draw(self) -> Basis:
-        """One random function as a one-function Basis."""
+        """One function: with probability `opts.learned` from the learned per-channel
+        distributions (normal in θ, K from the selected ones ± 2), otherwise `fresh`."""
+        learned = getattr(self, "learned", {})
+        if learned and self.rng.random() < self.opts.learned:
+            names = list(learned)
+            weights = np.array([learned[c][4] for c in names], float)
+            p, mean, std, Ks, _ = learned[names[self.rng.choice(len(names), p=weights / weights.sum())]]
+            theta = mean + self.rng.normal(size=mean.shape) * np.maximum(std, 0.05)
+            K = None
+            if Ks is not None:
+                K = int(np.clip(self.rng.choice(Ks) + self.rng.integers(-2, 3), 0, self.opts.K_max))
+            return p.function(theta, K)
+        return self.fresh()
+
+    def fresh(self) -> Basis:
+        """One random function as a one-function Basis (module docstring)."""
         s, c_A = self.system, self.opts.c_A
         n = s.n
         cm = s.cm_vector
@@ -184,7 +232,7 @@ class State:
         return abs(1.0 + (c @ self.m["V"] @ c) / (2.0 * (c @ self.m["T_ti"] @ c)))
 
     def candidates(self, trials: Basis, exclude: int | None = None, eig=None):
-        """Lowest energy with each trial added (to the basis without `exclude`), and the rows."""
+        """Lowest energy with each trial added (to the basis without `exclude`)."""
         rows, diag = self.rep.rows(trials, self.basis)
         H = rows["T_ti"] + rows["V"]
         S = rows["S"]
@@ -197,27 +245,17 @@ class State:
             eigen.lowest_with_added(E, C, H[t, keep], S[t, keep], diag[t, 2] + diag[t, 3], diag[t, 0])
             for t in range(len(trials))
         ])
-        return energies, rows, diag
+        return energies
 
-    def put(self, i: int, f: Basis, row: dict, d):
-        """Append (i == len) or replace function i by `f`, updating the matrices from its row."""
-        nb = len(self.basis)
-        values = {"S": d[0], "T": d[1], "T_ti": d[2], "V": d[3]}
-        if i == nb:
+    def put(self, i: int, f: Basis):
+        """Append (i == len) or replace function i by `f`. The matrices are rebuilt, not patched
+        from the candidate's row, so that the state is a function of the basis alone (a resumed
+        run then continues bit for bit)."""
+        if i == len(self.basis):
             self.basis.append(f)
-            for k in self.m:
-                M = np.zeros((nb + 1, nb + 1))
-                M[:nb, :nb] = self.m[k]
-                M[nb, :nb] = M[:nb, nb] = row[k]
-                M[nb, nb] = values[k]
-                self.m[k] = M
         else:
             self.basis.replace(i, f)
-            for k in self.m:
-                r = row[k].copy()
-                r[i] = values[k]
-                self.m[k][i, :] = r
-                self.m[k][:, i] = r
+        self.m = self.rep.matrices(self.basis)
         self.solve()
 
 
@@ -228,60 +266,120 @@ def _concat(fs: list[Basis]) -> Basis:
     return out
 
 
-def optimise(system: System, opts: Optimiser, out: Path | None = None, basis: Basis | None = None,
-             progress: bool = True) -> Basis:
-    """Grow a basis to `opts.size` by competitive selection, then run `opts.sweeps` replacement sweeps."""
+@dataclass
+class Cursor:
+    """The next unit of work: one competitive step ("grow"), or function `index` of
+    replacement sweep / Powell refinement sweep `sweep` ("sweep", "refine"), or "done"."""
+
+    phase: str = "grow"
+    sweep: int = 0
+    index: int = 0
+
+    def advance(self, nb: int, opts: Optimiser) -> "Cursor":
+        if self.phase == "grow":
+            if nb < opts.size:
+                return self
+            return Cursor("sweep").settle(opts)
+        nxt = Cursor(self.phase, self.sweep, self.index + 1)
+        if nxt.index >= nb:
+            nxt = Cursor(self.phase, self.sweep + 1, 0)
+        return nxt.settle(opts)
+
+    def settle(self, opts: Optimiser) -> "Cursor":
+        """Skip phases whose sweeps are used up."""
+        if self.phase == "sweep" and self.sweep >= opts.sweeps:
+            return Cursor("refine").settle(opts)
+        if self.phase == "refine" and self.sweep >= opts.refine:
+            return Cursor("done")
+        return self
+
+
+CHECKPOINT = "basis.json"
+
+
+def optimise(system: System, opts: Optimiser, out: Path | None = None, progress: bool = True,
+             resume: dict | None = None) -> Basis:
+    """Grow a basis to `opts.size` by competitive selection, then `opts.sweeps` random replacement
+    sweeps and `opts.refine` Powell sweeps. With `out`, the basis, the random-number state and the
+    position in this schedule are written atomically after every step (out/basis.json); `resume`
+    (that file's content) continues such a run exactly where it stopped."""
     rng = np.random.default_rng(opts.seed)
     sampler = Sampler(system, opts, rng)
     rep = laboratory(system)
-    st = State(basis or Basis.empty(system, opts.kind), rep, opts.threshold)
+    if resume is None:
+        basis, cursor, history = Basis.empty(system, opts.kind), Cursor().advance(0, opts), []
+    else:
+        basis = Basis.from_dict(resume, "checkpoint")
+        rng.bit_generator.state = resume["rng"]
+        cursor, history = Cursor(**resume["progress"]), resume["history"]
+    st = State(basis, rep, opts.threshold)
+    sampler.learn(st.basis)
     report = Reporter(opts, progress)
 
     def checkpoint():
         if out is not None:
-            st.basis.coefficients = st.eig.vectors[:, 0]
-            st.basis.save(Path(out) / "basis.json", {"energy": st.energy, "optimiser": vars(opts) | {
-                "length_range": list(opts.length_range)}})
+            st.basis.coefficients = st.eig.vectors[:, 0] if st.eig is not None else None
+            st.basis.save(Path(out) / CHECKPOINT, {
+                "energy": st.energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
+                "rng": rng.bit_generator.state, "history": history})
 
     def draw(k) -> Basis:
         return _concat([sampler.draw() for _ in range(k)])
 
+
     with report:
-        while len(st.basis) < opts.size:
-            trials = draw(opts.trials)
-            energies, rows, diag = st.candidates(trials)
-            best = int(np.argmin(energies))
-            report.trials(len(trials))
-            if np.isfinite(energies[best]) and energies[best] < st.energy:
-                old = st.energy
-                st.put(len(st.basis), trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
-                if opts.refine:  # competitive selection, then Powell refinement of the winner
-                    refine_function(st, len(st.basis) - 1, opts.refine_evaluations)
-                checkpoint()
-                report.step(st, old)
-        for sweep in range(opts.sweeps):
-            for i in range(len(st.basis)):
+        while cursor.phase != "done":
+            old = st.energy
+            if cursor.phase == "grow":
+                trials = draw(opts.trials)
+                energies = st.candidates(trials)
+                best = int(np.argmin(energies))
+                report.trials(len(trials))
+                if np.isfinite(energies[best]) and energies[best] < st.energy:
+                    st.put(len(st.basis), trials.subset([best]))
+                    if opts.refine:  # competitive selection, then Powell refinement of the winner
+                        refine_function(st, len(st.basis) - 1, opts.refine_evaluations)
+            elif cursor.phase == "sweep":
+                i = cursor.index
                 keep = np.arange(len(st.basis)) != i
                 sub = eigen.solve((st.m["T_ti"] + st.m["V"])[np.ix_(keep, keep)], st.m["S"][np.ix_(keep, keep)],
                                   opts.threshold)
                 trials = draw(opts.trials)
-                energies, rows, diag = st.candidates(trials, exclude=i, eig=sub)
+                energies = st.candidates(trials, exclude=i, eig=sub)
                 report.trials(len(trials))
                 best = int(np.argmin(energies))
                 if np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
-                    old = st.energy
-                    st.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
-                    checkpoint()
-                    report.step(st, old, sweep=sweep + 1)
-        for sweep in range(opts.refine):
-            for i in range(len(st.basis)):
-                old = st.energy
+                    st.put(i, trials.subset([best]))
+            else:
                 report.trials(1)
-                if refine_function(st, i, opts.refine_evaluations):
-                    checkpoint()
-                    report.step(st, old, sweep=sweep + 1, label="refine")
+                refine_function(st, cursor.index, opts.refine_evaluations)
+            if st.energy < old:
+                history.append([len(st.basis), st.energy, cursor.phase])
+                report.step(st, old, cursor)
+                sampler.learn(st.basis)  # a function of the basis alone, so a resumed run learns the same
+            cursor = cursor.advance(len(st.basis), opts)
+            checkpoint()
     st.basis.coefficients = st.eig.vectors[:, 0]
     return st.basis
+
+
+def resume_from(folder: Path, progress: bool = True) -> tuple[Basis, Optimiser]:
+    """Continue the run whose checkpoint is folder/basis.json."""
+    import json
+
+    from .errors import BasisFileError
+    path = Path(folder) / CHECKPOINT
+    try:
+        d = json.loads(path.read_text())
+    except OSError as exc:
+        raise BasisFileError(f"{path}: no checkpoint to resume ({exc.strerror})") from exc
+    except json.JSONDecodeError as exc:
+        raise BasisFileError(f"{path}: corrupt checkpoint (line {exc.lineno}: {exc.msg})") from exc
+    if not {"optimiser", "progress", "rng", "history"} <= set(d):
+        raise BasisFileError(f"{path}: not a run checkpoint (no optimiser state)")
+    opts = Optimiser.from_dict(d["optimiser"])
+    system = Basis.from_dict(d, str(path)).system
+    return optimise(system, opts, out=Path(folder), progress=progress, resume=d), opts
 
 
 class Reporter:
@@ -308,13 +406,14 @@ class Reporter:
     def trials(self, k):
         self.n_trials += k
 
-    def step(self, st: State, old: float, sweep: int = 0, label: str = "sweep"):
+    def step(self, st: State, old: float, cursor: Cursor):
         if self.progress is None:
             return
         rate = self.n_trials / max(time.perf_counter() - self.t0, 1e-9)
         gain = old - st.energy if np.isfinite(old) else float("nan")
-        info = f"E = {st.energy:.12f}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.0f} trials/s"
-        if sweep:
-            self.progress.update(self.task, description=f"{label} {sweep}", info=info)
-        else:
+        info = f"E = {st.energy:.12f}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.1f} trials/s"
+        if cursor.phase == "grow":
             self.progress.update(self.task, completed=len(st.basis), info=info)
+        else:
+            self.progress.update(self.task, description=f"{cursor.phase} {cursor.sweep + 1}",
+                                 completed=cursor.index + 1, total=len(st.basis), info=info)

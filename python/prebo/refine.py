@@ -17,6 +17,7 @@ from scipy.optimize import minimize
 from . import coordinates as coords
 from . import eigen
 from .basis import Basis
+from .errors import PreboError
 
 
 @dataclass
@@ -44,7 +45,7 @@ class Parametrisation:
             parts.append((self.x.U @ self.f.s[0])[:-1].ravel())
         return np.concatenate(parts)
 
-    def function(self, theta: np.ndarray) -> Basis:
+    def function(self, theta: np.ndarray, K: int | None = None) -> Basis:
         d = self.f.system.n - 1
         L = np.diag(np.exp(np.clip(theta[:d], -30, 30)))
         nl = d * (d - 1) // 2
@@ -59,7 +60,8 @@ class Parametrisation:
             return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="fecg", s=(self.x.U_inv @ sx)[None])
         c_U = float(self.f.u[0].sum())
         u = self.x.U.T @ np.append(theta[d + nl:], c_U)
-        return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="ecg-gvr", u=u[None], K=self.f.K[:1])
+        return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="ecg-gvr", u=u[None],
+                     K=self.f.K[:1] if K is None else [K])
 
 
 def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
@@ -73,24 +75,29 @@ def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
     else:
         E, C = np.zeros(0), np.zeros((0, 0))
     p = Parametrisation.of(basis.subset([i]))
-    best = {"E": state.energy, "f": None, "row": None, "diag": None}
+    best = {"E": state.energy, "f": None}
 
     def energy(theta):
         f = p.function(theta)
+        # a θ that leaves the valid region, or a function linearly dependent on the others,
+        # scores worse than the current energy (a finite value keeps Powell's line search sane)
+        worse = state.energy + 1.0
         try:
             rows, diag = state.rep.rows(f, basis)
-        except Exception:  # a θ that leaves the valid region (e.g. overflow): reject
-            return np.inf
+        except PreboError:
+            return worse
         e = eigen.lowest_with_added(E, C, (rows["T_ti"] + rows["V"])[0, keep],
                                     rows["S"][0, keep], diag[0, 2] + diag[0, 3], diag[0, 0])
+        if not np.isfinite(e):
+            return worse
         if e < best["E"]:
-            best.update(E=e, f=f, row={k: v[0] for k, v in rows.items()}, diag=diag[0])
+            best.update(E=e, f=f)
         return e
 
     theta0 = p.theta()
     minimize(energy, theta0, method="Powell",
              options={"maxfev": max_evaluations, "xtol": 1e-4, "ftol": 1e-14, "direc": 0.1 * np.eye(len(theta0))})
     if best["f"] is not None and best["E"] < state.energy - 1e-15 * abs(state.energy):
-        state.put(i, best["f"], best["row"], best["diag"])
+        state.put(i, best["f"])
         return True
     return False
