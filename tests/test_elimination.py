@@ -88,3 +88,29 @@ def test_unequal_c_A_energy_is_an_upper_bound_of_the_shared_one():
     r_mixed = prebo.evaluate(mixed)
     assert r_mixed["energy"] >= exact
     assert r_shared["energy"] >= exact
+
+
+def test_non_separable_gvr_and_fecg_energies_stay_upper_bounds():
+    """c_U != 0 (GVR) or centres with different CM positions (FECG): the function is no CM ×
+    internal product, and the eliminated energy is <H_int ⊗ 1_CM>, still above the internal
+    ground state. For N > 0, c_U != 0 lets the CM carry angular momentum: the internal part may
+    then be an s state, so the energy is bounded by the ground state, not by the N = 1 level
+    (docs/gvr.md) — which is why the optimiser keeps c_U = 0."""
+    system = prebo.System(["p", "e"])
+    mu = system.masses[0] / (1 + system.masses[0])
+    x = jacobi(system.masses)
+    alphas = 0.02 * 2.0 ** np.arange(12)
+    A = np.array([x.to_lab(np.array([[a]]), 1.0) for a in alphas])
+    rng = np.random.default_rng(8)
+    fecg = prebo.Basis(system, A, np.ones(12), kind="fecg", s=rng.normal(size=(12, 2, 3)))
+    assert np.ptp(np.einsum("i,nij->nj", system.cm_vector, fecg.s)) > 0.1  # CM positions differ
+    assert prebo.evaluate(fecg)["energy"] > -mu / 2
+    p2 = prebo.System(["p", "e"], state=prebo.State(N=1, parity=-1))
+    u = np.tile([-1.0, 1.0], (12, 1)) + rng.normal(size=(12, 2))  # c_U = u_1 + u_2 != 0
+    gvr = prebo.Basis(p2, A, np.ones(12), kind="ecg-gvr", u=u, K=np.zeros(12, int))
+    assert np.all(np.abs(u.sum(axis=1)) > 1e-3)
+    e = prebo.evaluate(gvr)["energy"]
+    assert -mu / 2 < e < -mu / 8  # above the 1s level, below the 2p level it no longer describes
+    gvr.u -= np.outer(u.sum(axis=1), system.cm_vector)  # c_U = 0: a genuine internal N = 1 state
+    assert np.allclose(gvr.u.sum(axis=1), 0)
+    assert prebo.evaluate(gvr)["energy"] > -mu / 8

@@ -29,7 +29,7 @@
 //!
 //! CM elimination (paper eq. GENCONSTR:ecggvr, generalised to c_U ≠ 0 and unequal c_A):
 //! the same expression with `Λ = 1 1^T/(2 m_tot)`; with `A 1 = c_A m/m_tot`, `1^T u = c_U`,
-//! `s = c_I + c_J` it collapses to the closed form of [`cm_kinetic`].
+//! `s = c_I + c_J` it collapses to the closed form of `cm_kinetic`.
 //!
 //! Coulomb `<1/|w^T r|>`: `1/r = (2/√π)∫exp(-t²r²)dt` and `τ² = t²c/(1+t²c)`, `c = w^T B^{-1} w`:
 //!
@@ -154,18 +154,14 @@ fn series_shifted(ki: u32, kj: u32, r2: f64) -> (f64, f64, f64, f64) {
     (0.0, 0.0, 0.0, gz)
 }
 
-/// Closed form of the kinetic element with `Λ = 1 1^T/(2 m_tot)` over `e^L S_0` (module docs).
+/// Closed form of the kinetic element with `Λ = 1 1^T/(2 m_tot)` over `e^L S_0` (docs/gvr.md):
+/// `3 c_I c_J/(m s) Ω − (c_UI² c_J Ω_x + c_UJ² c_I Ω_y)/(m s) + c_I c_J (c_UI² Ω_x + c_UI c_UJ Ω_z + c_UJ² Ω_y)/(m s²)`.
 #[inline]
 fn cm_kinetic(ci: f64, cj: f64, ui: f64, uj: f64, m: f64, w: (f64, f64, f64, f64)) -> f64 {
     let (om, ox, oy, oz) = w;
     let s = ci + cj;
-    ui * uj / (2.0 * m) * oz - ui * ui * cj / (m * s) * ox - ui * uj * cj / (2.0 * m * s) * oz
-        - uj * uj * ci / (m * s) * oy
-        - ui * uj * ci / (2.0 * m * s) * oz
-        + 3.0 * ci * cj / (m * s) * om
-        + ci * cj * ui * ui / (m * s * s) * ox
-        + ci * cj * ui * uj / (m * s * s) * oz
-        + ci * cj * uj * uj / (m * s * s) * oy
+    3.0 * ci * cj / (m * s) * om - (ui * ui * cj * ox + uj * uj * ci * oy) / (m * s)
+        + ci * cj * (ui * ui * ox + ui * uj * oz + uj * uj * oy) / (m * s * s)
 }
 
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised ECG-GVR functions.
