@@ -92,3 +92,27 @@ def test_refinement_and_learning_lower_the_energy():
                             progress=False)
     e_plain, e_better = prebo.evaluate(plain)["energy"], prebo.evaluate(better)["energy"]
     assert -0.527445881114 < e_better < e_plain
+
+
+@pytest.mark.parametrize("kind, extra", [("ecg-gvr", {"K_max": 3}), ("fecg", {})])
+def test_patched_matrices_have_the_bits_of_a_full_build(kind, extra):
+    """Appending and replacing through oriented rows gives exactly the matrices of a fresh build
+    (what makes a resumed run continue bit for bit without rebuilding after every step)."""
+    import importlib
+
+    from prebo import eigen
+    from prebo.integrals import laboratory
+    O = importlib.import_module("prebo.optimise")
+    s = prebo.System(["p", "e", "e"], spin={"e": 0})
+    b = prebo.optimise(s, Optimiser(size=6, trials=4, seed=3, kind=kind, channels="all", **extra), progress=False)
+    rep = laboratory(s)
+    st = O.State(b.subset(slice(0, 4)), rep, 1e-13)
+    _, rows, diag = st.candidates(b.subset([4]))
+    st.put(4, b.subset([4]), {k: v[0] for k, v in rows.items()}, diag[0])
+    keep = np.arange(5) != 1
+    sub = eigen.solve((st.m["T_ti"] + st.m["V"])[np.ix_(keep, keep)], st.m["S"][np.ix_(keep, keep)])
+    _, rows, diag = st.candidates(b.subset([5]), exclude=1, eig=sub)
+    st.put(1, b.subset([5]), {k: v[0] for k, v in rows.items()}, diag[0])
+    full = rep.matrices(st.basis)
+    for k in full:
+        assert np.array_equal(full[k], st.m[k]), k

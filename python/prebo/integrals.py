@@ -75,13 +75,22 @@ class Representation:
             return _core.fecg_matrices(*self.arrays(f), *self._ops())
         return _core.matrices(*self.arrays(f), *self._ops())
 
-    def rows(self, trials, f) -> tuple[dict, np.ndarray]:
-        """Rows (k x nb) of `trials` against the basis `f`, and the trials' diagonals [S, T, T_ti, V]."""
+    def rows(self, trials, f, position: int | None = None) -> tuple[dict, np.ndarray]:
+        """Rows (k x nb) of `trials` against the basis `f`, and the trials' diagonals [S, T, T_ti, V].
+
+        `position`: where a trial would sit in the basis (default: appended). ECG-GVR and FECG rows
+        are then evaluated in the orientation of a full build, so patching them into the matrices
+        gives the bits of `matrices` (`oriented`); plain-ECG rows always have the trial as bra."""
         if f.kind == "ecg-gvr":
-            return _core.gvr_rows(*self.arrays(trials), *self.arrays(f), f.N, *self._ops())
+            return _core.gvr_rows(*self.arrays(trials), *self.arrays(f), f.N, *self._ops(), position)
         if f.kind == "fecg":
-            return _core.fecg_rows(*self.arrays(trials), *self.arrays(f), *self._ops())
+            return _core.fecg_rows(*self.arrays(trials), *self.arrays(f), *self._ops(), position)
         return _core.rows(*self.arrays(trials), *self.arrays(f), *self._ops())
+
+    @staticmethod
+    def oriented(kind: str) -> bool:
+        """Whether `rows(..., position)` reproduces full-build bits for this basis type."""
+        return kind in ("ecg-gvr", "fecg")
 
     def angular(self, f, mu: np.ndarray) -> np.ndarray:
         """The symmetrised translation-free <N²> matrix of a floating-ECG basis (laboratory frame)."""

@@ -232,8 +232,10 @@ class State:
         return abs(1.0 + (c @ self.m["V"] @ c) / (2.0 * (c @ self.m["T_ti"] @ c)))
 
     def candidates(self, trials: Basis, exclude: int | None = None, eig=None):
-        """Lowest energy with each trial added (to the basis without `exclude`)."""
-        rows, diag = self.rep.rows(trials, self.basis)
+        """Lowest energy with each trial added (to the basis without `exclude`, where the trial
+        would replace it), with the rows and diagonals for `put`."""
+        position = len(self.basis) if exclude is None else exclude
+        rows, diag = self.rep.rows(trials, self.basis, position)
         H = rows["T_ti"] + rows["V"]
         S = rows["S"]
         keep = np.ones(len(self.basis), bool)
@@ -245,17 +247,33 @@ class State:
             eigen.lowest_with_added(E, C, H[t, keep], S[t, keep], diag[t, 2] + diag[t, 3], diag[t, 0])
             for t in range(len(trials))
         ])
-        return energies
+        return energies, rows, diag
 
-    def put(self, i: int, f: Basis):
-        """Append (i == len) or replace function i by `f`. The matrices are rebuilt, not patched
-        from the candidate's row, so that the state is a function of the basis alone (a resumed
-        run then continues bit for bit)."""
-        if i == len(self.basis):
+    def put(self, i: int, f: Basis, row: dict | None = None, d=None):
+        """Append (i == len) or replace function i by `f`. The matrices are patched from the
+        function's oriented row (`Representation.rows` with position i) or else rebuilt, so that
+        the state is a function of the basis alone and a resumed run continues bit for bit."""
+        nb = len(self.basis)
+        if i == nb:
             self.basis.append(f)
         else:
             self.basis.replace(i, f)
-        self.m = self.rep.matrices(self.basis)
+        if row is None or not self.rep.oriented(self.basis.kind):
+            self.m = self.rep.matrices(self.basis)
+        else:
+            values = {"S": d[0], "T": d[1], "T_ti": d[2], "V": d[3]}
+            for k in self.m:
+                r = np.array(row[k], copy=True)
+                if i == nb:
+                    M = np.zeros((nb + 1, nb + 1))
+                    M[:nb, :nb] = self.m[k]
+                    M[nb, :nb] = M[:nb, nb] = r
+                    M[nb, nb] = values[k]
+                    self.m[k] = M
+                else:
+                    r[i] = values[k]
+                    self.m[k][i, :] = r
+                    self.m[k][:, i] = r
         self.solve()
 
 
@@ -332,11 +350,11 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
             old = st.energy
             if cursor.phase == "grow":
                 trials = draw(opts.trials)
-                energies = st.candidates(trials)
+                energies, rows, diag = st.candidates(trials)
                 best = int(np.argmin(energies))
                 report.trials(len(trials))
                 if np.isfinite(energies[best]) and energies[best] < st.energy:
-                    st.put(len(st.basis), trials.subset([best]))
+                    st.put(len(st.basis), trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
                     if opts.refine:  # competitive selection, then Powell refinement of the winner
                         refine_function(st, len(st.basis) - 1, opts.refine_evaluations)
             elif cursor.phase == "sweep":
@@ -345,11 +363,11 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 sub = eigen.solve((st.m["T_ti"] + st.m["V"])[np.ix_(keep, keep)], st.m["S"][np.ix_(keep, keep)],
                                   opts.threshold)
                 trials = draw(opts.trials)
-                energies = st.candidates(trials, exclude=i, eig=sub)
+                energies, rows, diag = st.candidates(trials, exclude=i, eig=sub)
                 report.trials(len(trials))
                 best = int(np.argmin(energies))
                 if np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
-                    st.put(i, trials.subset([best]))
+                    st.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
             else:
                 report.trials(1)
                 refine_function(st, cursor.index, opts.refine_evaluations)

@@ -75,7 +75,7 @@ def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
     else:
         E, C = np.zeros(0), np.zeros((0, 0))
     p = Parametrisation.of(basis.subset([i]))
-    best = {"E": state.energy, "f": None}
+    best = {"E": state.energy, "f": None, "row": None, "diag": None}
 
     def energy(theta):
         f = p.function(theta)
@@ -83,7 +83,7 @@ def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
         # scores worse than the current energy (a finite value keeps Powell's line search sane)
         worse = state.energy + 1.0
         try:
-            rows, diag = state.rep.rows(f, basis)
+            rows, diag = state.rep.rows(f, basis, i)
         except PreboError:
             return worse
         e = eigen.lowest_with_added(E, C, (rows["T_ti"] + rows["V"])[0, keep],
@@ -91,13 +91,13 @@ def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
         if not np.isfinite(e):
             return worse
         if e < best["E"]:
-            best.update(E=e, f=f)
+            best.update(E=e, f=f, row={k: v[0] for k, v in rows.items()}, diag=diag[0])
         return e
 
     theta0 = p.theta()
     minimize(energy, theta0, method="Powell",
              options={"maxfev": max_evaluations, "xtol": 1e-4, "ftol": 1e-14, "direc": 0.1 * np.eye(len(theta0))})
     if best["f"] is not None and best["E"] < state.energy - 1e-15 * abs(state.energy):
-        state.put(i, best["f"])
+        state.put(i, best["f"], best["row"], best["diag"])
         return True
     return False

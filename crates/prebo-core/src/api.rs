@@ -155,13 +155,33 @@ fn gvr_rows_d<const D: usize>(
     n_ang: u32,
     trials: &GvrFunctions,
     basis: &GvrFunctions,
+    position: Option<usize>,
 ) -> Result<(Matrices, Vec<Element>)> {
     let k_max = basis.k.iter().chain(trials.k).copied().max().unwrap_or(0);
     let (go, sym) = gvr_ops::<D>(setup, n_ang, k_max)?;
     let t = Images::new(gvr_functions(trials, &go)?, &sym, &go)?;
     let b = Images::new(gvr_functions(basis, &go)?, &sym, &go)?;
     let el = |x: &Gvr<D>, y: &Gvr<D>| gvr::element(x, y, &go);
-    Ok(assemble::rows(t.len(), b.len(), |i, j| b.element(&t.functions[i], j, el), |i| t.element(&t.functions[i], i, el)))
+    Ok(oriented_rows(&t, &b, position, el))
+}
+
+/// Rows of trials `t` against basis `b` for a trial that will sit at `position` (`None`: appended).
+/// Element `j` is evaluated with the lower index as bra — `(b_j, t)` for `j < position`,
+/// `(t, b_j)` after — exactly as `assemble::symmetric` evaluates the full matrix, so a basis
+/// grown from such rows has bit-for-bit the matrices of a fresh build.
+fn oriented_rows<F: Sync>(
+    t: &Images<F>,
+    b: &Images<F>,
+    position: Option<usize>,
+    el: impl Fn(&F, &F) -> Element + Sync + Copy,
+) -> (Matrices, Vec<Element>) {
+    let pos = position.unwrap_or(b.len());
+    assemble::rows(
+        t.len(),
+        b.len(),
+        |i, j| if j < pos { t.element(&b.functions[j], i, el) } else { b.element(&t.functions[i], j, el) },
+        |i| t.element(&t.functions[i], i, el),
+    )
 }
 
 /// Symmetrised matrices of an ECG-GVR basis with total angular momentum `n_ang` (M = N).
@@ -169,9 +189,16 @@ pub fn gvr_matrices(setup: &Setup, n_ang: u32, basis: &GvrFunctions) -> Result<M
     dispatch!(setup.n, gvr_matrices_d(setup, n_ang, basis))
 }
 
-/// Rows of ECG-GVR trial functions against a basis, with the trials' diagonal elements.
-pub fn gvr_rows(setup: &Setup, n_ang: u32, trials: &GvrFunctions, basis: &GvrFunctions) -> Result<(Matrices, Vec<Element>)> {
-    dispatch!(setup.n, gvr_rows_d(setup, n_ang, trials, basis))
+/// Rows of ECG-GVR trial functions against a basis, with the trials' diagonal elements
+/// (`position`: where the trial will sit, see `oriented_rows`).
+pub fn gvr_rows(
+    setup: &Setup,
+    n_ang: u32,
+    trials: &GvrFunctions,
+    basis: &GvrFunctions,
+    position: Option<usize>,
+) -> Result<(Matrices, Vec<Element>)> {
+    dispatch!(setup.n, gvr_rows_d(setup, n_ang, trials, basis, position))
 }
 
 /// Floating ECGs: `k x n x n` exponents, `k x n x 3` centres, `k` values of c_A.
@@ -204,12 +231,13 @@ fn fecg_rows_d<const D: usize>(
     setup: &Setup,
     trials: &FecgFunctions,
     basis: &FecgFunctions,
+    position: Option<usize>,
 ) -> Result<(Matrices, Vec<Element>)> {
     let (ops, sym) = setup.operators::<D>()?;
     let t = Images::new(fecg_functions::<D>(trials)?, &sym, &())?;
     let b = Images::new(fecg_functions::<D>(basis)?, &sym, &())?;
     let el = |x: &Fecg<D>, y: &Fecg<D>| fecg::element(x, y, &ops);
-    Ok(assemble::rows(t.len(), b.len(), |i, j| b.element(&t.functions[i], j, el), |i| t.element(&t.functions[i], i, el)))
+    Ok(oriented_rows(&t, &b, position, el))
 }
 
 fn fecg_angular_d<const D: usize>(setup: &Setup, mu: &[f64], basis: &FecgFunctions) -> Result<Vec<f64>> {
@@ -229,9 +257,15 @@ pub fn fecg_matrices(setup: &Setup, basis: &FecgFunctions) -> Result<Matrices> {
     dispatch!(setup.n, fecg_matrices_d(setup, basis))
 }
 
-/// Rows of floating-ECG trial functions against a basis, with the trials' diagonal elements.
-pub fn fecg_rows(setup: &Setup, trials: &FecgFunctions, basis: &FecgFunctions) -> Result<(Matrices, Vec<Element>)> {
-    dispatch!(setup.n, fecg_rows_d(setup, trials, basis))
+/// Rows of floating-ECG trial functions against a basis, with the trials' diagonal elements
+/// (`position`: where the trial will sit, see `oriented_rows`).
+pub fn fecg_rows(
+    setup: &Setup,
+    trials: &FecgFunctions,
+    basis: &FecgFunctions,
+    position: Option<usize>,
+) -> Result<(Matrices, Vec<Element>)> {
+    dispatch!(setup.n, fecg_rows_d(setup, trials, basis, position))
 }
 
 /// The symmetrised `<phi_I|N_TI²|phi_J>` matrix (row-major) of a floating-ECG basis (LFCC only).

@@ -201,7 +201,7 @@ fn gvr_matrices<'py>(
 
 /// Rows (k x nb) of ECG-GVR trial functions against a basis, and the trials' diagonals (k x 4).
 #[pyfunction]
-#[pyo3(signature = (trial_a, trial_u, trial_k, trial_c_a, a, u, k, c_a, n_ang, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None))]
+#[pyo3(signature = (trial_a, trial_u, trial_k, trial_c_a, a, u, k, c_a, n_ang, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None, position=None))]
 #[allow(clippy::too_many_arguments)]
 fn gvr_rows<'py>(
     py: Python<'py>,
@@ -220,12 +220,13 @@ fn gvr_rows<'py>(
     sym_t: PyReadonlyArray3<f64>,
     sym_c: PyReadonlyArray1<f64>,
     cm_mass: Option<f64>,
+    position: Option<usize>,
 ) -> PyResult<(Bound<'py, pyo3::types::PyDict>, Arr2<'py>)> {
     let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
     let trials = GvrData::new(trial_a, trial_u, trial_k, trial_c_a)?;
     let basis = GvrData::new(a, u, k, c_a)?;
     let (m, diag) = py
-        .allow_threads(|| api::gvr_rows(&setup.view(), n_ang, &trials.view(), &basis.view()))
+        .allow_threads(|| api::gvr_rows(&setup.view(), n_ang, &trials.view(), &basis.view(), position))
         .map_err(to_py)?;
     Ok((dict(py, m)?, diag_array(py, &diag)))
 }
@@ -272,7 +273,7 @@ fn fecg_matrices<'py>(
 
 /// Rows (k x nb) of floating-ECG trial functions against a basis, and the trials' diagonals (k x 4).
 #[pyfunction]
-#[pyo3(signature = (trial_a, trial_s, trial_c_a, a, s, c_a, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None))]
+#[pyo3(signature = (trial_a, trial_s, trial_c_a, a, s, c_a, lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass=None, position=None))]
 #[allow(clippy::too_many_arguments)]
 fn fecg_rows<'py>(
     py: Python<'py>,
@@ -288,12 +289,14 @@ fn fecg_rows<'py>(
     sym_t: PyReadonlyArray3<f64>,
     sym_c: PyReadonlyArray1<f64>,
     cm_mass: Option<f64>,
+    position: Option<usize>,
 ) -> PyResult<(Bound<'py, pyo3::types::PyDict>, Arr2<'py>)> {
     let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
     let trials = FecgData::new(trial_a, trial_s, trial_c_a)?;
     let basis = FecgData::new(a, s, c_a)?;
-    let (m, diag) =
-        py.allow_threads(|| api::fecg_rows(&setup.view(), &trials.view(), &basis.view())).map_err(to_py)?;
+    let (m, diag) = py
+        .allow_threads(|| api::fecg_rows(&setup.view(), &trials.view(), &basis.view(), position))
+        .map_err(to_py)?;
     Ok((dict(py, m)?, diag_array(py, &diag)))
 }
 
