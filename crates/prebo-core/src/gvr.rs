@@ -120,6 +120,19 @@ fn series(ki: u32, kj: u32, n: u32, r2: f64) -> (f64, f64, f64, f64) {
     (g, gx, gy, gz)
 }
 
+/// `ĉ_k`, k = 0..=min(K_I, K_J) (module docs).
+#[inline]
+fn coefficients(ki: u32, kj: u32, n: u32) -> Vec<f64> {
+    let alpha = n as f64 + 0.5;
+    let mut c = Vec::with_capacity(ki.min(kj) as usize + 1);
+    let mut ck = 1.0;
+    for k in 0..=ki.min(kj) {
+        c.push(ck);
+        ck *= ((ki - k) as f64) * ((kj - k) as f64) / (((k + 1) as f64) * (k as f64 + 1.0 + alpha));
+    }
+    c
+}
+
 /// Ω and its derivatives divided by `e^L`, `L = (K_I+N/2) ln x + (K_J+N/2) ln y`:
 /// returns `(L, ω, ω_x, ω_y, ω_z)`.
 #[inline]
@@ -203,8 +216,12 @@ pub fn element<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>) -> El
         None => t,
     };
 
-    // Coulomb by exact Gauss–Legendre quadrature in τ
+    // Coulomb by exact Gauss–Legendre quadrature in τ. At a node, Ω(τ)/e^L =
+    // (x_τ/x)^{K_I} (y_τ/y)^{K_J} (z_τ/√(xy))^N G(ρ_τ²): integer powers of ratios ≤ 1 and a
+    // polynomial in ρ_τ² ≤ 1 with the coefficients ĉ_k computed once per element.
     let rule = &go.legendre[(bra.k + ket.k + n + 1) as usize];
+    let coef = coefficients(bra.k, ket.k, n);
+    let rt = (x * y).sqrt();
     let mut v = 0.0;
     for (wv, q) in &ops.pairs {
         let bw = binv * wv;
@@ -215,11 +232,16 @@ pub fn element<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>) -> El
         for &(tau, weight) in rule {
             let t2 = tau * tau;
             // x_τ, y_τ >= 0 analytically (covariances of B + t² w w^T); clamp rounding
-            let xt = (x - t2 * gam_i * gam_i).max(x * 1e-300);
-            let yt = (y - t2 * gam_j * gam_j).max(y * 1e-300);
+            let xt = (x - t2 * gam_i * gam_i).max(0.0);
+            let yt = (y - t2 * gam_j * gam_j).max(0.0);
             let zt = z - t2 * gam_i * gam_j;
-            let (lt, omt, _, _, _) = omega(bra.k, ket.k, n, xt, yt, zt);
-            integral += weight * (lt - l).exp() * omt;
+            let r2 = if xt * yt > 0.0 { (zt * zt / (xt * yt)).min(1.0) } else { 1.0 };
+            let g = coef.iter().rev().fold(0.0, |acc, ck| acc * r2 + ck);
+            integral += weight
+                * (xt / x).powi(bra.k as i32)
+                * (yt / y).powi(ket.k as i32)
+                * (zt / rt).powi(n as i32)
+                * g;
         }
         v += q * 2.0 / (PI * c).sqrt() * integral;
     }
