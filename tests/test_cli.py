@@ -121,3 +121,13 @@ def test_ti_refuses_a_basis_with_unequal_c_A(run_dir, tmp_path):
     f = _edit_basis(run_dir, tmp_path, edit)
     assert prebo("energy", f).returncode == 0  # the laboratory-frame elimination takes it
     assert_clean_error(prebo("energy", f, "--coordinates", "ti"), "not separable in the CM coordinate")
+
+
+def test_plot_draws_the_convergence_of_runs(run_dir, tmp_path):
+    png = tmp_path / "conv.png"
+    r = prebo("plot", run_dir, run_dir, "--reference", -0.4997278397, "--out", png)
+    assert r.returncode == 0, r.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 5000
+    history = json.loads((run_dir / "basis.json").read_text())["history"]
+    assert [h[0] for h in history] == sorted(h[0] for h in history)  # basis size never shrinks
+    assert all(b[1] <= a[1] for a, b in zip(history, history[1:]))  # energy never rises
