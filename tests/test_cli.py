@@ -131,3 +131,20 @@ def test_plot_draws_the_convergence_of_runs(run_dir, tmp_path):
     history = json.loads((run_dir / "basis.json").read_text())["history"]
     assert [h[0] for h in history] == sorted(h[0] for h in history)  # basis size never shrinks
     assert all(b[1] <= a[1] for a, b in zip(history, history[1:]))  # energy never rises
+
+
+def test_ecgpack_import_export_and_energy(tmp_path):
+    """`prebo import`, `prebo export --format ecgpack` and `prebo energy FILE.inout.txt`; the Li file's
+    own Young operator survives basis.json (ecgpack energy in tests/data/ecgpack/README.md)."""
+    li = __import__("conftest").ROOT / "tests" / "data" / "ecgpack" / "ecgpack-Li7-100.inout.txt"
+    reference = -7.477376525757929
+    direct = json.loads(prebo("energy", li, "--json").stdout)["energy"]
+    assert direct == pytest.approx(reference, rel=1e-13)
+    assert prebo("import", li, "--out", tmp_path / "li.json").returncode == 0
+    via_json = json.loads(prebo("energy", tmp_path / "li.json", "--json").stdout)["energy"]
+    assert via_json == pytest.approx(reference, rel=1e-13)
+    assert prebo("export", tmp_path / "li.json", "--format", "ecgpack", "--out", tmp_path / "li.inout.txt").returncode == 0
+    back = json.loads(prebo("energy", tmp_path / "li.inout.txt", "--json").stdout)["energy"]
+    assert back == pytest.approx(reference, rel=1e-13)
+    (tmp_path / "bad.inout.txt").write_text("PARTICLES 3\nbroken\n")
+    assert_clean_error(prebo("energy", tmp_path / "bad.inout.txt"), "bad.inout.txt")

@@ -184,7 +184,7 @@ class Basis:
         if kind not in KINDS:
             raise BasisFileError(f"{where}: basis type {kind!r} is not supported by this version")
         try:
-            system = System.from_dict(d["system"])
+            system = System.from_dict(d["system"], d.get("symmetry"))
             funcs = d["functions"]
             n = system.n
             A = np.array([f["A"] for f in funcs], dtype=float).reshape(len(funcs), n, n)

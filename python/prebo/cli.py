@@ -1,4 +1,4 @@
-"""Command line: `prebo run`, `prebo energy`, `prebo plot`. Errors print one line and exit 2, never a traceback."""
+"""Command line: `prebo run`, `energy`, `import`, `export`, `plot`. Errors print one line and exit 2, never a traceback."""
 from __future__ import annotations
 
 import argparse
@@ -54,6 +54,29 @@ def cmd_run(args) -> int:
     return 0
 
 
+def cmd_import(args) -> int:
+    from .ecgpack import read_inout
+
+    basis = read_inout(args.file, c_A=args.c_A)
+    out = Path(args.out or str(args.file).removesuffix(".txt").removesuffix(".inout") + ".json")
+    basis.save(out)
+    print(f"wrote {out} ({len(basis)} {basis.kind} functions, {basis.system.label()})")
+    return 0
+
+
+def cmd_export(args) -> int:
+    from .ecgpack import write_inout
+    from .errors import UnsupportedError
+
+    basis = load_basis(args.basis)
+    if basis.kind != "pecg":
+        raise UnsupportedError(f"ecgpack's RG_0S format holds plain ECGs only, not {basis.kind}")
+    out = Path(args.out or str(args.basis).removesuffix(".json") + ".inout.txt")
+    write_inout(basis, out)
+    print(f"wrote {out}")
+    return 0
+
+
 def cmd_plot(args) -> int:
     from .plot import convergence
 
@@ -62,11 +85,20 @@ def cmd_plot(args) -> int:
     return 0
 
 
-def cmd_energy(args) -> int:
+def load_basis(path):
+    """A basis.json, or an ecgpack ``*.inout.txt`` (recognised by its name)."""
     from .basis import Basis
+
+    if str(path).endswith(".inout.txt"):
+        from .ecgpack import read_inout
+        return read_inout(path)
+    return Basis.load(path)
+
+
+def cmd_energy(args) -> int:
     from .results import evaluate, public
 
-    basis = Basis.load(args.basis)
+    basis = load_basis(args.basis)
     r = public(evaluate(basis, coordinates=args.coordinates))
     if args.json:
         print(json.dumps(r))
@@ -85,11 +117,21 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--quiet", action="store_true", help="no progress display")
     run.set_defaults(func=cmd_run)
     en = sub.add_parser("energy", help="re-evaluate a stored basis")
-    en.add_argument("basis", help="basis.json")
+    en.add_argument("basis", help="basis.json, or an ecgpack FILE.inout.txt")
     en.add_argument("--coordinates", choices=["lab", "ti"], default="lab",
                     help="lab: LFCC with CM elimination (default); ti: translationally invariant (shared c_A only)")
     en.add_argument("--json", action="store_true", help="print one JSON object")
     en.set_defaults(func=cmd_energy)
+    im = sub.add_parser("import", help="convert an ecgpack / ATOM-MOL-nonBO FILE.inout.txt to basis.json")
+    im.add_argument("file", help="ecgpack FILE.inout.txt (RG_0S: real plain ECGs)")
+    im.add_argument("--out", help="basis.json to write (default FILE.json)")
+    im.add_argument("--c-A", dest="c_A", type=float, default=1.0, help="CM exponent c_A of the LFCC functions")
+    im.set_defaults(func=cmd_import)
+    ex = sub.add_parser("export", help="write a plain-ECG basis in another code's format")
+    ex.add_argument("basis", help="basis.json")
+    ex.add_argument("--format", choices=["ecgpack"], required=True)
+    ex.add_argument("--out", help="file to write (default BASIS.inout.txt)")
+    ex.set_defaults(func=cmd_export)
     pl = sub.add_parser("plot", help="energy against basis size of one or more runs (PNG)")
     pl.add_argument("runs", nargs="+", type=Path, help="run folders (with basis.json checkpoints)")
     pl.add_argument("--reference", type=float, help="exact energy: plot E - E_ref on a log axis")

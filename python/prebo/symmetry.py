@@ -176,3 +176,22 @@ class Symmetriser:
 
     def as_dict(self) -> dict:
         return {"permutations": [list(p) for p in self.permutations], "coefficients": list(self.coefficients)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Symmetriser":
+        try:
+            perms = tuple(tuple(int(i) for i in p) for p in d["permutations"])
+            coefs = tuple(float(c) for c in d["coefficients"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise SpinError(f"malformed symmetry operator ({exc})") from exc
+        if len(perms) != len(coefs) or not perms:
+            raise SpinError("symmetry operator: permutations and coefficients do not match")
+        return cls(perms, coefs)
+
+    def equivalent(self, other: "Symmetriser", tol: float = 1e-10) -> bool:
+        """The same operator up to an overall factor."""
+        a, b = dict(zip(self.permutations, self.coefficients)), dict(zip(other.permutations, other.coefficients))
+        identity = tuple(range(len(self.permutations[0])))
+        if identity not in a or identity not in b:
+            return False
+        return all(abs(a.get(p, 0.0) / a[identity] - b.get(p, 0.0) / b[identity]) <= tol for p in set(a) | set(b))

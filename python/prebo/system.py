@@ -33,12 +33,17 @@ class System:
     M = diag(1/(2 m_i)).
     """
 
-    def __init__(self, particles, state: State | None = None, **state_kw):
+    def __init__(self, particles, state: State | None = None, symmetriser: Symmetriser | None = None,
+                 **state_kw):
         self.particles: list[Particle] = [particle(p) for p in particles]
         if len(self.particles) < 2:
             raise InputError("a system needs at least two particles")
         self.state = state if state is not None else State(**state_kw)
         self.groups = self._groups()
+        if symmetriser is not None:
+            self._check_operator(symmetriser)
+        # an explicit Young operator (e.g. an ecgpack file's), else the spin state's
+        self._symmetriser = symmetriser
 
     # --- identical particles -------------------------------------------------
     def _groups(self) -> list[Group]:
@@ -67,7 +72,19 @@ class System:
 
     @property
     def symmetriser(self) -> Symmetriser:
+        if self._symmetriser is not None:
+            return self._symmetriser
         return Symmetriser.from_groups(self.n, self.groups)
+
+    def _check_operator(self, sym: Symmetriser) -> None:
+        """An explicit operator may only permute identical particles and must contain the identity."""
+        identity = tuple(range(self.n))
+        if identity not in sym.permutations:
+            raise InputError("symmetry operator: the identity permutation is missing")
+        for p in sym.permutations:
+            if sorted(p) != list(identity) or any(self.particles[i].name != self.particles[p[i]].name
+                                                  for i in range(self.n)):
+                raise InputError(f"symmetry operator: {list(p)} permutes particles that are not identical")
 
     # --- masses and charges --------------------------------------------------
     @property
@@ -123,14 +140,21 @@ class System:
         }
 
     @classmethod
-    def from_dict(cls, d: dict) -> "System":
+    def from_dict(cls, d: dict, symmetry: dict | None = None) -> "System":
+        """The system of `to_dict`; `symmetry` (`Symmetriser.as_dict`) is honoured when it is not
+        the spin state's own operator (an explicit Young operator, e.g. imported from ecgpack)."""
         if "particles" not in d:
             raise InputError("system: missing 'particles'")
         st = dict(d.get("state", {}))
         unknown = set(st) - {"N", "parity", "spin"}
         if unknown:
             raise InputError(f"state: unknown keys {sorted(unknown)}")
-        return cls(d["particles"], State(**st))
+        system = cls(d["particles"], State(**st))
+        if symmetry is not None:
+            stored = Symmetriser.from_dict(symmetry)
+            if not stored.equivalent(system.symmetriser):
+                system = cls(system.particles, system.state, symmetriser=stored)
+        return system
 
     def label(self) -> str:
         return " ".join(p.name for p in self.particles)

@@ -1,7 +1,9 @@
 //! ECG-GVR matrix elements (paper eqs. globalvector, ecg-gvr; Suzuki & Varga, Lect. Notes
 //! Phys. m54, ch. 6–7) in prebo's convention (no 1/2 in the exponent, docs/conventions.md):
 //!
+//! ```text
 //!     phi(r) = |v|^{2K} (v_x + i v_y)^N exp(-r^T A r),   v = u^T r,
+//! ```
 //!
 //! i.e. |v|^{2K+N} Y_NN(v̂) up to a constant of N alone (cancelled by normalisation).
 //!
@@ -11,8 +13,10 @@
 //! `x = u_I^T C u_I`, `y = u_J^T C u_J`, `z = u_I^T C u_J`, `C = B^{-1}/2`. Expanding
 //! `|b|^{2K}(e·b)^N` in the Laguerre eigenfunctions of the Ornstein–Uhlenbeck semigroup gives
 //!
+//! ```text
 //!     <phi_I|phi_J> = S_0(B) Ω,   Ω = Σ_k ĉ_k x^{K_I-k} y^{K_J-k} z^{N+2k},
 //!     ĉ_0 = 1,  ĉ_{k+1} = ĉ_k (K_I-k)(K_J-k) / ((k+1)(k+N+3/2)),   S_0 = (π^D/|B|)^{3/2},
+//! ```
 //!
 //! up to factors f(K_I) f(K_J) that normalisation removes. All terms have one sign, so
 //! the sum is stable for large K; it is evaluated as `x^{K_I+N/2} y^{K_J+N/2} ρ^N G(ρ²)`,
@@ -21,8 +25,10 @@
 //! Kinetic `<∇φ_I|Λ|∇φ_J>`: Stein's lemma and Price's theorem (`∂E/∂z = E[∇_a·∇_b]`,
 //! `∂E/∂x = E[Δ_a]/2`) turn every term into Ω or its first derivatives:
 //!
+//! ```text
 //!     T/S_0 = λ Ω_z − 4⟨A_JΛu_I,u_I⟩Ω_x − 2⟨A_JΛu_I,u_J⟩Ω_z − 4⟨A_IΛu_J,u_J⟩Ω_y − 2⟨A_IΛu_J,u_I⟩Ω_z
 //!             + 12 Tr(A_IΛA_J C) Ω + 8 ũ_IWũ_I Ω_x + 4 (ũ_IWũ_J + ũ_JWũ_I) Ω_z + 8 ũ_JWũ_J Ω_y,
+//! ```
 //!
 //! `λ = u_I^T Λ u_J`, `⟨p,q⟩ = p^T C q`, `ũ = C u`, `W = A_I Λ A_J`. For K = N = 0 this is the
 //! plain-ECG `6 Tr(B^{-1} A_I Λ A_J) S`.
@@ -33,8 +39,10 @@
 //!
 //! Coulomb `<1/|w^T r|>`: `1/r = (2/√π)∫exp(-t²r²)dt` and `τ² = t²c/(1+t²c)`, `c = w^T B^{-1} w`:
 //!
+//! ```text
 //!     <1/|w^T r|> = (2/√(πc)) S_0 ∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ,
 //!     γ = (B^{-1}u)·w / √(2c),
+//! ```
 //!
 //! a polynomial of degree 2(K_I+K_J+N) in τ, integrated exactly by Gauss–Legendre with
 //! K_I+K_J+N+1 nodes.
