@@ -16,10 +16,10 @@ ACCEPTANCE = {
     "ps-": ("Ps-", 1e-6),
     "he": ("He", 1e-5),
     "h-": ("H-", 1e-5),
-    "h2plus": ("H2+", None),
+    "h2plus-pecg": ("H2+", None),
     "h2plus-gvr": ("H2+", 6.3e-8),  # issue 3: at or below -0.5971390 with at most 180 functions
     "h2plus-fecg": ("H2+", None),
-    "h2": ("H2", None),
+    "h2-pecg": ("H2", None),
 }
 
 
