@@ -50,6 +50,7 @@ class Optimiser:
     learned: float = 0.5
     learn_after: int = 5
     min_norm: float = 1e-8
+    max_overlap: float = 0.99
     threshold: float = 1e-13
 
     def to_dict(self) -> dict:
@@ -211,8 +212,9 @@ class Sampler:
 class State:
     """Current basis with its matrices (S, T, T_ti, V) and eigen-solution."""
 
-    def __init__(self, basis: Basis, rep, threshold: float):
+    def __init__(self, basis: Basis, rep, threshold: float, min_norm: float = 1e-8, max_overlap: float = 0.99):
         self.basis, self.rep, self.threshold = basis, rep, threshold
+        self.min_norm, self.max_overlap = min_norm, max_overlap
         if len(basis):
             self.m = rep.matrices(basis)
         else:
@@ -233,7 +235,9 @@ class State:
 
     def candidates(self, trials: Basis, exclude: int | None = None, eig=None):
         """Lowest energy with each trial added (to the basis without `exclude`, where the trial
-        would replace it), with the rows and diagonals for `put`."""
+        would replace it), with the rows and diagonals for `put`. The linear-dependence guard
+        gives +inf to a trial whose normalised overlap with a function exceeds `max_overlap`
+        or whose part orthogonal to the basis is below `min_norm` of its norm."""
         position = len(self.basis) if exclude is None else exclude
         rows, diag = self.rep.rows(trials, self.basis, position)
         H = rows["T_ti"] + rows["V"]
@@ -243,8 +247,11 @@ class State:
             keep[exclude] = False
         eig = eig if eig is not None else self.eig
         E, C = (eig.energies, eig.vectors) if eig is not None else (np.zeros(0), np.zeros((0, 0)))
+        overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(diag[:, 0], np.diag(self.m["S"])[keep]))
         energies = np.array([
-            eigen.lowest_with_added(E, C, H[t, keep], S[t, keep], diag[t, 2] + diag[t, 3], diag[t, 0])
+            np.inf if overlap.shape[1] and overlap[t].max() > self.max_overlap else
+            eigen.lowest_with_added(E, C, H[t, keep], S[t, keep], diag[t, 2] + diag[t, 3], diag[t, 0],
+                                    self.min_norm)
             for t in range(len(trials))
         ])
         return energies, rows, diag
@@ -330,7 +337,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         basis = Basis.from_dict(resume, "checkpoint")
         rng.bit_generator.state = resume["rng"]
         cursor, history = Cursor(**resume["progress"]), resume["history"]
-    st = State(basis, rep, opts.threshold)
+    st = State(basis, rep, opts.threshold, opts.min_norm, opts.max_overlap)
     sampler.learn(st.basis)
     report = Reporter(opts, progress)
 

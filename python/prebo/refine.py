@@ -87,7 +87,7 @@ def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
         except PreboError:
             return worse
         e = eigen.lowest_with_added(E, C, (rows["T_ti"] + rows["V"])[0, keep],
-                                    rows["S"][0, keep], diag[0, 2] + diag[0, 3], diag[0, 0])
+                                    rows["S"][0, keep], diag[0, 2] + diag[0, 3], diag[0, 0], state.min_norm)
         if not np.isfinite(e):
             return worse
         if e < best["E"]:
