@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _core
 from .errors import LinearDependenceError, NotPositiveDefiniteError
 
 
@@ -49,38 +50,15 @@ def solve(H: np.ndarray, S: np.ndarray, threshold: float = 1e-13) -> Eigen:
 
 
 def lowest_with_added(E, C, h, s, h_nn, s_nn, min_norm: float = 1e-10) -> float:
-    """Lowest eigenvalue after adding one function (secular equation); +inf if it is
-    linearly dependent on the basis (orthogonal remainder below `min_norm` of its norm)."""
-    if len(E) == 0:
-        return h_nn / s_nn
-    d = C.T @ s
-    b = C.T @ h
-    nu = s_nn - d @ d
-    if not nu > min_norm * s_nn:
-        return np.inf
-    gamma2 = (b - E * d) ** 2 / nu
-    hp = (h_nn - 2.0 * b @ d + E @ (d * d)) / nu
+    """Lowest eigenvalue after adding one function (secular equation, in the Rust core); +inf if
+    it is linearly dependent on the basis (orthogonal remainder below `min_norm` of its norm)."""
+    return float(lowest_with_added_many(E, C, np.atleast_2d(h), np.atleast_2d(s), [h_nn], [s_nn], min_norm)[0])
 
-    def f(x):
-        return hp - x - np.sum(gamma2 / (E - x))
 
-    top = E[0]
-    lo = min(top, hp) - np.sqrt(gamma2.sum()) - 1e-3 * max(1.0, abs(top))
-    while f(lo) < 0:  # widen until the root is bracketed
-        lo -= 2.0 * (top - lo)
-    hi = top
-    x = lo
-    for _ in range(200):
-        fx = f(x)
-        if fx == 0.0 or hi - lo < 1e-15 * max(1.0, abs(x)):
-            break
-        if fx > 0:
-            lo = x
-        else:
-            hi = x
-        # Newton (f is concave and decreasing below E_0), bisection when it leaves the bracket
-        step = x - fx / (-1.0 - np.sum(gamma2 / (E - x) ** 2))
-        x = step if lo < step < hi else 0.5 * (lo + hi)
-        if abs(step - x) == 0.0 and abs(fx) < 1e-15 * max(1.0, abs(x)):
-            break
-    return float(x)
+def lowest_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10) -> np.ndarray:
+    """`lowest_with_added` for k trials at once: rows H, S (k x nb), diagonals h_nn, s_nn (k)."""
+    c = np.ascontiguousarray
+    E = c(E, dtype=float)
+    C = c(np.asarray(C, dtype=float).reshape(-1, len(E)) if len(E) else np.zeros((0, 0)))
+    return _core.lowest_with_added(E, C, c(H, dtype=float), c(S, dtype=float), c(h_nn, dtype=float),
+                                   c(s_nn, dtype=float), float(min_norm))

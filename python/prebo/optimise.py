@@ -247,13 +247,11 @@ class State:
             keep[exclude] = False
         eig = eig if eig is not None else self.eig
         E, C = (eig.energies, eig.vectors) if eig is not None else (np.zeros(0), np.zeros((0, 0)))
-        overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(diag[:, 0], np.diag(self.m["S"])[keep]))
-        energies = np.array([
-            np.inf if overlap.shape[1] and overlap[t].max() > self.max_overlap else
-            eigen.lowest_with_added(E, C, H[t, keep], S[t, keep], diag[t, 2] + diag[t, 3], diag[t, 0],
-                                    self.min_norm)
-            for t in range(len(trials))
-        ])
+        energies = eigen.lowest_with_added_many(E, C, H[:, keep], S[:, keep], diag[:, 2] + diag[:, 3],
+                                                diag[:, 0], self.min_norm)
+        if keep.any():
+            overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(diag[:, 0], np.diag(self.m["S"])[keep]))
+            energies[overlap.max(axis=1) > self.max_overlap] = np.inf
         return energies, rows, diag
 
     def put(self, i: int, f: Basis, row: dict | None = None, d=None):

@@ -12,5 +12,6 @@ pub mod fecg;
 pub mod gvr;
 pub mod images;
 pub mod pecg;
+pub mod secular;
 
 pub use error::{CoreError, Result};

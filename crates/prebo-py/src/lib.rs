@@ -324,6 +324,37 @@ fn fecg_angular<'py>(
     Ok(matrix(py, nb, nb, m))
 }
 
+
+/// Lowest eigenvalue after adding each of k trials (secular equation, prebo_core::secular):
+/// `e` (kept), `c` (nb x kept, S-orthonormal columns), rows `h`, `s` (k x nb), diagonals (k).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn lowest_with_added<'py>(
+    py: Python<'py>,
+    e: PyReadonlyArray1<f64>,
+    c: PyReadonlyArray2<f64>,
+    h: PyReadonlyArray2<f64>,
+    s: PyReadonlyArray2<f64>,
+    h_nn: PyReadonlyArray1<f64>,
+    s_nn: PyReadonlyArray1<f64>,
+    min_norm: f64,
+) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+    let kept = e.len()?;
+    let (e, c) = (slice(&e, "e")?.to_vec(), slice(&c, "c")?.to_vec());
+    let (h, s) = (slice(&h, "h")?.to_vec(), slice(&s, "s")?.to_vec());
+    let (hn, sn) = (slice(&h_nn, "h_nn")?.to_vec(), slice(&s_nn, "s_nn")?.to_vec());
+    if hn.len() != sn.len() || h.len() != s.len() || (!hn.is_empty() && h.len() % hn.len() != 0) {
+        return Err(ShapeError::new_err("rows and diagonals do not fit together"));
+    }
+    if kept > 0 && !hn.is_empty() && c.len() != kept * (h.len() / hn.len()) {
+        return Err(ShapeError::new_err("eigenvectors do not fit the rows"));
+    }
+    let out = py.allow_threads(|| {
+        prebo_core::secular::lowest_with_added_many(&e, &c, kept, &h, &s, &hn, &sn, min_norm)
+    });
+    Ok(numpy::ndarray::Array1::from_vec(out).into_pyarray(py))
+}
+
 /// Number of rayon worker threads in use.
 #[pyfunction]
 fn num_threads() -> usize {
@@ -339,6 +370,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fecg_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(fecg_rows, m)?)?;
     m.add_function(wrap_pyfunction!(fecg_angular, m)?)?;
+    m.add_function(wrap_pyfunction!(lowest_with_added, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add("MAX_DIM", api::MAX_DIM)?;
     Ok(())
