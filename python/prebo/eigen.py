@@ -60,5 +60,7 @@ def lowest_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10) -> n
     c = np.ascontiguousarray
     E = c(E, dtype=float)
     C = c(np.asarray(C, dtype=float).reshape(-1, len(E)) if len(E) else np.zeros((0, 0)))
-    return _core.lowest_with_added(E, C, c(H, dtype=float), c(S, dtype=float), c(h_nn, dtype=float),
-                                   c(s_nn, dtype=float), float(min_norm))
+    out = _core.lowest_with_added(E, C, c(H, dtype=float), c(S, dtype=float), c(h_nn, dtype=float),
+                                  c(s_nn, dtype=float), float(min_norm))
+    out[~np.isfinite(out)] = np.inf  # NaN elements (a near-singular trial) never win
+    return out

@@ -47,7 +47,7 @@ class Parametrisation:
 
     def function(self, theta: np.ndarray, K: int | None = None) -> Basis:
         d = self.f.system.n - 1
-        L = np.diag(np.exp(np.clip(theta[:d], -30, 30)))
+        L = np.diag(np.exp(np.clip(theta[:d], -8.0, 10.0)))  # exponents within ~1e-7..5e8
         nl = d * (d - 1) // 2
         L[np.tril_indices(d, -1)] = theta[d:d + nl]
         c_A = self.f.c_A[0]

@@ -128,22 +128,26 @@ fn row<const D: usize>(m: &Centres<D>, i: usize) -> [f64; 3] {
     [m[(i, 0)], m[(i, 1)], m[(i, 2)]]
 }
 
-/// The shared pieces of one pair: `(S, B^{-1}, r̄)`.
+/// The shared pieces of one pair: `(S, B^{-1}, r̄)`, or `None` when `A_I + A_J` has no
+/// Cholesky factor in floating point (possible only for near-singular functions, whose
+/// elements are then NaN and the caller rejects them).
 #[inline]
-fn pair<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>) -> (f64, Mat<D>, Centres<D>) {
+fn pair<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>) -> Option<(f64, Mat<D>, Centres<D>)> {
     let b = bra.a + ket.a;
-    let chol = Cholesky::new(b).expect("A_I + A_J of positive-definite A_I, A_J");
+    let chol = Cholesky::new(b)?;
     let log_det: f64 = 2.0 * chol.l_dirty().diagonal().iter().map(|d| d.ln()).sum::<f64>();
     let v = bra.a_s + ket.a_s;
     let rbar = chol.solve(&v);
     let delta = bra.s_a_s + ket.s_a_s - v.component_mul(&rbar).sum();
     let s = (1.5 * (D as f64 * 2f64.ln() + 0.5 * (bra.log_det + ket.log_det) - log_det) - delta).exp();
-    (s, chol.inverse(), rbar)
+    Some((s, chol.inverse(), rbar))
 }
+
+const NAN: Element = Element { s: f64::NAN, t: f64::NAN, t_ti: f64::NAN, v: f64::NAN };
 
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised floating ECGs.
 pub fn element<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>, ops: &Operators<D>) -> Element {
-    let (s, binv, rbar) = pair(bra, ket);
+    let Some((s, binv, rbar)) = pair(bra, ket) else { return NAN };
     let w = bra.a * ops.lambda * ket.a;
     let r = binv.component_mul(&w.transpose()).sum();
     let di = rbar - bra.s;
@@ -181,7 +185,7 @@ pub fn element<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>, ops: &Operators<D>)
 
 /// `<phi_I| N_TI² |phi_J>` (module docs); `mu` = m/m_tot.
 pub fn angular<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>, mu: &Vector<D>) -> f64 {
-    let (s, binv, rbar) = pair(bra, ket);
+    let Some((s, binv, rbar)) = pair(bra, ket) else { return f64::NAN };
     let ti = bra.a_s - bra.c_a * mu * (mu.transpose() * bra.s);
     let tj = ket.a_s - ket.c_a * mu * (mu.transpose() * ket.s);
     let (mut li, mut lj) = ([0.0; 3], [0.0; 3]);

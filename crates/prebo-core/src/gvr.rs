@@ -190,7 +190,11 @@ pub fn element<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>) -> El
     let ops = &go.ops;
     let n = go.n_ang;
     let b_mat = bra.a + ket.a;
-    let chol = Cholesky::new(b_mat).expect("A_I + A_J of positive-definite A_I, A_J");
+    // A_I + A_J is positive definite, but for near-singular functions its factorisation can
+    // fail in floating point: the element is then NaN and the caller rejects the function
+    let Some(chol) = Cholesky::new(b_mat) else {
+        return Element { s: f64::NAN, t: f64::NAN, t_ti: f64::NAN, v: f64::NAN };
+    };
     let log_det: f64 = 2.0 * chol.l_dirty().diagonal().iter().map(|d| d.ln()).sum::<f64>();
     let binv = chol.inverse();
     let gi = binv * bra.u;

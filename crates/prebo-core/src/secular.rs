@@ -34,6 +34,9 @@ pub fn lowest_with_added(e: &[f64], c: &[f64], kept: usize, h: &[f64], s: &[f64]
     let bd: f64 = (0..kept).map(|k| b[k] * d[k]).sum();
     let edd: f64 = (0..kept).map(|k| e[k] * d[k] * d[k]).sum();
     let hp = (h_nn - 2.0 * bd + edd) / nu;
+    if !hp.is_finite() || gamma2.iter().any(|g| !g.is_finite()) {
+        return f64::INFINITY; // NaN elements of a near-singular trial
+    }
     let f = |x: f64| hp - x - (0..kept).map(|k| gamma2[k] / (e[k] - x)).sum::<f64>();
     let top = e[0];
     let mut lo = top.min(hp) - gamma2.iter().sum::<f64>().sqrt() - 1e-3 * top.abs().max(1.0);
