@@ -1,10 +1,13 @@
-"""Stochastic basis optimisation: competitive selection and replacement sweeps.
+"""Stochastic basis optimisation: competitive selection, replacement and Powell sweeps.
 
 Growth (Suzuki & Varga, Lect. Notes Phys. m54, ch. 4, "stochastic variational
 method"): draw `trials` random functions, get each one's row against the basis from
 the Rust core (O(N_b) integrals), the new lowest eigenvalue from the secular
-equation (O(N_b^2), eigen.lowest_with_added), keep the best. Sweeps: each function
-in turn competes with `trials` random replacements in the basis without it.
+equation (O(N_b^2), eigen.lowest_with_added_many), keep the best and, with `refine`,
+Powell-refine it (refine.py). Then `sweeps` random replacement sweeps (each function in
+turn competes with `trials` random replacements in the basis without it) and `refine`
+Powell sweeps. After the first functions of a channel, a share `learned` of the trials
+is drawn from the distribution of the parameters selected so far in that channel.
 
 Functions are drawn in a coordinate set ("channel") or in pair form:
 - "pairs": A = Σ_{i<j} α_ij w_ij w_ij^T + c_A (m/m_tot)(m/m_tot)^T, α_ij = 1/b_ij^2,
@@ -12,8 +15,9 @@ Functions are drawn in a coordinate set ("channel") or in pair form:
 - a coordinate set x (coordinates.all_sets): 𝒜 = diag(1/b_k^2) in x, b_k log-uniform
   over the same range with the lengths of the particles the coordinate joins, then
   A^(r) = U_x^T blockdiag(𝒜, c_A) U_x.
-The basis is written atomically after every accepted step (a killed run loses at
-most the step in flight).
+With an output folder, the basis, the random-number state and the position in the
+schedule are written atomically after every step: a killed run loses at most the step
+in flight, and `prebo run --resume` continues it bit for bit.
 """
 from __future__ import annotations
 
@@ -229,6 +233,14 @@ class State:
         self.eig = eigen.solve(self.m["T_ti"] + self.m["V"], self.m["S"], self.threshold)
         self.energy = float(self.eig.energies[0])
 
+    def without(self, i: int):
+        """The eigen-solution of the basis without function i (None if that leaves nothing)."""
+        keep = np.arange(len(self.basis)) != i
+        if not keep.any():
+            return None
+        H = self.m["T_ti"] + self.m["V"]
+        return eigen.solve(H[np.ix_(keep, keep)], self.m["S"][np.ix_(keep, keep)], self.threshold)
+
     def virial(self) -> float:
         c = self.eig.vectors[:, 0]
         return abs(1.0 + (c @ self.m["V"] @ c) / (2.0 * (c @ self.m["T_ti"] @ c)))
@@ -245,7 +257,8 @@ class State:
         keep = np.ones(len(self.basis), bool)
         if exclude is not None:
             keep[exclude] = False
-        eig = eig if eig is not None else self.eig
+        if eig is None:
+            eig = self.eig if exclude is None else self.without(exclude)
         E, C = (eig.energies, eig.vectors) if eig is not None else (np.zeros(0), np.zeros((0, 0)))
         energies = eigen.lowest_with_added_many(E, C, H[:, keep], S[:, keep], diag[:, 2] + diag[:, 3],
                                                 diag[:, 0], self.min_norm)
@@ -349,7 +362,6 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     def draw(k) -> Basis:
         return _concat([sampler.draw() for _ in range(k)])
 
-
     with report:
         while cursor.phase != "done":
             old = st.energy
@@ -364,11 +376,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                         refine_function(st, len(st.basis) - 1, opts.refine_evaluations)
             elif cursor.phase == "sweep":
                 i = cursor.index
-                keep = np.arange(len(st.basis)) != i
-                sub = eigen.solve((st.m["T_ti"] + st.m["V"])[np.ix_(keep, keep)], st.m["S"][np.ix_(keep, keep)],
-                                  opts.threshold)
                 trials = draw(opts.trials)
-                energies, rows, diag = st.candidates(trials, exclude=i, eig=sub)
+                energies, rows, diag = st.candidates(trials, exclude=i)
                 report.trials(len(trials))
                 best = int(np.argmin(energies))
                 if np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):

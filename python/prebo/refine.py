@@ -68,12 +68,8 @@ def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
     """Powell-minimise the energy over the parameters of function i; True if it improved."""
     basis = state.basis
     keep = np.arange(len(basis)) != i
-    Hm = state.m["T_ti"] + state.m["V"]
-    if keep.any():
-        sub = eigen.solve(Hm[np.ix_(keep, keep)], state.m["S"][np.ix_(keep, keep)], state.threshold)
-        E, C = sub.energies, sub.vectors
-    else:
-        E, C = np.zeros(0), np.zeros((0, 0))
+    sub = state.without(i)
+    E, C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
     p = Parametrisation.of(basis.subset([i]))
     best = {"E": state.energy, "f": None, "row": None, "diag": None}
 
