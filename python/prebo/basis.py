@@ -209,15 +209,22 @@ class Basis:
     @classmethod
     def load(cls, path) -> "Basis":
         path = Path(path)
-        try:
-            text = path.read_text()
-        except OSError as exc:
-            raise BasisFileError(f"{path}: cannot read ({exc.strerror})") from exc
+        text = read_text(path, BasisFileError)
         try:
             d = json.loads(text)
         except json.JSONDecodeError as exc:
             raise BasisFileError(f"{path}: corrupt or truncated JSON (line {exc.lineno}: {exc.msg})") from exc
         return cls.from_dict(d, str(path))
+
+
+def read_text(path: Path, error: type[PreboError]) -> str:
+    """A file's text, or `error` naming the file when it is unreadable or not text."""
+    try:
+        return Path(path).read_text()
+    except OSError as exc:
+        raise error(f"{path}: cannot read ({exc.strerror})") from exc
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: not a text file ({exc.reason})") from exc
 
 
 def write_json_atomic(path, obj) -> None:

@@ -93,7 +93,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .basis import Basis
+from .basis import Basis, read_text
 from .coordinates import heavy_particle_centred
 from .errors import BasisFileError, PreboError, UnsupportedError
 from .particles import KNOWN
@@ -480,13 +480,7 @@ def _reals(path, line_no, values, what):
 def parse_inout(path) -> InoutFile:
     """Read an ecgpack ``*.inout.txt`` without converting it; BasisFileError names the line."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise BasisFileError(f"{path}: cannot read ({exc.strerror})") from exc
-    except UnicodeDecodeError as exc:
-        raise BasisFileError(f"{path}: not a text file ({exc.reason})") from exc
-    lines = text.splitlines()
+    lines = read_text(path, BasisFileError).splitlines()
     seps = [i for i, l in enumerate(lines) if _SEP.match(l)]
     if not seps:
         _fail(path, None, "no ===== section separators: not an ecgpack .inout file")

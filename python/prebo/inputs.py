@@ -11,6 +11,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from .basis import read_text
 from .errors import InputError
 from .optimise import Optimiser
 from .system import State, System
@@ -64,10 +65,7 @@ def from_dict(d: dict) -> Job:
 
 def load(path) -> Job:
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read ({exc.strerror})") from exc
+    text = read_text(path, InputError)
     try:
         d = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
