@@ -10,6 +10,10 @@ function n with rows h, s and diagonal h_nn, s_nn, let d = C^T s, b = C^T h. The
 of n orthogonal to the basis has norm^2 ν = s_nn - d·d, couplings γ_k = (b_k - E_k d_k)/√ν
 and energy h' = (h_nn - 2 b·d + Σ E_k d_k^2)/ν. The new lowest eigenvalue is the root
 below E_0 of f(x) = h' - x - Σ γ_k^2 / (E_k - x), strictly decreasing there.
+
+Gradient (Hellmann–Feynman for the augmented problem): at the root e the eigenvector is
+c = (C a, 1) with a_k = -(b_k - e d_k)/(E_k - e); when only the new function's parameters move,
+de = [2 (C a)·(dh - e ds) + dh_nn - e ds_nn] / (|a|^2 + 2 a·d + s_nn).
 """
 from __future__ import annotations
 
@@ -53,6 +57,21 @@ def lowest_with_added(E, C, h, s, h_nn, s_nn, min_norm: float = 1e-10) -> float:
     """Lowest eigenvalue after adding one function (secular equation, in the Rust core); +inf if
     it is linearly dependent on the basis (orthogonal remainder below `min_norm` of its norm)."""
     return float(lowest_with_added_many(E, C, np.atleast_2d(h), np.atleast_2d(s), [h_nn], [s_nn], min_norm)[0])
+
+
+def lowest_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float = 1e-10):
+    """`lowest_with_added` and its gradient with respect to parameters of the new function, given the
+    derivatives dh, ds (P x nb) and dh_nn, ds_nn (P) of its rows and diagonal (module docstring)."""
+    e = lowest_with_added(E, C, h, s, h_nn, s_nn, min_norm)
+    if not np.isfinite(e):
+        return e, np.zeros(len(dh_nn))
+    if len(E) == 0:
+        return e, (dh_nn - e * ds_nn) / s_nn
+    d, b = C.T @ s, C.T @ h
+    a = -(b - e * d) / (E - e)
+    c_old = C @ a
+    norm2 = a @ a + 2.0 * a @ d + s_nn
+    return e, (2.0 * (dh - e * ds) @ c_old + dh_nn - e * ds_nn) / norm2
 
 
 def lowest_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10) -> np.ndarray:

@@ -87,6 +87,27 @@ class Representation:
             return _core.fecg_rows(*self.arrays(trials), *self.arrays(f), *self._ops(), position)
         return _core.rows(*self.arrays(trials), *self.arrays(f), *self._ops())
 
+    def row_gradient(self, f, dA: np.ndarray, dv: np.ndarray | None, basis) -> tuple[dict, np.ndarray]:
+        """Row of the one-function basis `f` against `basis` (f as bra) and its diagonal, with the
+        derivatives along P directions: dA (P x n x n) of A and dv (P x n) of u or (P x n x 3) of s.
+        Returns dict of (1 + P) x nb arrays (row 0 the values) and the (1 + P) x 4 diagonal.
+        Laboratory frame only; a plain ECG goes through the ECG-GVR kernel at K = N = 0, where
+        u drops out (crates/prebo-core/src/gvr.rs)."""
+        if self.coords is not None:
+            raise ValueError("row gradients are computed in the laboratory frame")
+        c = np.ascontiguousarray
+        if f.kind == "fecg":
+            return _core.fecg_row_gradient(*self.arrays(f), c(dA), c(dv), *self.arrays(basis), *self._ops())
+        if f.kind == "ecg-gvr":
+            return _core.gvr_row_gradient(*self.arrays(f), c(dA), c(dv), *self.arrays(basis), basis.N, *self._ops())
+        as_gvr = []
+        for g in (f, basis):
+            u = np.zeros((len(g), g.system.n))
+            u[:, 0] = 1.0
+            as_gvr.append((c(g.A), u, np.zeros(len(g), np.uint32), c(g.c_A)))
+        P = len(dA)
+        return _core.gvr_row_gradient(*as_gvr[0], c(dA), np.zeros((P, f.system.n)), *as_gvr[1], 0, *self._ops())
+
     @staticmethod
     def oriented(kind: str) -> bool:
         """Whether `rows(..., position)` reproduces full-build bits for this basis type."""

@@ -32,7 +32,7 @@ from . import eigen
 from .basis import Basis
 from .errors import InputError
 from .integrals import laboratory
-from .refine import Parametrisation, refine_function
+from .refine import METHODS, Parametrisation, refine_function
 from .system import System
 
 
@@ -51,6 +51,7 @@ class Optimiser:
     K_max: int = 0
     refine: int = 0
     refine_evaluations: int = 200
+    refine_method: str = "powell"
     learned: float = 0.5
     learn_after: int = 5
     min_norm: float = 1e-8
@@ -87,6 +88,8 @@ class Optimiser:
             raise InputError(f"optimiser.learned must be a probability in [0, 1], got {self.learned!r}")
         if not (isinstance(self.refine, int) and self.refine >= 0):
             raise InputError(f"optimiser.refine must be a non-negative integer, got {self.refine!r}")
+        if self.refine_method not in METHODS:
+            raise InputError(f"optimiser.refine_method must be one of {', '.join(METHODS)}, got {self.refine_method!r}")
         if not (isinstance(self.K_max, int) and 0 <= self.K_max <= 60):
             raise InputError(f"basis.K_max must be an integer in 0..60, got {self.K_max!r}")
 
@@ -373,7 +376,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 if np.isfinite(energies[best]) and energies[best] < st.energy:
                     st.put(len(st.basis), trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
                     if opts.refine:  # competitive selection, then Powell refinement of the winner
-                        refine_function(st, len(st.basis) - 1, opts.refine_evaluations)
+                        refine_function(st, len(st.basis) - 1, opts.refine_evaluations, opts.refine_method)
             elif cursor.phase == "sweep":
                 i = cursor.index
                 trials = draw(opts.trials)
@@ -384,7 +387,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                     st.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
             else:
                 report.trials(1)
-                refine_function(st, cursor.index, opts.refine_evaluations)
+                refine_function(st, cursor.index, opts.refine_evaluations, opts.refine_method)
             if st.energy < old:
                 history.append([len(st.basis), st.energy, cursor.phase])
                 report.step(st, old, cursor)

@@ -6,6 +6,10 @@ A^(r) = U_x^T blockdiag(𝒜, c_A) U_x; for ECG-GVR u^(r) = U_x^T (u', c_U), for
 s^(r) = U_x^-1 (s', μ^T s); c_A, c_U, the CM centre μ^T s and K stay fixed. A function from the pair sampler is refined in the first Jacobi set.
 The energy of a trial θ is the lowest root of the secular equation (eigen.lowest_with_added)
 against the basis without the function: one row of integrals and O(N_b^2) per evaluation.
+
+Two minimisers: Powell's method on the energy (the paper's), and L-BFGS on the energy and its
+exact gradient — the row's derivatives along ∂(A, u or s)/∂θ_p by forward-mode dual numbers
+in the Rust core (Representation.row_gradient), then eigen.lowest_with_added_gradient.
 """
 from __future__ import annotations
 
@@ -45,11 +49,16 @@ class Parametrisation:
             parts.append((self.x.U @ self.f.s[0])[:-1].ravel())
         return np.concatenate(parts)
 
+    def _L(self, theta: np.ndarray) -> np.ndarray:
+        d = self.f.system.n - 1
+        L = np.diag(np.exp(np.clip(theta[:d], *LOG_DIAG)))
+        L[np.tril_indices(d, -1)] = theta[d:d + d * (d - 1) // 2]
+        return L
+
     def function(self, theta: np.ndarray, K: int | None = None) -> Basis:
         d = self.f.system.n - 1
-        L = np.diag(np.exp(np.clip(theta[:d], -8.0, 10.0)))  # exponents within ~1e-7..5e8
+        L = self._L(theta)
         nl = d * (d - 1) // 2
-        L[np.tril_indices(d, -1)] = theta[d:d + nl]
         c_A = self.f.c_A[0]
         A = self.x.to_lab(L @ L.T, c_A)
         if self.f.kind == "pecg":
@@ -63,37 +72,104 @@ class Parametrisation:
         return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="ecg-gvr", u=u[None],
                      K=self.f.K[:1] if K is None else [K])
 
+    def directions(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """∂A^(r)/∂θ_p (P x n x n) and ∂u^(r)/∂θ_p (P x n) or ∂s^(r)/∂θ_p (P x n x 3); None for plain ECGs.
+        With 𝒜 = L L^T: ∂𝒜 = ∂L L^T + L ∂L^T, ∂L = L_kk E_kk for θ = ln L_kk (0 where clipped),
+        E_ab for a strict-lower entry; A^(r) and u^(r), s^(r) are linear in 𝒜 and u', s'."""
+        n = self.f.system.n
+        d, P = n - 1, len(theta)
+        nl = d * (d - 1) // 2
+        L = self._L(theta)
+        inside = (theta[:d] > LOG_DIAG[0]) & (theta[:d] < LOG_DIAG[1])
+        entries = [(k, k, L[k, k] * inside[k]) for k in range(d)]
+        entries += [(a, b, 1.0) for a, b in zip(*np.tril_indices(d, -1))]
+        dA = np.zeros((P, n, n))
+        for p, (a, b, v) in enumerate(entries):
+            dL = np.zeros((d, d))
+            dL[a, b] = v
+            dA[p] = self.x.to_lab(dL @ L.T + L @ dL.T, 0.0)
+        if self.f.kind == "pecg":
+            return dA, None
+        if self.f.kind == "ecg-gvr":
+            dv = np.zeros((P, n))
+            dv[d + nl:] = self.x.U[:d]  # u^(r) = U^T (u', c_U)
+            return dA, dv
+        dv = np.zeros((P, n, 3))
+        for a in range(d):
+            for k in range(3):
+                dv[d + nl + 3 * a + k, :, k] = self.x.U_inv[:, a]  # s^(r) = U^-1 (s', μ^T s)
+        return dA, dv
 
-def refine_function(state, i: int, max_evaluations: int = 200) -> bool:
-    """Powell-minimise the energy over the parameters of function i; True if it improved."""
-    basis = state.basis
-    keep = np.arange(len(basis)) != i
-    sub = state.without(i)
-    E, C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
-    p = Parametrisation.of(basis.subset([i]))
-    best = {"E": state.energy, "f": None, "row": None, "diag": None}
 
-    def energy(theta):
-        f = p.function(theta)
-        # a θ that leaves the valid region, or a function linearly dependent on the others,
-        # scores worse than the current energy (a finite value keeps Powell's line search sane)
-        worse = state.energy + 1.0
+LOG_DIAG = (-8.0, 10.0)  # ln L_kk: exponents within ~1e-7..5e8
+METHODS = ("powell", "gradient")
+
+
+class Objective:
+    """The energy as a function of θ of function i, all others fixed: the lowest root of the
+    secular equation against the basis without i. Remembers the best function seen. A θ that
+    leaves the valid region, or makes the function linearly dependent on the others, scores
+    worse than the current energy (a finite value keeps the line searches sane)."""
+
+    def __init__(self, state, i: int):
+        self.state, self.i = state, i
+        basis = state.basis
+        self.keep = np.arange(len(basis)) != i
+        sub = state.without(i)
+        self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
+        self.rest = basis.subset(np.flatnonzero(self.keep))
+        self.p = Parametrisation.of(basis.subset([i]))
+        self.worse = state.energy + 1.0
+        self.best_E, self.best_f = state.energy, None
+
+    def _seen(self, e: float, f: Basis) -> None:
+        if e < self.best_E:
+            self.best_E, self.best_f = e, f
+
+    def energy(self, theta: np.ndarray) -> float:
+        st, f = self.state, self.p.function(theta)
         try:
-            rows, diag = state.rep.rows(f, basis, i)
+            rows, diag = st.rep.rows(f, st.basis, self.i)
         except PreboError:
-            return worse
-        e = eigen.lowest_with_added(E, C, (rows["T_ti"] + rows["V"])[0, keep],
-                                    rows["S"][0, keep], diag[0, 2] + diag[0, 3], diag[0, 0], state.min_norm)
+            return self.worse
+        e = eigen.lowest_with_added(self.E, self.C, (rows["T_ti"] + rows["V"])[0, self.keep],
+                                    rows["S"][0, self.keep], diag[0, 2] + diag[0, 3], diag[0, 0], st.min_norm)
         if not np.isfinite(e):
-            return worse
-        if e < best["E"]:
-            best.update(E=e, f=f, row={k: v[0] for k, v in rows.items()}, diag=diag[0])
+            return self.worse
+        self._seen(e, f)
         return e
 
-    theta0 = p.theta()
-    minimize(energy, theta0, method="Powell",
-             options={"maxfev": max_evaluations, "xtol": 1e-4, "ftol": 1e-14, "direc": 0.1 * np.eye(len(theta0))})
-    if best["f"] is not None and best["E"] < state.energy - 1e-15 * abs(state.energy):
-        state.put(i, best["f"], best["row"], best["diag"])
-        return True
-    return False
+    def energy_and_gradient(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
+        st, f = self.state, self.p.function(theta)
+        dA, dv = self.p.directions(theta)
+        try:
+            rows, diag = st.rep.row_gradient(f, dA, dv, self.rest)
+        except PreboError:
+            return self.worse, np.zeros_like(theta)
+        H, S = rows["T_ti"] + rows["V"], rows["S"]
+        h_nn, s_nn = diag[:, 2] + diag[:, 3], diag[:, 0]
+        e, g = eigen.lowest_with_added_gradient(self.E, self.C, H[0], S[0], h_nn[0], s_nn[0], H[1:], S[1:],
+                                                h_nn[1:], s_nn[1:], st.min_norm)
+        if not (np.isfinite(e) and np.all(np.isfinite(g))):
+            return self.worse, np.zeros_like(theta)
+        self._seen(e, f)
+        return e, g
+
+
+def refine_function(state, i: int, max_evaluations: int = 200, method: str = "powell") -> bool:
+    """Minimise the energy over the parameters of function i — Powell, or L-BFGS with exact
+    gradients — with at most `max_evaluations` energies; True if it improved."""
+    obj = Objective(state, i)
+    theta0 = obj.p.theta()
+    if method == "gradient":
+        minimize(obj.energy_and_gradient, theta0, jac=True, method="L-BFGS-B",
+                 options={"maxfun": max_evaluations, "maxiter": max_evaluations, "ftol": 1e-16, "gtol": 1e-12,
+                          "maxcor": 20})
+    else:
+        minimize(obj.energy, theta0, method="Powell",
+                 options={"maxfev": max_evaluations, "xtol": 1e-4, "ftol": 1e-14, "direc": 0.1 * np.eye(len(theta0))})
+    if obj.best_f is None or not obj.best_E < state.energy - 1e-15 * abs(state.energy):
+        return False
+    rows, diag = state.rep.rows(obj.best_f, state.basis, i)  # oriented: patched matrices equal a rebuild
+    state.put(i, obj.best_f, {k: v[0] for k, v in rows.items()}, diag[0])
+    return True

@@ -3,6 +3,7 @@
 use crate::assemble;
 use crate::build::{self, Matrices, Symmetrised};
 use crate::fecg::{self, Centres, Fecg};
+use crate::gradient::{self, Dual};
 use crate::gvr::{self, Gvr, GvrOps};
 use crate::images::Images;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Vector};
@@ -201,6 +202,82 @@ pub fn gvr_rows(
     dispatch!(setup.n, gvr_rows_d(setup, n_ang, trials, basis, position))
 }
 
+/// P directions in one function's parameter space: `P x n x n` derivatives of `A` and
+/// `P x n` of `u` (ECG-GVR) or `P x n x 3` of `s` (floating ECGs).
+pub struct Directions<'a> {
+    pub a: &'a [f64],
+    pub v: &'a [f64],
+}
+
+impl Directions<'_> {
+    /// The directions as matrices (`R x C` each for the vector part).
+    fn split<const D: usize, const R: usize, const C: usize>(&self) -> Result<(Vec<Mat<D>>, Vec<nalgebra::SMatrix<f64, R, C>>)> {
+        let p = self.a.len() / (D * D).max(1);
+        check(self.a.len(), p * D * D, "exponent directions")?;
+        check(self.v.len(), p * R * C, "vector directions")?;
+        let a = (0..p).map(|k| Mat::<D>::from_row_slice(&self.a[k * D * D..(k + 1) * D * D])).collect();
+        let v = (0..p).map(|k| nalgebra::SMatrix::<f64, R, C>::from_row_slice(&self.v[k * R * C..(k + 1) * R * C])).collect();
+        Ok((a, v))
+    }
+}
+
+/// Calls `$f::<W>` with the narrowest lane count W ∈ {4, 8, 16} that holds `$count` directions.
+macro_rules! lanes {
+    ($count:expr, $f:ident ( $($arg:expr),* )) => {
+        match $count {
+            0..=4 => $f::<D, 4>($($arg),*),
+            5..=8 => $f::<D, 8>($($arg),*),
+            _ => $f::<D, 16>($($arg),*),
+        }
+    };
+}
+
+fn gvr_chunk<const D: usize, const W: usize>(
+    go: &GvrOps<D>,
+    sym: &[(Mat<D>, f64)],
+    f: &Gvr<D>,
+    da: &[Mat<D>],
+    du: &[Vector<D>],
+    b: &Images<Gvr<D>>,
+) -> Result<(Vec<Vec<Element>>, Vec<Element>)> {
+    let trial = Gvr::<D, Dual<W>>::new(gradient::seed_matrix(&f.a, da), gradient::seed_matrix(&f.u, du), f.k, f.c_a, go, 0)?;
+    let t = Images::new(vec![trial], sym, go)?;
+    let bd = b.map(|g| g.cast::<Dual<W>>());
+    Ok(gradient::chunk(&t, &bd, da.len(), |x, y| gvr::element(x, y, go)))
+}
+
+fn gvr_row_gradient_d<const D: usize>(
+    setup: &Setup,
+    n_ang: u32,
+    trial: &GvrFunctions,
+    dir: &Directions,
+    basis: &GvrFunctions,
+) -> Result<(Matrices, Vec<Element>)> {
+    check(trial.c_a.len(), 1, "trial functions")?;
+    let k_max = basis.k.iter().chain(trial.k).copied().max().unwrap_or(0);
+    let (go, sym) = gvr_ops::<D>(setup, n_ang, k_max)?;
+    let f = gvr_functions(trial, &go)?.remove(0);
+    let b = Images::new(gvr_functions(basis, &go)?, &sym, &go)?;
+    let (da, du) = dir.split::<D, D, 1>()?;
+    gradient::gather(b.len(), da.len(), |first, count| {
+        let (da, du) = (&da[first..first + count], &du[first..first + count]);
+        lanes!(count, gvr_chunk(&go, &sym, &f, da, du, &b))
+    })
+}
+
+/// The row of one ECG-GVR function against a basis and its diagonal, with their derivatives
+/// along the directions `dir`: `(1 + P) x nb` matrices (row 0 the values, the function as bra)
+/// and `1 + P` diagonal elements (module `gradient`).
+pub fn gvr_row_gradient(
+    setup: &Setup,
+    n_ang: u32,
+    trial: &GvrFunctions,
+    dir: &Directions,
+    basis: &GvrFunctions,
+) -> Result<(Matrices, Vec<Element>)> {
+    dispatch!(setup.n, gvr_row_gradient_d(setup, n_ang, trial, dir, basis))
+}
+
 /// Floating ECGs: `k x n x n` exponents, `k x n x 3` centres, `k` values of c_A.
 pub struct FecgFunctions<'a> {
     pub a: &'a [f64],
@@ -250,6 +327,47 @@ fn fecg_angular_d<const D: usize>(setup: &Setup, mu: &[f64], basis: &FecgFunctio
         b.element(&b.functions[i], j, |x, y| Element { s: fecg::angular(x, y, &mu), ..Default::default() })
     });
     Ok(m.s)
+}
+
+fn fecg_chunk<const D: usize, const W: usize>(
+    ops: &Operators<D>,
+    sym: &[(Mat<D>, f64)],
+    f: &Fecg<D>,
+    da: &[Mat<D>],
+    ds: &[Centres<D>],
+    b: &Images<Fecg<D>>,
+) -> Result<(Vec<Vec<Element>>, Vec<Element>)> {
+    let trial = Fecg::<D, Dual<W>>::new(gradient::seed_matrix(&f.a, da), gradient::seed_matrix(&f.s, ds), f.c_a, 0)?;
+    let t = Images::new(vec![trial], sym, &())?;
+    let bd = b.map(|g| g.cast::<Dual<W>>());
+    Ok(gradient::chunk(&t, &bd, da.len(), |x, y| fecg::element(x, y, ops)))
+}
+
+fn fecg_row_gradient_d<const D: usize>(
+    setup: &Setup,
+    trial: &FecgFunctions,
+    dir: &Directions,
+    basis: &FecgFunctions,
+) -> Result<(Matrices, Vec<Element>)> {
+    check(trial.c_a.len(), 1, "trial functions")?;
+    let (ops, sym) = setup.operators::<D>()?;
+    let f = fecg_functions::<D>(trial)?.remove(0);
+    let b = Images::new(fecg_functions::<D>(basis)?, &sym, &())?;
+    let (da, ds) = dir.split::<D, D, 3>()?;
+    gradient::gather(b.len(), da.len(), |first, count| {
+        let (da, ds) = (&da[first..first + count], &ds[first..first + count]);
+        lanes!(count, fecg_chunk(&ops, &sym, &f, da, ds, &b))
+    })
+}
+
+/// `gvr_row_gradient` for floating ECGs (directions of `A` and of the centres `s`).
+pub fn fecg_row_gradient(
+    setup: &Setup,
+    trial: &FecgFunctions,
+    dir: &Directions,
+    basis: &FecgFunctions,
+) -> Result<(Matrices, Vec<Element>)> {
+    dispatch!(setup.n, fecg_row_gradient_d(setup, trial, dir, basis))
 }
 
 /// Symmetrised matrices of a floating-ECG basis.

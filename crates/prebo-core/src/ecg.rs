@@ -3,12 +3,32 @@
 //! Convention (docs/conventions.md): a plain ECG in `D` coordinates is
 //! `phi(r) = exp(-r^T (A ⊗ I_3) r)` — no factor 1/2 in the exponent — so that
 //! `<phi|phi> = (pi^D / |2A|)^{3/2}`. Every function is used normalised.
-use nalgebra::{Cholesky, SMatrix, SVector};
+use std::ops::{Add, Div, Mul, Sub};
+
+use nalgebra::{Cholesky, RealField, SMatrix, SVector};
 
 use crate::error::{CoreError, Result};
 
 pub type Mat<const D: usize> = SMatrix<f64, D, D>;
 pub type Vector<const D: usize> = SVector<f64, D>;
+
+/// A real scalar the generic kernels run on: `f64`, or a forward-mode dual number of
+/// num-dual (`DualSVec64<W>`) that carries W directional derivatives through every operation.
+pub trait Real:
+    RealField + Copy + From<f64> + Add<f64, Output = Self> + Sub<f64, Output = Self> + Mul<f64, Output = Self> + Div<f64, Output = Self>
+{
+}
+
+impl<T> Real for T where
+    T: RealField + Copy + From<f64> + Add<f64, Output = T> + Sub<f64, Output = T> + Mul<f64, Output = T> + Div<f64, Output = T>
+{
+}
+
+/// `x` as a `T` (a constant: zero derivatives).
+#[inline(always)]
+pub fn re<T: Real>(x: f64) -> T {
+    <T as From<f64>>::from(x)
+}
 
 /// One basis function: exponent matrix `A`, `ln|A|`, and its centre-of-mass exponent `c_A`.
 #[derive(Clone, Debug)]
@@ -32,16 +52,16 @@ impl<const D: usize> Gaussian<D> {
 }
 
 /// `ln|A|` from the Cholesky factor, `None` if `A` is not positive definite.
-pub fn log_det_pd<const D: usize>(a: &Mat<D>) -> Option<f64> {
+pub fn log_det_pd<T: Real, const D: usize>(a: &SMatrix<T, D, D>) -> Option<T> {
     let chol = Cholesky::new(*a)?;
     let l = chol.l_dirty();
-    let mut ld = 0.0;
+    let mut ld = T::zero();
     for k in 0..D {
         let d = l[(k, k)];
-        if !(d > 0.0) || !d.is_finite() {
+        if !(d > T::zero()) || !d.is_finite() {
             return None;
         }
-        ld += 2.0 * d.ln();
+        ld += d.ln() * 2.0;
     }
     Some(ld)
 }
@@ -61,22 +81,33 @@ pub struct Operators<const D: usize> {
 
 /// One (normalised, un-symmetrised) matrix element of every operator.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Element {
+pub struct Element<T = f64> {
     /// overlap `<I|J>`
-    pub s: f64,
+    pub s: T,
     /// kinetic energy with the full `Λ` (laboratory frame: includes CM motion)
-    pub t: f64,
+    pub t: T,
     /// kinetic energy with the CM part eliminated (equal to `t` without `cm_mass`)
-    pub t_ti: f64,
+    pub t_ti: T,
     /// Coulomb potential energy
-    pub v: f64,
+    pub v: T,
 }
 
-impl std::ops::AddAssign<(f64, Element)> for Element {
-    fn add_assign(&mut self, (c, e): (f64, Element)) {
-        self.s += c * e.s;
-        self.t += c * e.t;
-        self.t_ti += c * e.t_ti;
-        self.v += c * e.v;
+impl<T: Real> Element<T> {
+    pub fn zero() -> Self {
+        Self { s: T::zero(), t: T::zero(), t_ti: T::zero(), v: T::zero() }
+    }
+
+    pub fn nan() -> Self {
+        let n = re(f64::NAN);
+        Self { s: n, t: n, t_ti: n, v: n }
+    }
+}
+
+impl<T: Real> std::ops::AddAssign<(f64, Element<T>)> for Element<T> {
+    fn add_assign(&mut self, (c, e): (f64, Element<T>)) {
+        self.s += e.s * c;
+        self.t += e.t * c;
+        self.t_ti += e.t_ti * c;
+        self.v += e.v * c;
     }
 }

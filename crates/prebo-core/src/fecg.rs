@@ -20,48 +20,66 @@ use std::f64::consts::PI;
 
 use nalgebra::{Cholesky, SMatrix};
 
-use crate::ecg::{Element, Mat, Operators, Vector};
+use crate::ecg::{re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
 use crate::images::Transform;
 
-pub type Centres<const D: usize> = SMatrix<f64, D, 3>;
+pub type Centres<const D: usize, T = f64> = SMatrix<T, D, 3>;
 
 /// One floating ECG: exponent `A`, centres `s` (one 3-vector per coordinate), `c_A`.
+/// `T` is `f64`, or a dual number when derivatives with respect to `A` and `s` are wanted.
 #[derive(Clone, Debug)]
-pub struct Fecg<const D: usize> {
-    pub a: Mat<D>,
-    pub s: Centres<D>,
+pub struct Fecg<const D: usize, T: Real = f64> {
+    pub a: SMatrix<T, D, D>,
+    pub s: Centres<D, T>,
     pub c_a: f64,
-    pub log_det: f64,
+    pub log_det: T,
     /// `A s`
-    pub a_s: Centres<D>,
+    pub a_s: Centres<D, T>,
     /// `s^T A s` (trace over Cartesian components)
-    pub s_a_s: f64,
+    pub s_a_s: T,
 }
 
-impl<const D: usize> Fecg<D> {
-    pub fn new(a: Mat<D>, s: Centres<D>, c_a: f64, index: usize) -> Result<Self> {
+impl<const D: usize, T: Real> Fecg<D, T> {
+    pub fn new(a: SMatrix<T, D, D>, s: Centres<D, T>, c_a: f64, index: usize) -> Result<Self> {
         let log_det = crate::ecg::log_det_pd(&a).ok_or(CoreError::NotPositiveDefinite { function: index })?;
         let a_s = a * s;
         let s_a_s = s.component_mul(&a_s).sum();
         Ok(Self { a, s, c_a, log_det, a_s, s_a_s })
     }
+
+    /// This function with dual-number entries of zero derivative.
+    pub fn cast<S: Real>(&self) -> Fecg<D, S>
+    where
+        T: Into<S>,
+    {
+        Fecg {
+            a: self.a.map(Into::into),
+            s: self.s.map(Into::into),
+            c_a: self.c_a,
+            log_det: self.log_det.into(),
+            a_s: self.a_s.map(Into::into),
+            s_a_s: self.s_a_s.into(),
+        }
+    }
 }
 
-impl<const D: usize> Transform<D, ()> for Fecg<D> {
+impl<const D: usize, T: Real> Transform<D, ()> for Fecg<D, T> {
     /// `phi(T r)`: `A -> T^T A T`, `s -> T^{-1} s`.
     fn transformed(&self, t: &Mat<D>, _: &(), index: usize) -> Result<Self> {
         let t_inv = t.try_inverse().ok_or_else(|| CoreError::Unsupported("singular symmetry operation".into()))?;
+        let (t, t_inv): (SMatrix<T, D, D>, SMatrix<T, D, D>) = (t.map(re), t_inv.map(re));
         Self::new(t.transpose() * self.a * t, t_inv * self.s, self.c_a, index)
     }
 }
 
 /// `erf(|m|/√c)/|m|` with the small-argument series (module docs).
 #[inline]
-fn coulomb_factor(m2: f64, c: f64) -> f64 {
+fn coulomb_factor<T: Real>(m2: T, c: T) -> T {
     let z2 = m2 / c;
-    if z2 < 1e-6 {
-        2.0 / (PI * c).sqrt() * (1.0 - z2 / 3.0 + z2 * z2 / 10.0 - z2 * z2 * z2 / 42.0 + z2.powi(4) / 216.0)
+    if z2 < re(1e-6) {
+        let series = T::one() - z2 / 3.0 + z2 * z2 / 10.0 - z2 * z2 * z2 / 42.0 + z2.powi(4) / 216.0;
+        (c * PI).sqrt().recip() * 2.0 * series
     } else {
         let m = m2.sqrt();
         erf(m / c.sqrt()) / m
@@ -70,10 +88,11 @@ fn coulomb_factor(m2: f64, c: f64) -> f64 {
 
 /// Error function: Maclaurin series below |x| = 2 (terms up to ~10, so ~1 digit of
 /// cancellation at worst), Lentz's continued fraction for erfc up to 6, 1 beyond
-/// (erfc(6) < 3e-17). Checked against tabulated values to 2e-16.
-pub fn erf(x: f64) -> f64 {
+/// (erfc(6) < 3e-17). Checked against tabulated values to 2e-16. Generic, so that dual
+/// numbers carry erf' = 2/√π exp(-x²) through the same arithmetic.
+pub fn erf<T: Real>(x: T) -> T {
     let ax = x.abs();
-    let r = if ax < 2.0 {
+    let r = if ax < re(2.0) {
         // erf(x) = 2/√π Σ (-1)^n x^{2n+1}/(n!(2n+1))
         let x2 = ax * ax;
         let (mut term, mut sum, mut n) = (ax, ax, 0.0);
@@ -82,36 +101,40 @@ pub fn erf(x: f64) -> f64 {
             term *= -x2 / n;
             let add = term / (2.0 * n + 1.0);
             sum += add;
-            if add.abs() < 1e-17 * sum.abs() {
+            if add.abs() < sum.abs() * 1e-17 {
                 break;
             }
         }
-        2.0 / PI.sqrt() * sum
-    } else if ax < 6.0 {
-        1.0 - erfc_cf(ax)
+        sum * (2.0 / PI.sqrt())
+    } else if ax < re(6.0) {
+        T::one() - erfc_cf(ax)
     } else {
-        1.0
+        T::one()
     };
-    r.copysign(x)
+    if x < T::zero() {
+        -r
+    } else {
+        r
+    }
 }
 
 /// erfc(x) for x >= 2 by Lentz's continued fraction.
-fn erfc_cf(x: f64) -> f64 {
+fn erfc_cf<T: Real>(x: T) -> T {
     // erfc(x) = exp(-x²)/√π · 1/(x + 1/2/(x + 1/(x + 3/2/(x + 2/(x + ...)))))
     let tiny = 1e-300;
     let mut f = x;
     let mut c = x;
-    let mut d = 0.0;
+    let mut d = T::zero();
     for k in 1..300 {
         let a = k as f64 / 2.0;
-        d = x + a * d;
-        d = if d.abs() < tiny { tiny } else { d };
-        c = x + a / c;
-        c = if c.abs() < tiny { tiny } else { c };
-        d = 1.0 / d;
+        d = x + d * a;
+        d = if d.abs() < re(tiny) { re(tiny) } else { d };
+        c = x + re::<T>(a) / c;
+        c = if c.abs() < re(tiny) { re(tiny) } else { c };
+        d = d.recip();
         let delta = c * d;
         f *= delta;
-        if (delta - 1.0).abs() < 1e-17 {
+        if (delta - 1.0).abs() < re(1e-17) {
             break;
         }
     }
@@ -132,36 +155,35 @@ fn row<const D: usize>(m: &Centres<D>, i: usize) -> [f64; 3] {
 /// Cholesky factor in floating point (possible only for near-singular functions, whose
 /// elements are then NaN and the caller rejects them).
 #[inline]
-fn pair<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>) -> Option<(f64, Mat<D>, Centres<D>)> {
+fn pair<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>) -> Option<(T, SMatrix<T, D, D>, Centres<D, T>)> {
     let b = bra.a + ket.a;
     let chol = Cholesky::new(b)?;
-    let log_det: f64 = 2.0 * chol.l_dirty().diagonal().iter().map(|d| d.ln()).sum::<f64>();
+    let log_det = chol.l_dirty().diagonal().iter().fold(T::zero(), |acc, d| acc + d.ln()) * 2.0;
     let v = bra.a_s + ket.a_s;
     let rbar = chol.solve(&v);
     let delta = bra.s_a_s + ket.s_a_s - v.component_mul(&rbar).sum();
-    let s = (1.5 * (D as f64 * 2f64.ln() + 0.5 * (bra.log_det + ket.log_det) - log_det) - delta).exp();
+    let s = (((bra.log_det + ket.log_det) * 0.5 + D as f64 * 2f64.ln() - log_det) * 1.5 - delta).exp();
     Some((s, chol.inverse(), rbar))
 }
 
-const NAN: Element = Element { s: f64::NAN, t: f64::NAN, t_ti: f64::NAN, v: f64::NAN };
-
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised floating ECGs.
-pub fn element<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>, ops: &Operators<D>) -> Element {
-    let Some((s, binv, rbar)) = pair(bra, ket) else { return NAN };
-    let w = bra.a * ops.lambda * ket.a;
+pub fn element<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops: &Operators<D>) -> Element<T> {
+    let Some((s, binv, rbar)) = pair(bra, ket) else { return Element::nan() };
+    let lam: SMatrix<T, D, D> = ops.lambda.map(re);
+    let w = bra.a * lam * ket.a;
     let r = binv.component_mul(&w.transpose()).sum();
     let di = rbar - bra.s;
     let dj = rbar - ket.s;
-    let q = 4.0 * di.component_mul(&(w * dj)).sum();
-    let t = (6.0 * r + q) * s;
+    let q = di.component_mul(&(w * dj)).sum() * 4.0;
+    let t = (r * 6.0 + q) * s;
     let t_ti = match ops.cm_mass {
         Some(m) => {
             let (ci, cj) = (bra.c_a, ket.c_a);
             let sum = ci + cj;
             // |μ^T (s_I - s_J)|²; μ = (A 1)/c_A, so μ^T s = 1^T A s / c_A
-            let mut d2 = 0.0;
+            let mut d2 = T::zero();
             for k in 0..3 {
-                let (mut xi, mut xj) = (0.0, 0.0);
+                let (mut xi, mut xj) = (T::zero(), T::zero());
                 for i in 0..D {
                     xi += bra.a_s[(i, k)];
                     xj += ket.a_s[(i, k)];
@@ -169,16 +191,17 @@ pub fn element<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>, ops: &Operators<D>)
                 d2 += (xi / ci - xj / cj).powi(2);
             }
             let r_cm = 3.0 * ci * cj / (m * sum);
-            let q_cm = -2.0 / m * (ci * cj / sum).powi(2) * d2;
-            t - (r_cm + q_cm) * s
+            let q_cm = d2 * (-2.0 / m * (ci * cj / sum).powi(2));
+            t - (q_cm + r_cm) * s
         }
         None => t,
     };
-    let mut v = 0.0;
+    let mut v = T::zero();
     for (wv, qq) in &ops.pairs {
+        let wv: nalgebra::SVector<T, D> = wv.map(re);
         let c = wv.dot(&(binv * wv));
         let m = rbar.transpose() * wv; // 3-vector w^T r̄
-        v += qq * coulomb_factor(m.norm_squared(), c);
+        v += coulomb_factor(m.norm_squared(), c) * *qq;
     }
     Element { s, t, t_ti, v: v * s }
 }

@@ -48,23 +48,24 @@
 //! K_I+K_J+N+1 nodes.
 use std::f64::consts::PI;
 
-use nalgebra::Cholesky;
+use nalgebra::{Cholesky, SMatrix, SVector};
 
-use crate::ecg::{Element, Mat, Operators, Vector};
+use crate::ecg::{re, Element, Mat, Operators, Real};
 use crate::error::{CoreError, Result};
 use crate::images::Transform;
 
 /// One ECG-GVR function: exponent `A`, global vector `u`, power `K`, and its CM parameters.
+/// `T` is `f64`, or a dual number when derivatives with respect to `A` and `u` are wanted.
 #[derive(Clone, Debug)]
-pub struct Gvr<const D: usize> {
-    pub a: Mat<D>,
-    pub u: Vector<D>,
+pub struct Gvr<const D: usize, T: Real = f64> {
+    pub a: SMatrix<T, D, D>,
+    pub u: SVector<T, D>,
     pub k: u32,
     pub c_a: f64,
     /// `c_U = 1^T u` (the CM component of `u^(x) = U^{-T} u^(r)`)
-    pub c_u: f64,
+    pub c_u: T,
     /// `ln <phi|phi>^{1/2}` in the scaling of this module
-    pub log_norm: f64,
+    pub log_norm: T,
 }
 
 /// Angular momentum and Gauss–Legendre nodes shared by all elements.
@@ -87,37 +88,57 @@ impl<const D: usize> GvrOps<D> {
     }
 }
 
-impl<const D: usize> Gvr<D> {
+/// `ln |B|` from a Cholesky factor.
+#[inline]
+fn log_det<T: Real, const D: usize>(chol: &Cholesky<T, nalgebra::Const<D>>) -> T {
+    chol.l_dirty().diagonal().iter().fold(T::zero(), |acc, d| acc + d.ln()) * 2.0
+}
+
+impl<const D: usize, T: Real> Gvr<D, T> {
     /// Checks `A` (positive definite), `u` (non-zero) and `K` (within the prepared range).
-    pub fn new(a: Mat<D>, u: Vector<D>, k: u32, c_a: f64, go: &GvrOps<D>, index: usize) -> Result<Self> {
+    pub fn new(a: SMatrix<T, D, D>, u: SVector<T, D>, k: u32, c_a: f64, go: &GvrOps<D>, index: usize) -> Result<Self> {
         if k > go.k_max() {
             return Err(CoreError::Unsupported(format!("function {index}: K = {k} above K_max = {}", go.k_max())));
         }
         let chol = Cholesky::new(a).ok_or(CoreError::NotPositiveDefinite { function: index })?;
-        let mut f = Self { a, u, k, c_a, c_u: u.sum(), log_norm: 0.0 };
         // <phi|phi>: B = 2A, x = y = z = u^T (2A)^{-1} u / 2 = u^T A^{-1} u / 4
-        let x = 0.25 * u.dot(&chol.solve(&u));
-        if !(x > 0.0) || !x.is_finite() {
+        let x = u.dot(&chol.solve(&u)) * 0.25;
+        if !(x > T::zero()) || !x.is_finite() {
             return Err(CoreError::Unsupported(format!("function {index}: global vector u is zero")));
         }
-        let log_det_2a = (D as f64) * 2f64.ln() + 2.0 * chol.l_dirty().diagonal().iter().map(|d| d.ln()).sum::<f64>();
+        let log_det_2a = log_det(&chol) + (D as f64) * 2f64.ln();
         let n = go.n_ang as f64;
-        let (g, _, _, _) = series(k, k, go.n_ang, 1.0);
-        let log_s0 = 1.5 * (D as f64 * PI.ln() - log_det_2a);
-        f.log_norm = 0.5 * (log_s0 + (2.0 * k as f64 + n) * x.ln() + g.ln());
-        Ok(f)
+        let (g, _, _, _) = series::<f64>(k, k, go.n_ang, 1.0);
+        let log_s0 = (log_det_2a - D as f64 * PI.ln()) * -1.5;
+        let log_norm = (log_s0 + x.ln() * (2.0 * k as f64 + n) + g.ln()) * 0.5;
+        Ok(Self { a, u, k, c_a, c_u: u.sum(), log_norm })
+    }
+
+    /// This function with dual-number entries of zero derivative.
+    pub fn cast<S: Real>(&self) -> Gvr<D, S>
+    where
+        T: Into<S>,
+    {
+        Gvr {
+            a: self.a.map(Into::into),
+            u: self.u.map(Into::into),
+            k: self.k,
+            c_a: self.c_a,
+            c_u: self.c_u.into(),
+            log_norm: self.log_norm.into(),
+        }
     }
 }
 
 /// `G = Σ ĉ_k ρ^{2k}`, `G_x = Σ ĉ_k (K_I−k) ρ^{2k}`, `G_y = Σ ĉ_k (K_J−k) ρ^{2k}`,
 /// `G_z = Σ ĉ_k (N+2k) ρ^{2k}` at `r2 = ρ²`; all terms non-negative.
 #[inline]
-fn series(ki: u32, kj: u32, n: u32, r2: f64) -> (f64, f64, f64, f64) {
+fn series<T: Real>(ki: u32, kj: u32, n: u32, r2: T) -> (T, T, T, T) {
     let alpha = n as f64 + 0.5;
-    let (mut c, mut p) = (1.0, 1.0);
-    let (mut g, mut gx, mut gy, mut gz) = (0.0, 0.0, 0.0, 0.0);
+    let (mut c, mut p) = (1.0, T::one());
+    let (mut g, mut gx, mut gy, mut gz) = (T::zero(), T::zero(), T::zero(), T::zero());
     for k in 0..=ki.min(kj) {
-        let term = c * p;
+        let term = p * c;
         g += term;
         gx += term * (ki - k) as f64;
         gy += term * (kj - k) as f64;
@@ -144,84 +165,80 @@ fn coefficients(ki: u32, kj: u32, n: u32) -> Vec<f64> {
 /// Ω and its derivatives divided by `e^L`, `L = (K_I+N/2) ln x + (K_J+N/2) ln y`:
 /// returns `(L, ω, ω_x, ω_y, ω_z)`.
 #[inline]
-fn omega(ki: u32, kj: u32, n: u32, x: f64, y: f64, z: f64) -> (f64, f64, f64, f64, f64) {
+fn omega<T: Real>(ki: u32, kj: u32, n: u32, x: T, y: T, z: T) -> (T, T, T, T, T) {
     let nf = n as f64;
     let rt = (x * y).sqrt();
-    let rho = (z / rt).clamp(-1.0, 1.0);
+    let rho = (z / rt).clamp(re(-1.0), re(1.0));
     let (g, gx, gy, gz) = series(ki, kj, n, rho * rho);
     let rho_n = rho.powi(n as i32);
-    let l = (ki as f64 + 0.5 * nf) * x.ln() + (kj as f64 + 0.5 * nf) * y.ln();
+    let l = x.ln() * (ki as f64 + 0.5 * nf) + y.ln() * (kj as f64 + 0.5 * nf);
     // Ω_z = x^{K_I} y^{K_J} Σ ĉ_k (N+2k) z^{N+2k-1} (xy)^{-k} = e^L Σ ĉ_k (N+2k) ρ^{N+2k-1} / √(xy);
     // for N = 0 the k = 0 term vanishes, so divide G_z by ρ only when N = 0 (ρ^{2k-1} = ρ^{2k}/ρ).
-    let omega_z = if n == 0 {
-        let (_, _, _, gz1) = series_shifted(ki, kj, rho * rho);
-        rho * gz1 / rt
-    } else {
-        rho.powi(n as i32 - 1) * gz / rt
-    };
+    let omega_z = if n == 0 { rho * series_shifted(ki, kj, rho * rho) / rt } else { rho.powi(n as i32 - 1) * gz / rt };
     (l, rho_n * g, rho_n * gx / x, rho_n * gy / y, omega_z)
 }
 
-/// For N = 0: `Σ_{k>=1} ĉ_k 2k ρ^{2k-2}` (the z-derivative series divided by ρ), in slot 3.
+/// For N = 0: `Σ_{k>=1} ĉ_k 2k ρ^{2k-2}` (the z-derivative series divided by ρ).
 #[inline]
-fn series_shifted(ki: u32, kj: u32, r2: f64) -> (f64, f64, f64, f64) {
+fn series_shifted<T: Real>(ki: u32, kj: u32, r2: T) -> T {
     let alpha = 0.5;
-    let (mut c, mut p, mut gz) = (1.0, 1.0, 0.0);
+    let (mut c, mut p, mut gz) = (1.0, T::one(), T::zero());
     for k in 0..ki.min(kj) {
         c *= ((ki - k) as f64) * ((kj - k) as f64) / (((k + 1) as f64) * (k as f64 + 1.0 + alpha));
-        gz += c * p * (2 * (k + 1)) as f64;
+        gz += p * c * (2 * (k + 1)) as f64;
         p *= r2;
     }
-    (0.0, 0.0, 0.0, gz)
+    gz
 }
 
 /// Closed form of the kinetic element with `Λ = 1 1^T/(2 m_tot)` over `e^L S_0` (docs/gvr.md):
 /// `3 c_I c_J/(m s) Ω − (c_UI² c_J Ω_x + c_UJ² c_I Ω_y)/(m s) + c_I c_J (c_UI² Ω_x + c_UI c_UJ Ω_z + c_UJ² Ω_y)/(m s²)`.
 #[inline]
-fn cm_kinetic(ci: f64, cj: f64, ui: f64, uj: f64, m: f64, w: (f64, f64, f64, f64)) -> f64 {
+fn cm_kinetic<T: Real>(ci: f64, cj: f64, ui: T, uj: T, m: f64, w: (T, T, T, T)) -> T {
     let (om, ox, oy, oz) = w;
     let s = ci + cj;
-    3.0 * ci * cj / (m * s) * om - (ui * ui * cj * ox + uj * uj * ci * oy) / (m * s)
-        + ci * cj * (ui * ui * ox + ui * uj * oz + uj * uj * oy) / (m * s * s)
+    om * (3.0 * ci * cj / (m * s)) - (ui * ui * cj * ox + uj * uj * ci * oy) / (m * s)
+        + (ui * ui * ox + ui * uj * oz + uj * uj * oy) * (ci * cj) / (m * s * s)
 }
 
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised ECG-GVR functions.
-pub fn element<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>) -> Element {
+pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
     let ops = &go.ops;
     let n = go.n_ang;
     let b_mat = bra.a + ket.a;
     // A_I + A_J is positive definite, but for near-singular functions its factorisation can
     // fail in floating point: the element is then NaN and the caller rejects the function
     let Some(chol) = Cholesky::new(b_mat) else {
-        return Element { s: f64::NAN, t: f64::NAN, t_ti: f64::NAN, v: f64::NAN };
+        return Element::nan();
     };
-    let log_det: f64 = 2.0 * chol.l_dirty().diagonal().iter().map(|d| d.ln()).sum::<f64>();
+    let log_det = log_det(&chol);
     let binv = chol.inverse();
     let gi = binv * bra.u;
     let gj = binv * ket.u;
-    let x = 0.5 * bra.u.dot(&gi);
-    let y = 0.5 * ket.u.dot(&gj);
-    let z = 0.5 * bra.u.dot(&gj);
-    let log_s0 = 1.5 * (D as f64 * PI.ln() - log_det);
+    let x = bra.u.dot(&gi) * 0.5;
+    let y = ket.u.dot(&gj) * 0.5;
+    let z = bra.u.dot(&gj) * 0.5;
+    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
     let (l, om, ox, oy, oz) = omega(bra.k, ket.k, n, x, y, z);
     let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
     let s = scale * om;
 
     // kinetic with Λ
-    let lam = &ops.lambda;
+    let lam: SMatrix<T, D, D> = ops.lambda.map(re);
     let lam_ui = lam * bra.u;
     let lam_uj = lam * ket.u;
     let zl = ket.a * lam_ui; // A_J Λ u_I
     let zr = bra.a * lam_uj; // A_I Λ u_J
     let w = bra.a * lam * ket.a; // A_I Λ A_J
-    let tr_wc = 0.5 * binv.component_mul(&w.transpose()).sum();
-    let (hi, hj) = (0.5 * gi, 0.5 * gj); // C u
-    let t = bra.u.dot(&lam_uj) * oz - 4.0 * zl.dot(&hi) * ox - 2.0 * zl.dot(&hj) * oz - 4.0 * zr.dot(&hj) * oy
-        - 2.0 * zr.dot(&hi) * oz
-        + 12.0 * tr_wc * om
-        + 8.0 * hi.dot(&(w * hi)) * ox
-        + 4.0 * (hi.dot(&(w * hj)) + hj.dot(&(w * hi))) * oz
-        + 8.0 * hj.dot(&(w * hj)) * oy;
+    let tr_wc = binv.component_mul(&w.transpose()).sum() * 0.5;
+    let (hi, hj) = (gi * re::<T>(0.5), gj * re::<T>(0.5)); // C u
+    // (written as `a * 4.0 * b` to keep the rounding of the f64 kernel's `4.0 * a * b`)
+    let t = bra.u.dot(&lam_uj) * oz - zl.dot(&hi) * 4.0 * ox - zl.dot(&hj) * 2.0 * oz - zr.dot(&hj) * 4.0 * oy
+        - zr.dot(&hi) * 2.0 * oz
+        + tr_wc * 12.0 * om
+        + hi.dot(&(w * hi)) * 8.0 * ox
+        + (hi.dot(&(w * hj)) + hj.dot(&(w * hi))) * 4.0 * oz
+        + hj.dot(&(w * hj)) * 8.0 * oy;
     let t = scale * t;
     let t_ti = match ops.cm_mass {
         Some(m) => t - scale * cm_kinetic(bra.c_a, ket.c_a, bra.c_u, ket.c_u, m, (om, ox, oy, oz)),
@@ -234,35 +251,34 @@ pub fn element<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>) -> El
     let rule = &go.legendre[(bra.k + ket.k + n + 1) as usize];
     let coef = coefficients(bra.k, ket.k, n);
     let rt = (x * y).sqrt();
-    let mut v = 0.0;
+    let mut v = T::zero();
     for (wv, q) in &ops.pairs {
+        let wv: SVector<T, D> = wv.map(re);
         let bw = binv * wv;
         let c = wv.dot(&bw);
-        let gam_i = gi.dot(wv) / (2.0 * c).sqrt();
-        let gam_j = gj.dot(wv) / (2.0 * c).sqrt();
-        let mut integral = 0.0;
+        let sq = (c * 2.0).sqrt();
+        let gam_i = gi.dot(&wv) / sq;
+        let gam_j = gj.dot(&wv) / sq;
+        let mut integral = T::zero();
         for &(tau, weight) in rule {
             let t2 = tau * tau;
             // x_τ, y_τ >= 0 analytically (covariances of B + t² w w^T); clamp rounding
-            let xt = (x - t2 * gam_i * gam_i).max(0.0);
-            let yt = (y - t2 * gam_j * gam_j).max(0.0);
-            let zt = z - t2 * gam_i * gam_j;
-            let r2 = if xt * yt > 0.0 { (zt * zt / (xt * yt)).min(1.0) } else { 1.0 };
-            let g = coef.iter().rev().fold(0.0, |acc, ck| acc * r2 + ck);
-            integral += weight
-                * (xt / x).powi(bra.k as i32)
-                * (yt / y).powi(ket.k as i32)
-                * (zt / rt).powi(n as i32)
-                * g;
+            let xt = (x - gam_i * t2 * gam_i).max(T::zero());
+            let yt = (y - gam_j * t2 * gam_j).max(T::zero());
+            let zt = z - gam_i * t2 * gam_j;
+            let r2 = if xt * yt > T::zero() { (zt * zt / (xt * yt)).min(T::one()) } else { T::one() };
+            let g = coef.iter().rev().fold(T::zero(), |acc, ck| acc * r2 + *ck);
+            integral += (xt / x).powi(bra.k as i32) * weight * (yt / y).powi(ket.k as i32) * (zt / rt).powi(n as i32) * g;
         }
-        v += q * 2.0 / (PI * c).sqrt() * integral;
+        v += re::<T>(*q * 2.0) / (c * PI).sqrt() * integral;
     }
     Element { s, t, t_ti, v: scale * v }
 }
 
-impl<const D: usize> Transform<D, GvrOps<D>> for Gvr<D> {
+impl<const D: usize, T: Real> Transform<D, GvrOps<D>> for Gvr<D, T> {
     /// `phi(T r)`: `A -> T^T A T`, `u -> T^T u`.
     fn transformed(&self, t: &Mat<D>, go: &GvrOps<D>, index: usize) -> Result<Self> {
+        let t: SMatrix<T, D, D> = t.map(re);
         Self::new(t.transpose() * self.a * t, t.transpose() * self.u, self.k, self.c_a, go, index)
     }
 }
@@ -312,7 +328,7 @@ mod tests {
     #[test]
     fn series_matches_hand_values() {
         // K_I = K_J = 1, N = 0: G = ĉ_0 + ĉ_1 ρ² with ĉ_1 = 1/(1·3/2) = 2/3
-        let (g, gx, gy, gz) = series(1, 1, 0, 0.25);
+        let (g, gx, gy, gz) = series(1, 1, 0, 0.25f64);
         assert!((g - (1.0 + 0.25 * 2.0 / 3.0)).abs() < 1e-15);
         assert!((gx - 1.0).abs() < 1e-15 && (gy - 1.0).abs() < 1e-15);
         assert!((gz - 2.0 * 0.25 * 2.0 / 3.0).abs() < 1e-15);

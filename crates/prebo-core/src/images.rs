@@ -2,7 +2,7 @@
 //!
 //! A symmetrised element is `Σ_P c_P <phi_I| O |P phi_J>`; the images `P phi_J` are
 //! computed once per function and operation (`Transform::transformed`).
-use crate::ecg::{Element, Mat};
+use crate::ecg::{Element, Mat, Real};
 use crate::error::Result;
 
 /// A function type that knows its image `phi(T r)` under a linear map `T`.
@@ -30,6 +30,15 @@ impl<F> Images<F> {
         Ok(Self { functions, images, coef: sym.iter().map(|(_, c)| *c).collect() })
     }
 
+    /// The same functions and images with `cast` applied (e.g. to dual numbers).
+    pub fn map<G>(&self, cast: impl Fn(&F) -> G) -> Images<G> {
+        Images {
+            functions: self.functions.iter().map(&cast).collect(),
+            images: self.images.iter().map(|im| im.iter().map(&cast).collect()).collect(),
+            coef: self.coef.clone(),
+        }
+    }
+
     pub fn len(&self) -> usize {
         self.functions.len()
     }
@@ -39,8 +48,8 @@ impl<F> Images<F> {
     }
 
     /// `Σ_P c_P element(bra, P phi_j)`.
-    pub fn element(&self, bra: &F, j: usize, element: impl Fn(&F, &F) -> Element) -> Element {
-        let mut e = Element::default();
+    pub fn element<B, T: Real>(&self, bra: &B, j: usize, element: impl Fn(&B, &F) -> Element<T>) -> Element<T> {
+        let mut e = Element::zero();
         for (ket, c) in self.images[j].iter().zip(&self.coef) {
             e += (*c, element(bra, ket));
         }

@@ -9,6 +9,7 @@ pub mod build;
 pub mod ecg;
 pub mod error;
 pub mod fecg;
+pub mod gradient;
 pub mod gvr;
 pub mod images;
 pub mod pecg;

@@ -3,7 +3,7 @@
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use prebo_core::ecg::Element;
-use prebo_core::api::{self, FecgFunctions, Functions, GvrFunctions, Setup};
+use prebo_core::api::{self, Directions, FecgFunctions, Functions, GvrFunctions, Setup};
 use prebo_core::build::Matrices;
 use prebo_core::CoreError;
 use pyo3::exceptions::PyValueError;
@@ -231,6 +231,43 @@ fn gvr_rows<'py>(
     Ok((dict(py, m)?, diag_array(py, &diag)))
 }
 
+/// The row of one ECG-GVR function against a basis, and its diagonal, with derivatives along
+/// `P` directions `(d_a[p], d_u[p])`: dict of `(1 + P) x nb` arrays (row 0 the values), `(1 + P) x 4` diagonal.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn gvr_row_gradient<'py>(
+    py: Python<'py>,
+    trial_a: PyReadonlyArray3<f64>,
+    trial_u: PyReadonlyArray2<f64>,
+    trial_k: PyReadonlyArray1<u32>,
+    trial_c_a: PyReadonlyArray1<f64>,
+    d_a: PyReadonlyArray3<f64>,
+    d_u: PyReadonlyArray2<f64>,
+    a: PyReadonlyArray3<f64>,
+    u: PyReadonlyArray2<f64>,
+    k: PyReadonlyArray1<u32>,
+    c_a: PyReadonlyArray1<f64>,
+    n_ang: u32,
+    lambda_: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+    cm_mass: Option<f64>,
+) -> PyResult<(Bound<'py, pyo3::types::PyDict>, Arr2<'py>)> {
+    let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
+    let trial = GvrData::new(trial_a, trial_u, trial_k, trial_c_a)?;
+    let basis = GvrData::new(a, u, k, c_a)?;
+    let (d_a, d_u) = (slice(&d_a, "d_a")?.to_vec(), slice(&d_u, "d_u")?.to_vec());
+    let (m, diag) = py
+        .allow_threads(|| {
+            let dir = Directions { a: &d_a, v: &d_u };
+            api::gvr_row_gradient(&setup.view(), n_ang, &trial.view(), &dir, &basis.view())
+        })
+        .map_err(to_py)?;
+    Ok((dict(py, m)?, diag_array(py, &diag)))
+}
+
 
 /// Owned floating-ECG arrays.
 struct FecgData {
@@ -296,6 +333,39 @@ fn fecg_rows<'py>(
     let basis = FecgData::new(a, s, c_a)?;
     let (m, diag) = py
         .allow_threads(|| api::fecg_rows(&setup.view(), &trials.view(), &basis.view(), position))
+        .map_err(to_py)?;
+    Ok((dict(py, m)?, diag_array(py, &diag)))
+}
+
+/// `gvr_row_gradient` for floating ECGs: directions `(d_a[p], d_s[p])` of the exponent and the centres.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn fecg_row_gradient<'py>(
+    py: Python<'py>,
+    trial_a: PyReadonlyArray3<f64>,
+    trial_s: PyReadonlyArray3<f64>,
+    trial_c_a: PyReadonlyArray1<f64>,
+    d_a: PyReadonlyArray3<f64>,
+    d_s: PyReadonlyArray3<f64>,
+    a: PyReadonlyArray3<f64>,
+    s: PyReadonlyArray3<f64>,
+    c_a: PyReadonlyArray1<f64>,
+    lambda_: PyReadonlyArray2<f64>,
+    pair_w: PyReadonlyArray2<f64>,
+    pair_q: PyReadonlyArray1<f64>,
+    sym_t: PyReadonlyArray3<f64>,
+    sym_c: PyReadonlyArray1<f64>,
+    cm_mass: Option<f64>,
+) -> PyResult<(Bound<'py, pyo3::types::PyDict>, Arr2<'py>)> {
+    let setup = setup_data(lambda_, pair_w, pair_q, sym_t, sym_c, cm_mass)?;
+    let trial = FecgData::new(trial_a, trial_s, trial_c_a)?;
+    let basis = FecgData::new(a, s, c_a)?;
+    let (d_a, d_s) = (slice(&d_a, "d_a")?.to_vec(), slice(&d_s, "d_s")?.to_vec());
+    let (m, diag) = py
+        .allow_threads(|| {
+            let dir = Directions { a: &d_a, v: &d_s };
+            api::fecg_row_gradient(&setup.view(), &trial.view(), &dir, &basis.view())
+        })
         .map_err(to_py)?;
     Ok((dict(py, m)?, diag_array(py, &diag)))
 }
@@ -367,8 +437,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rows, m)?)?;
     m.add_function(wrap_pyfunction!(gvr_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(gvr_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(gvr_row_gradient, m)?)?;
     m.add_function(wrap_pyfunction!(fecg_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(fecg_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(fecg_row_gradient, m)?)?;
     m.add_function(wrap_pyfunction!(fecg_angular, m)?)?;
     m.add_function(wrap_pyfunction!(lowest_with_added, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
