@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 
 from prebo import eigen
-from prebo.errors import InputError
+from prebo.errors import IllConditionedError, InputError
 from prebo.integrals import laboratory
 from prebo.optimise import Optimiser, Sampler, State
+from prebo.polish import Joint, polish
 from prebo.refine import Objective, Parametrisation, refine_function
 from prebo.system import State as QState
 from prebo.system import System
@@ -108,3 +109,64 @@ def test_gradient_refinement_lowers_the_energy_and_keeps_the_matrices_exact():
 def test_unknown_refine_method_is_refused():
     with pytest.raises(InputError, match="refine_method"):
         Optimiser(refine_method="newton")
+
+
+def test_extreme_parameters_are_refused_not_collapsed():
+    """An exponent with condition number ~1e16 (reached once by unguarded L-BFGS restarts, where
+    lost digits gave E = -8e9 Eh) is refused; implausible elements are caught by their bounds."""
+    system, basis, p, theta = setup("gvr-H2+", nb=6)
+    extreme = theta.copy()
+    extreme[:2] = -13.0
+    extreme[2] = 115.0
+    with pytest.raises(IllConditionedError):
+        p.function(extreme)
+    basis.append(p.function(theta))
+    st = State(basis, laboratory(system), 1e-13)
+    obj = Objective(st, len(basis) - 1)
+    assert obj.energy(extreme) == obj.worse and obj.energy_and_gradient(extreme)[0] == obj.worse
+    rows, diag = st.rep.rows(p.function(theta), basis.subset(range(6)))
+    S_b = np.diag(st.m["S"])[:6]
+    assert st.rep.plausible(rows, diag, S_b)[0]
+    for k, bad in [(0, 3.0), (1, -1.0), (2, -1e-3)]:  # S_nn above Σ|c_P| = 2, negative kinetic energies
+        d = diag.copy()
+        d[0, k] = bad
+        assert not st.rep.plausible(rows, d, S_b)[0]
+    r = {"S": rows["S"].copy()}
+    r["S"][0, 2] = 1.01 * np.sqrt(diag[0, 0] * S_b[2])  # Cauchy–Schwarz
+    assert not st.rep.plausible(r, diag, S_b)[0]
+
+
+def test_the_length_of_the_global_vector_is_irrelevant():
+    """u is kept at unit length in its channel (it would otherwise drift along the flat direction)."""
+    system, basis, p, theta = setup("gvr-H2", nb=4)
+    rep = laboratory(system)
+    d = len(theta) - 3
+    scaled = theta.copy()
+    scaled[d:] *= 1e6
+    assert np.allclose(p.function(scaled).u, p.function(theta).u, rtol=1e-14)
+    a, b = rep.rows(p.function(theta), basis), rep.rows(p.function(scaled), basis)
+    for k in a[0]:
+        assert np.allclose(a[0][k], b[0][k], rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("case", ["gvr-H2+", "fecg-H2+", "pecg-H2"])
+def test_joint_gradient_matches_finite_differences(case):
+    system, basis, p, theta = setup(case, nb=5)
+    basis.append(p.function(theta))
+    st = State(basis, laboratory(system), 1e-13)
+    joint = Joint(st)
+    x = joint.theta0 + 0.05 * np.random.default_rng(1).standard_normal(len(joint.theta0))
+    e, g = joint(x)
+    assert e < joint.worse
+    fd = np.array([richardson(lambda t: joint(t)[0], x, k, 1e-4) for k in range(len(x))])
+    assert np.max(np.abs(g - fd)) < 1e-7 * np.max(np.abs(g)), (g, fd)
+
+
+def test_polish_lowers_the_energy_and_leaves_a_consistent_state():
+    system, basis, p, theta = setup("gvr-H2+", nb=12)
+    st = State(basis, laboratory(system), 1e-13)
+    before = st.energy
+    assert polish(st, 15) and st.energy < before
+    fresh = st.rep.matrices(st.basis)
+    for k in fresh:
+        assert np.array_equal(fresh[k], st.m[k]), k

@@ -25,6 +25,8 @@ trials = 6
 sweeps = 1
 refine = 1
 refine_evaluations = 30
+polish = 2
+polish_iterations = 5
 seed = 7
 channels = "all"
 """
@@ -73,7 +75,7 @@ def test_resume_without_checkpoint_is_a_clear_error(tmp_path):
 
 
 def test_cursor_schedule():
-    opts = Optimiser(size=2, sweeps=1, refine=2)
+    opts = Optimiser(size=2, sweeps=1, refine=2, polish=2)
     c, seen = Cursor().advance(0, opts), []
     nb = 0
     while c.phase != "done":
@@ -81,11 +83,12 @@ def test_cursor_schedule():
         nb = min(nb + 1, 2) if c.phase == "grow" else nb
         c = c.advance(nb, opts)
     assert seen == [("grow", 0, 0), ("grow", 0, 0), ("sweep", 0, 0), ("sweep", 0, 1),
-                    ("refine", 0, 0), ("refine", 0, 1), ("refine", 1, 0), ("refine", 1, 1)]
+                    ("refine", 0, 0), ("refine", 0, 1), ("refine", 1, 0), ("refine", 1, 1),
+                    ("polish", 0, 0), ("polish", 1, 0)]
 
 
 def test_refinement_and_learning_lower_the_energy():
-    """Same seed and size: Powell refinement and learned sampling must beat plain selection."""
+    """Same seed and size: refinement and learned sampling must beat plain selection."""
     system = prebo.System(["p", "e", "e"], spin={"e": 0})
     plain = prebo.optimise(system, Optimiser(size=8, trials=5, seed=2, learned=0.0), progress=False)
     better = prebo.optimise(system, Optimiser(size=8, trials=5, seed=2, refine=1, refine_evaluations=40),

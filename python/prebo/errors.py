@@ -21,6 +21,10 @@ class NotPositiveDefiniteError(PreboError):
     """An exponent matrix A (or the overlap matrix) is not positive definite."""
 
 
+class IllConditionedError(NotPositiveDefiniteError):
+    """An exponent matrix too ill-conditioned for accurate integrals."""
+
+
 class LinearDependenceError(PreboError):
     """The overlap matrix is numerically singular beyond the chosen threshold."""
 

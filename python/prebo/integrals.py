@@ -108,6 +108,17 @@ class Representation:
         P = len(dA)
         return _core.gvr_row_gradient(*as_gvr[0], c(dA), np.zeros((P, f.system.n)), *as_gvr[1], 0, *self._ops())
 
+    def plausible(self, rows: dict, diag: np.ndarray, S_basis: np.ndarray) -> np.ndarray:
+        """Per trial, whether its elements pass the bounds exact integrals obey: 0 < S_nn ≤ Σ_P |c_P|,
+        T_nn, T_ti,nn ≥ 0, |S_nj| ≤ (S_nn S_jj)^{1/2} (Cauchy–Schwarz). Integrals of extreme
+        parameters that lost their digits fail them, and would otherwise break the variational bound."""
+        S_nn = diag[:, 0]
+        ok = (S_nn > 0) & (S_nn <= np.abs(self.sym_c).sum() * (1 + 1e-10)) & (diag[:, 1] >= 0) & (diag[:, 2] >= 0)
+        if rows["S"].shape[1]:
+            bound = np.sqrt(np.outer(np.maximum(S_nn, 0), S_basis)) * (1 + 1e-8)
+            ok &= np.all(np.abs(rows["S"]) <= bound, axis=1)
+        return ok & np.all(np.isfinite(diag), axis=1)
+
     @staticmethod
     def oriented(kind: str) -> bool:
         """Whether `rows(..., position)` reproduces full-build bits for this basis type."""

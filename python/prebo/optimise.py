@@ -1,12 +1,13 @@
-"""Stochastic basis optimisation: competitive selection, replacement and Powell sweeps.
+"""Stochastic basis optimisation: competitive selection, replacement and refinement sweeps.
 
 Growth (Suzuki & Varga, Lect. Notes Phys. m54, ch. 4, "stochastic variational
 method"): draw `trials` random functions, get each one's row against the basis from
 the Rust core (O(N_b) integrals), the new lowest eigenvalue from the secular
 equation (O(N_b^2), eigen.lowest_with_added_many), keep the best and, with `refine`,
-Powell-refine it (refine.py). Then `sweeps` random replacement sweeps (each function in
-turn competes with `trials` random replacements in the basis without it) and `refine`
-Powell sweeps. After the first functions of a channel, a share `learned` of the trials
+refine it (refine.py: L-BFGS on exact gradients, or Powell). Then `sweeps` random
+replacement sweeps (each function in turn competes with `trials` random replacements in
+the basis without it), `refine` refinement sweeps, and `polish` steps of
+`polish_iterations` joint L-BFGS iterations over all parameters (polish.py). After the first functions of a channel, a share `learned` of the trials
 is drawn from the distribution of the parameters selected so far in that channel.
 
 Functions are drawn in a coordinate set ("channel") or in pair form:
@@ -30,8 +31,9 @@ import numpy as np
 from . import coordinates as coords
 from . import eigen
 from .basis import Basis
-from .errors import InputError
+from .errors import IllConditionedError, InputError
 from .integrals import laboratory
+from .polish import polish
 from .refine import METHODS, Parametrisation, refine_function
 from .system import System
 
@@ -51,7 +53,9 @@ class Optimiser:
     K_max: int = 0
     refine: int = 0
     refine_evaluations: int = 200
-    refine_method: str = "powell"
+    refine_method: str = "gradient"
+    polish: int = 0
+    polish_iterations: int = 20
     learned: float = 0.5
     learn_after: int = 5
     min_norm: float = 1e-8
@@ -88,6 +92,10 @@ class Optimiser:
             raise InputError(f"optimiser.learned must be a probability in [0, 1], got {self.learned!r}")
         if not (isinstance(self.refine, int) and self.refine >= 0):
             raise InputError(f"optimiser.refine must be a non-negative integer, got {self.refine!r}")
+        if not (isinstance(self.polish, int) and self.polish >= 0):
+            raise InputError(f"optimiser.polish must be a non-negative integer, got {self.polish!r}")
+        if not (isinstance(self.polish_iterations, int) and self.polish_iterations >= 1):
+            raise InputError(f"optimiser.polish_iterations must be a positive integer, got {self.polish_iterations!r}")
         if self.refine_method not in METHODS:
             raise InputError(f"optimiser.refine_method must be one of {', '.join(METHODS)}, got {self.refine_method!r}")
         if not (isinstance(self.K_max, int) and 0 <= self.K_max <= 60):
@@ -163,7 +171,10 @@ class Sampler:
             K = None
             if Ks is not None:
                 K = int(np.clip(self.rng.choice(Ks) + self.rng.integers(-2, 3), 0, self.opts.K_max))
-            return p.function(theta, K)
+            try:
+                return p.function(theta, K)
+            except IllConditionedError:
+                return self.fresh()
         return self.fresh()
 
     def fresh(self) -> Basis:
@@ -236,6 +247,12 @@ class State:
         self.eig = eigen.solve(self.m["T_ti"] + self.m["V"], self.m["S"], self.threshold)
         self.energy = float(self.eig.energies[0])
 
+    def replace_basis(self, basis: Basis) -> None:
+        """Take a whole new basis (matrices rebuilt)."""
+        self.basis = basis
+        self.m = self.rep.matrices(basis)
+        self.solve()
+
     def without(self, i: int):
         """The eigen-solution of the basis without function i (None if that leaves nothing)."""
         keep = np.arange(len(self.basis)) != i
@@ -252,7 +269,8 @@ class State:
         """Lowest energy with each trial added (to the basis without `exclude`, where the trial
         would replace it), with the rows and diagonals for `put`. The linear-dependence guard
         gives +inf to a trial whose normalised overlap with a function exceeds `max_overlap`
-        or whose part orthogonal to the basis is below `min_norm` of its norm."""
+        or whose part orthogonal to the basis is below `min_norm` of its norm, and so does a
+        trial whose elements fail `Representation.plausible`."""
         position = len(self.basis) if exclude is None else exclude
         rows, diag = self.rep.rows(trials, self.basis, position)
         H = rows["T_ti"] + rows["V"]
@@ -268,6 +286,7 @@ class State:
         if keep.any():
             overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(diag[:, 0], np.diag(self.m["S"])[keep]))
             energies[overlap.max(axis=1) > self.max_overlap] = np.inf
+        energies[~self.rep.plausible({"S": S[:, keep]}, diag, np.diag(self.m["S"])[keep])] = np.inf
         return energies, rows, diag
 
     def put(self, i: int, f: Basis, row: dict | None = None, d=None):
@@ -307,8 +326,9 @@ def _concat(fs: list[Basis]) -> Basis:
 
 @dataclass
 class Cursor:
-    """The next unit of work: one competitive step ("grow"), or function `index` of
-    replacement sweep / Powell refinement sweep `sweep` ("sweep", "refine"), or "done"."""
+    """The next unit of work: one competitive step ("grow"), function `index` of
+    replacement sweep / refinement sweep `sweep` ("sweep", "refine"), joint-refinement step
+    `sweep` ("polish"), or "done"."""
 
     phase: str = "grow"
     sweep: int = 0
@@ -320,7 +340,7 @@ class Cursor:
                 return self
             return Cursor("sweep").settle(opts)
         nxt = Cursor(self.phase, self.sweep, self.index + 1)
-        if nxt.index >= nb:
+        if nxt.index >= nb or self.phase == "polish":
             nxt = Cursor(self.phase, self.sweep + 1, 0)
         return nxt.settle(opts)
 
@@ -329,6 +349,8 @@ class Cursor:
         if self.phase == "sweep" and self.sweep >= opts.sweeps:
             return Cursor("refine").settle(opts)
         if self.phase == "refine" and self.sweep >= opts.refine:
+            return Cursor("polish").settle(opts)
+        if self.phase == "polish" and self.sweep >= opts.polish:
             return Cursor("done")
         return self
 
@@ -339,18 +361,25 @@ CHECKPOINT = "basis.json"
 def optimise(system: System, opts: Optimiser, out: Path | None = None, progress: bool = True,
              resume: dict | None = None) -> Basis:
     """Grow a basis to `opts.size` by competitive selection, then `opts.sweeps` random replacement
-    sweeps and `opts.refine` Powell sweeps. With `out`, the basis, the random-number state and the
+    sweeps, `opts.refine` refinement sweeps and `opts.polish` joint steps. With `out`, the basis, the random-number state and the
     position in this schedule are written atomically after every step (out/basis.json); `resume`
     (that file's content) continues such a run exactly where it stopped."""
     rng = np.random.default_rng(opts.seed)
     sampler = Sampler(system, opts, rng)
     rep = laboratory(system)
     if resume is None:
-        basis, cursor, history = Basis.empty(system, opts.kind), Cursor().advance(0, opts), []
+        basis, cursor, history, elapsed = Basis.empty(system, opts.kind), Cursor().advance(0, opts), [], 0.0
     else:
         basis = Basis.from_dict(resume, "checkpoint")
         rng.bit_generator.state = resume["rng"]
         cursor, history = Cursor(**resume["progress"]), resume["history"]
+        elapsed = float(resume.get("elapsed", 0.0))
+    t_start = time.perf_counter()
+
+    def wall() -> float:
+        """Seconds of optimisation so far, over all segments of a resumed run."""
+        return round(elapsed + time.perf_counter() - t_start, 1)
+
     st = State(basis, rep, opts.threshold, opts.min_norm, opts.max_overlap)
     sampler.learn(st.basis)
     report = Reporter(opts, progress)
@@ -360,7 +389,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
             st.basis.coefficients = st.eig.vectors[:, 0] if st.eig is not None else None
             st.basis.save(Path(out) / CHECKPOINT, {
                 "energy": st.energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
-                "rng": rng.bit_generator.state, "history": history})
+                "rng": rng.bit_generator.state, "history": history, "elapsed": wall()})
 
     def draw(k) -> Basis:
         return _concat([sampler.draw() for _ in range(k)])
@@ -385,11 +414,13 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 best = int(np.argmin(energies))
                 if np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
                     st.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
-            else:
+            elif cursor.phase == "refine":
                 report.trials(1)
                 refine_function(st, cursor.index, opts.refine_evaluations, opts.refine_method)
+            else:
+                polish(st, opts.polish_iterations)
             if st.energy < old:
-                history.append([len(st.basis), st.energy, cursor.phase])
+                history.append([len(st.basis), st.energy, cursor.phase, wall()])
                 report.step(st, old, cursor)
                 sampler.learn(st.basis)  # a function of the basis alone, so a resumed run learns the same
             cursor = cursor.advance(len(st.basis), opts)
@@ -449,6 +480,9 @@ class Reporter:
         info = f"E = {st.energy:.12f}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.1f} trials/s"
         if cursor.phase == "grow":
             self.progress.update(self.task, completed=len(st.basis), info=info)
+        elif cursor.phase == "polish":
+            self.progress.update(self.task, description="polish", completed=cursor.sweep + 1, total=self.opts.polish,
+                                 info=info)
         else:
             self.progress.update(self.task, description=f"{cursor.phase} {cursor.sweep + 1}",
                                  completed=cursor.index + 1, total=len(st.basis), info=info)

@@ -2,8 +2,11 @@
 
 A function generated in coordinate set x is refined in x: its parameters are
 θ = (ln diag L, strict lower L, u' or s') with 𝒜^(x) = L L^T (positive definite for every θ),
-A^(r) = U_x^T blockdiag(𝒜, c_A) U_x; for ECG-GVR u^(r) = U_x^T (u', c_U), for floating ECGs
-s^(r) = U_x^-1 (s', μ^T s); c_A, c_U, the CM centre μ^T s and K stay fixed. A function from the pair sampler is refined in the first Jacobi set.
+A^(r) = U_x^T blockdiag(𝒜, c_A) U_x; for ECG-GVR u^(r) = U_x^T v/|v|, v = (u', c_U) (the
+normalised function does not depend on the length of u, which is kept at 1), for floating ECGs
+s^(r) = U_x^-1 (s', μ^T s); c_A, c_U, the CM centre μ^T s and K stay fixed. A θ whose 𝒜 has a
+condition number above MAX_CONDITION is refused (IllConditionedError): the optimised bases stay
+below 1e5, and integrals of far more extreme exponents lose their digits. A function from the pair sampler is refined in the first Jacobi set.
 The energy of a trial θ is the lowest root of the secular equation (eigen.lowest_with_added)
 against the basis without the function: one row of integrals and O(N_b^2) per evaluation.
 
@@ -21,7 +24,7 @@ from scipy.optimize import minimize
 from . import coordinates as coords
 from . import eigen
 from .basis import Basis
-from .errors import PreboError
+from .errors import IllConditionedError, PreboError
 
 
 @dataclass
@@ -36,6 +39,9 @@ class Parametrisation:
         m = f.system.masses
         name = f.channels[0]
         x = coords.by_name(m, name) if name.split(":")[0] in ("jacobi", "hpc", "cmc") else coords.jacobi(m)
+        if f.kind == "ecg-gvr":  # the same normalised function with |(u', c_U)| = 1
+            scale = np.linalg.norm(x.transform_vectors_to_x(f.u[0]))
+            f = Basis(f.system, f.A, f.c_A, f.channels, kind="ecg-gvr", u=f.u / scale, K=f.K)
         return cls(f, x)
 
     def theta(self) -> np.ndarray:
@@ -53,7 +59,17 @@ class Parametrisation:
         d = self.f.system.n - 1
         L = np.diag(np.exp(np.clip(theta[:d], *LOG_DIAG)))
         L[np.tril_indices(d, -1)] = theta[d:d + d * (d - 1) // 2]
+        sv = np.linalg.svd(L, compute_uv=False)
+        if not sv[-1] > 0 or (sv[0] / sv[-1]) ** 2 > MAX_CONDITION:
+            raise IllConditionedError(f"exponent matrix with condition number above {MAX_CONDITION:.0e}")
         return L
+
+    def _v(self, theta: np.ndarray) -> tuple[np.ndarray, float]:
+        """(v/|v|, |v|) for ECG-GVR, v = (u', c_U)."""
+        d = self.f.system.n - 1
+        v = np.append(theta[d + d * (d - 1) // 2:], float(self.f.u[0].sum()))
+        norm = np.linalg.norm(v)
+        return v / norm, norm
 
     def function(self, theta: np.ndarray, K: int | None = None) -> Basis:
         d = self.f.system.n - 1
@@ -67,8 +83,7 @@ class Parametrisation:
             sx = self.x.U @ self.f.s[0]
             sx[:-1] = theta[d + nl:].reshape(d, 3)
             return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="fecg", s=(self.x.U_inv @ sx)[None])
-        c_U = float(self.f.u[0].sum())
-        u = self.x.U.T @ np.append(theta[d + nl:], c_U)
+        u = self.x.U.T @ self._v(theta)[0]
         return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="ecg-gvr", u=u[None],
                      K=self.f.K[:1] if K is None else [K])
 
@@ -91,8 +106,10 @@ class Parametrisation:
         if self.f.kind == "pecg":
             return dA, None
         if self.f.kind == "ecg-gvr":
+            v, norm = self._v(theta)  # u^(r) = U^T v/|v|: ∂(v/|v|)/∂u'_k = (e_k - v v_k)/|v|
             dv = np.zeros((P, n))
-            dv[d + nl:] = self.x.U[:d]  # u^(r) = U^T (u', c_U)
+            for k in range(d):
+                dv[d + nl + k] = self.x.U.T @ ((np.eye(n)[k] - v * v[k]) / norm)
             return dA, dv
         dv = np.zeros((P, n, 3))
         for a in range(d):
@@ -102,14 +119,15 @@ class Parametrisation:
 
 
 LOG_DIAG = (-8.0, 10.0)  # ln L_kk: exponents within ~1e-7..5e8
+MAX_CONDITION = 1e8  # of 𝒜 (module docstring)
 METHODS = ("powell", "gradient")
 
 
 class Objective:
     """The energy as a function of θ of function i, all others fixed: the lowest root of the
     secular equation against the basis without i. Remembers the best function seen. A θ that
-    leaves the valid region, or makes the function linearly dependent on the others, scores
-    worse than the current energy (a finite value keeps the line searches sane)."""
+    leaves the valid region (an ill-conditioned 𝒜, elements failing `Representation.plausible`),
+    or makes the function linearly dependent on the others, scores worse than the current energy (a finite value keeps the line searches sane)."""
 
     def __init__(self, state, i: int):
         self.state, self.i = state, i
@@ -118,6 +136,7 @@ class Objective:
         sub = state.without(i)
         self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
         self.rest = basis.subset(np.flatnonzero(self.keep))
+        self.S_rest = np.diag(state.m["S"])[self.keep]
         self.p = Parametrisation.of(basis.subset([i]))
         self.worse = state.energy + 1.0
         self.best_E, self.best_f = state.energy, None
@@ -127,10 +146,13 @@ class Objective:
             self.best_E, self.best_f = e, f
 
     def energy(self, theta: np.ndarray) -> float:
-        st, f = self.state, self.p.function(theta)
+        st = self.state
         try:
+            f = self.p.function(theta)
             rows, diag = st.rep.rows(f, st.basis, self.i)
         except PreboError:
+            return self.worse
+        if not st.rep.plausible({"S": rows["S"][:, self.keep]}, diag, self.S_rest)[0]:
             return self.worse
         e = eigen.lowest_with_added(self.E, self.C, (rows["T_ti"] + rows["V"])[0, self.keep],
                                     rows["S"][0, self.keep], diag[0, 2] + diag[0, 3], diag[0, 0], st.min_norm)
@@ -140,11 +162,14 @@ class Objective:
         return e
 
     def energy_and_gradient(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
-        st, f = self.state, self.p.function(theta)
-        dA, dv = self.p.directions(theta)
+        st = self.state
         try:
+            f = self.p.function(theta)
+            dA, dv = self.p.directions(theta)
             rows, diag = st.rep.row_gradient(f, dA, dv, self.rest)
         except PreboError:
+            return self.worse, np.zeros_like(theta)
+        if not st.rep.plausible({"S": rows["S"][:1]}, diag[:1], self.S_rest)[0]:
             return self.worse, np.zeros_like(theta)
         H, S = rows["T_ti"] + rows["V"], rows["S"]
         h_nn, s_nn = diag[:, 2] + diag[:, 3], diag[:, 0]
@@ -156,7 +181,7 @@ class Objective:
         return e, g
 
 
-def refine_function(state, i: int, max_evaluations: int = 200, method: str = "powell") -> bool:
+def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gradient") -> bool:
     """Minimise the energy over the parameters of function i — Powell, or L-BFGS with exact
     gradients — with at most `max_evaluations` energies; True if it improved."""
     obj = Objective(state, i)

@@ -141,7 +141,7 @@ fn gvr_functions<const D: usize>(f: &GvrFunctions, go: &GvrOps<D>) -> Result<Vec
 
 fn gvr_ops<const D: usize>(setup: &Setup, n_ang: u32, k_max: u32) -> Result<(GvrOps<D>, Vec<(Mat<D>, f64)>)> {
     let (ops, sym) = setup.operators::<D>()?;
-    Ok((GvrOps::new(ops, n_ang, k_max), sym))
+    Ok((GvrOps::new(ops, n_ang, k_max)?, sym))
 }
 
 fn gvr_matrices_d<const D: usize>(setup: &Setup, n_ang: u32, basis: &GvrFunctions) -> Result<Matrices> {

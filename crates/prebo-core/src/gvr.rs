@@ -74,13 +74,24 @@ pub struct GvrOps<const D: usize> {
     pub ops: Operators<D>,
     pub n_ang: u32,
     /// `legendre[n]` = nodes and weights of the n-point rule on [0, 1]
-    legendre: Vec<Vec<(f64, f64)>>,
+    legendre: Vec<&'static [(f64, f64)]>,
+}
+
+/// Gauss–Legendre rules computed once per process (`legendre_rule`).
+static RULES: [std::sync::OnceLock<Vec<(f64, f64)>>; 512] = [const { std::sync::OnceLock::new() }; 512];
+
+/// The n-point rule on [0, 1], computed on first use (n < 512, i.e. K up to ~250).
+fn legendre_rule(n: usize) -> &'static [(f64, f64)] {
+    RULES[n].get_or_init(|| gauss_legendre_01(n))
 }
 
 impl<const D: usize> GvrOps<D> {
-    pub fn new(ops: Operators<D>, n_ang: u32, k_max: u32) -> Self {
+    pub fn new(ops: Operators<D>, n_ang: u32, k_max: u32) -> Result<Self> {
         let n_max = (2 * k_max + n_ang + 1) as usize;
-        Self { ops, n_ang, legendre: (0..=n_max).map(gauss_legendre_01).collect() }
+        if n_max >= RULES.len() {
+            return Err(CoreError::Unsupported(format!("2 K_max + N = {} (at most {})", n_max - 1, RULES.len() - 2)));
+        }
+        Ok(Self { ops, n_ang, legendre: (0..=n_max).map(legendre_rule).collect() })
     }
 
     fn k_max(&self) -> u32 {
@@ -248,7 +259,7 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     // Coulomb by exact Gauss–Legendre quadrature in τ. At a node, Ω(τ)/e^L =
     // (x_τ/x)^{K_I} (y_τ/y)^{K_J} (z_τ/√(xy))^N G(ρ_τ²): integer powers of ratios ≤ 1 and a
     // polynomial in ρ_τ² ≤ 1 with the coefficients ĉ_k computed once per element.
-    let rule = &go.legendre[(bra.k + ket.k + n + 1) as usize];
+    let rule = go.legendre[(bra.k + ket.k + n + 1) as usize];
     let coef = coefficients(bra.k, ket.k, n);
     let rt = (x * y).sqrt();
     let mut v = T::zero();

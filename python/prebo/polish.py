@@ -1,0 +1,91 @@
+"""Joint refinement: L-BFGS over the parameters of every function at once, on the exact gradient.
+
+Refinement sweeps move one function at a time; near the optimum, where the functions' parameters
+are coupled, that coordinate descent crawls. Here θ = (θ_1, ..., θ_N) (refine.Parametrisation of
+each function in its own channel; K fixed) and, with c the S-normalised ground-state vector,
+
+    ∂E/∂θ_i = 2 c_i Σ_{j≠i} c_j (∂H_ij − E ∂S_ij) + c_i² (∂H_ii − E ∂S_ii),
+
+where ∂H_ij, ∂S_ij are the derivatives of function i's row (i as bra) and ∂H_ii, ∂S_ii those of
+its diagonal — exactly what Representation.row_gradient returns for function i against the basis.
+N such rows give the matrices and the gradient: the cost of ~(1 + W/4) matrix builds per step.
+A θ that leaves the valid region (refine.Parametrisation, Representation.plausible) or lets the
+overlap matrix's condition number grow beyond max(10 × its start, 1e9) scores worse than the start:
+refinement may not buy energy with near-linear dependence, where rounding is amplified.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import minimize
+
+from . import eigen
+from .basis import Basis
+from .errors import PreboError
+from .refine import Parametrisation
+
+
+class Joint:
+    """E(θ) and ∂E/∂θ of a whole basis; remembers the best basis seen."""
+
+    def __init__(self, state):
+        self.state = state
+        basis = state.basis
+        self.ps = [Parametrisation.of(basis.subset([i])) for i in range(len(basis))]
+        thetas = [p.theta() for p in self.ps]
+        self.cut = np.cumsum([0] + [len(t) for t in thetas])
+        self.theta0 = np.concatenate(thetas)
+        self.worse = state.energy + 1.0
+        self.max_condition = max(10 * state.eig.overlap_condition, 1e9)
+        self.best_E, self.best = state.energy, None
+
+    def basis(self, theta: np.ndarray) -> Basis:
+        fs = [p.function(theta[a:b]) for p, a, b in zip(self.ps, self.cut[:-1], self.cut[1:])]
+        first = fs[0]
+        extra = {name: np.concatenate([getattr(f, name) for f in fs]) for name in first.parameters}
+        return Basis(first.system, np.concatenate([f.A for f in fs]), np.concatenate([f.c_A for f in fs]),
+                     [f.channels[0] for f in fs], kind=first.kind, **extra)
+
+    def __call__(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
+        st, nb = self.state, len(self.ps)
+        fail = (self.worse, np.zeros_like(theta))
+        try:
+            basis = self.basis(theta)
+            parts = [st.rep.row_gradient(basis.subset([i]), *p.directions(theta[a:b]), basis)
+                     for i, (p, a, b) in enumerate(zip(self.ps, self.cut[:-1], self.cut[1:]))]
+        except PreboError:
+            return fail
+        M = {k: np.array([rows[k][0] for rows, _ in parts]) for k in ("S", "T_ti", "V")}
+        diag = np.array([d[0] for _, d in parts])
+        for k, col in (("S", 0), ("T_ti", 2), ("V", 3)):
+            M[k][np.diag_indices(nb)] = diag[:, col]
+            M[k] = 0.5 * (M[k] + M[k].T)  # i as bra and j as bra agree to rounding
+        S_diag = np.diag(M["S"])
+        if not all(st.rep.plausible({"S": M["S"][i:i + 1]}, parts[i][1][:1], S_diag)[0] for i in range(nb)):
+            return fail
+        try:
+            eig = eigen.solve(M["T_ti"] + M["V"], M["S"], st.threshold)
+        except PreboError:
+            return fail
+        if eig.kept < nb or eig.overlap_condition > self.max_condition:
+            return fail
+        E, c = float(eig.energies[0]), eig.vectors[:, 0]
+        grad = []
+        for i, (rows, d) in enumerate(parts):
+            dH, dS = rows["T_ti"][1:] + rows["V"][1:], rows["S"][1:]
+            off = (dH - E * dS) @ c - (dH[:, i] - E * dS[:, i]) * c[i]  # Σ_{j≠i}
+            grad.append(2.0 * c[i] * off + c[i] ** 2 * ((d[1:, 2] + d[1:, 3]) - E * d[1:, 0]))
+        if E < self.best_E:
+            self.best_E, self.best = E, basis
+        return E, np.concatenate(grad)
+
+
+def polish(state, iterations: int) -> bool:
+    """At most `iterations` L-BFGS iterations over all parameters; the state takes the best basis
+    seen (rebuilt from scratch, so it is a function of the basis alone). True if it improved."""
+    joint = Joint(state)
+    minimize(joint, joint.theta0, jac=True, method="L-BFGS-B",
+             options={"maxiter": iterations, "maxfun": 2 * iterations, "ftol": 1e-16, "gtol": 1e-12, "maxcor": 20})
+    if joint.best is None or not joint.best_E < state.energy - 1e-15 * abs(state.energy):
+        return False
+    state.replace_basis(joint.best)
+    return True
