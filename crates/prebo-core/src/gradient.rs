@@ -39,7 +39,7 @@ pub fn seed_matrix<const R: usize, const C: usize, const W: usize>(
 
 /// The value and derivatives of one element: `out[0]` the value, `out[1 + p]` its derivative along direction `p`.
 fn unpack<const W: usize>(e: &Element<Dual<W>>, p: usize, out: &mut [Element]) {
-    let parts = |x: &Dual<W>| (x.re, x.eps.clone().unwrap_generic(Const::<W>, U1));
+    let parts = |x: &Dual<W>| (x.re, x.eps.unwrap_generic(Const::<W>, U1));
     let (s, t, t_ti, v) = (parts(&e.s), parts(&e.t), parts(&e.t_ti), parts(&e.v));
     out[0] = Element { s: s.0, t: t.0, t_ti: t_ti.0, v: v.0 };
     for k in 0..p {
