@@ -1,8 +1,10 @@
-"""Convergence plots from run checkpoints: energy against basis size (one line per run).
+"""Convergence plots from run checkpoints: energy against basis size and against wall time
+(one line per run).
 
 The growth phase gives one point per basis size; refinement sweeps at the final size are
-drawn as a vertical run of points there. With a reference energy the error E - E_ref is
-drawn on a logarithmic axis.
+drawn as a vertical run of points there, and spread out in the wall-time panel (histories
+written before wall times were recorded leave that panel out). With a reference energy the
+error E - E_ref is drawn on a logarithmic axis.
 """
 from __future__ import annotations
 
@@ -29,20 +31,25 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None) 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    for folder in folders:
-        h = history(folder)
-        n = [row[0] for row in h]
+    runs = [(Path(folder).name, history(folder)) for folder in folders]
+    timed = all(len(row) > 3 for _, h in runs for row in h)
+    fig, axes = plt.subplots(1, 2 if timed else 1, figsize=(11.5 if timed else 6.4, 4.4), squeeze=False)
+    for name, h in runs:
         e = [row[1] - reference if reference is not None else row[1] for row in h]
-        ax.plot(n, e, ".-", ms=3, lw=1, label=Path(folder).name)
-    ax.set_xlabel("basis size")
-    if reference is not None:
-        ax.set_yscale("log")
-        ax.set_ylabel(f"E − E_ref  (E_ref = {reference} Eh)")
-    else:
-        ax.set_ylabel("E / Eh (translation-free)")
-    ax.grid(alpha=0.3)
-    ax.legend()
+        axes[0, 0].plot([row[0] for row in h], e, ".-", ms=3, lw=1, label=name)
+        if timed:
+            axes[0, 1].plot([row[3] / 60 for row in h], e, ".-", ms=3, lw=1, label=name)
+    axes[0, 0].set_xlabel("basis size")
+    if timed:
+        axes[0, 1].set_xlabel("wall time / min")
+    for ax in axes[0]:
+        if reference is not None:
+            ax.set_yscale("log")
+            ax.set_ylabel(f"E − E_ref  (E_ref = {reference} Eh)")
+        else:
+            ax.set_ylabel("E / Eh (translation-free)")
+        ax.grid(alpha=0.3)
+        ax.legend()
     fig.tight_layout()
     fig.savefig(png, dpi=130)
     plt.close(fig)
