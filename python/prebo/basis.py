@@ -108,6 +108,14 @@ class Basis:
         extra = {name: v[idx] for name, v in self.parameters.items()}
         return Basis(self.system, self.A[idx], self.c_A[idx], [self.channels[i] for i in idx], kind=self.kind, **extra)
 
+    @classmethod
+    def concat(cls, fs: list["Basis"]) -> "Basis":
+        """The functions of several bases (same system and kind), in order."""
+        first = fs[0]
+        extra = {name: np.concatenate([getattr(f, name) for f in fs]) for name in first.parameters}
+        return cls(first.system, np.concatenate([f.A for f in fs]), np.concatenate([f.c_A for f in fs]),
+                   [c for f in fs for c in f.channels], kind=first.kind, **extra)
+
     def append(self, f: "Basis") -> None:
         """Append the functions of `f` (same system and kind)."""
         self.A = np.ascontiguousarray(np.concatenate([self.A, f.A]))

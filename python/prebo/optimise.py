@@ -317,13 +317,6 @@ class State:
         self.solve()
 
 
-def _concat(fs: list[Basis]) -> Basis:
-    out = fs[0].subset(slice(0, 1))
-    for f in fs[1:]:
-        out.append(f)
-    return out
-
-
 @dataclass
 class Cursor:
     """The next unit of work: one competitive step ("grow"), function `index` of
@@ -392,7 +385,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 "rng": rng.bit_generator.state, "history": history, "elapsed": wall()})
 
     def draw(k) -> Basis:
-        return _concat([sampler.draw() for _ in range(k)])
+        return Basis.concat([sampler.draw() for _ in range(k)])
 
     with report:
         while cursor.phase != "done":

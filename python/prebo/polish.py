@@ -39,11 +39,7 @@ class Joint:
         self.best_E, self.best = state.energy, None
 
     def basis(self, theta: np.ndarray) -> Basis:
-        fs = [p.function(theta[a:b]) for p, a, b in zip(self.ps, self.cut[:-1], self.cut[1:])]
-        first = fs[0]
-        extra = {name: np.concatenate([getattr(f, name) for f in fs]) for name in first.parameters}
-        return Basis(first.system, np.concatenate([f.A for f in fs]), np.concatenate([f.c_A for f in fs]),
-                     [f.channels[0] for f in fs], kind=first.kind, **extra)
+        return Basis.concat([p.function(theta[a:b]) for p, a, b in zip(self.ps, self.cut[:-1], self.cut[1:])])
 
     def __call__(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
         st, nb = self.state, len(self.ps)
@@ -55,12 +51,11 @@ class Joint:
         except PreboError:
             return fail
         M = {k: np.array([rows[k][0] for rows, _ in parts]) for k in ("S", "T_ti", "V")}
-        diag = np.array([d[0] for _, d in parts])
+        diag = np.array([d[0] for _, d in parts])  # (nb, 4): S, T, T_ti, V
         for k, col in (("S", 0), ("T_ti", 2), ("V", 3)):
             M[k][np.diag_indices(nb)] = diag[:, col]
             M[k] = 0.5 * (M[k] + M[k].T)  # i as bra and j as bra agree to rounding
-        S_diag = np.diag(M["S"])
-        if not all(st.rep.plausible({"S": M["S"][i:i + 1]}, parts[i][1][:1], S_diag)[0] for i in range(nb)):
+        if not st.rep.plausible({"S": M["S"]}, diag, np.diag(M["S"])).all():
             return fail
         try:
             eig = eigen.solve(M["T_ti"] + M["V"], M["S"], st.threshold)

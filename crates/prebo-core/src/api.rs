@@ -241,9 +241,7 @@ fn gvr_chunk<const D: usize, const W: usize>(
     b: &Images<Gvr<D>>,
 ) -> Result<(Vec<Vec<Element>>, Vec<Element>)> {
     let trial = Gvr::<D, Dual<W>>::new(gradient::seed_matrix(&f.a, da), gradient::seed_matrix(&f.u, du), f.k, f.c_a, go, 0)?;
-    let t = Images::new(vec![trial], sym, go)?;
-    let bd = b.map(|g| g.cast::<Dual<W>>());
-    Ok(gradient::chunk(&t, &bd, da.len(), |x, y| gvr::element(x, y, go)))
+    gradient::chunk(trial, sym, go, b, Gvr::cast, da.len(), |x, y| gvr::element(x, y, go))
 }
 
 fn gvr_row_gradient_d<const D: usize>(
@@ -338,9 +336,7 @@ fn fecg_chunk<const D: usize, const W: usize>(
     b: &Images<Fecg<D>>,
 ) -> Result<(Vec<Vec<Element>>, Vec<Element>)> {
     let trial = Fecg::<D, Dual<W>>::new(gradient::seed_matrix(&f.a, da), gradient::seed_matrix(&f.s, ds), f.c_a, 0)?;
-    let t = Images::new(vec![trial], sym, &())?;
-    let bd = b.map(|g| g.cast::<Dual<W>>());
-    Ok(gradient::chunk(&t, &bd, da.len(), |x, y| fecg::element(x, y, ops)))
+    gradient::chunk(trial, sym, &(), b, Fecg::cast, da.len(), |x, y| fecg::element(x, y, ops))
 }
 
 fn fecg_row_gradient_d<const D: usize>(

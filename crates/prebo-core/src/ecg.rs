@@ -51,6 +51,12 @@ impl<const D: usize> Gaussian<D> {
     }
 }
 
+/// `ln|B|` from a Cholesky factor `B = L L^T`: `2 Σ ln L_kk`.
+#[inline]
+pub fn log_det_cholesky<T: Real, const D: usize>(chol: &Cholesky<T, nalgebra::Const<D>>) -> T {
+    chol.l_dirty().diagonal().iter().fold(T::zero(), |acc, d| acc + d.ln()) * 2.0
+}
+
 /// `ln|A|` from the Cholesky factor, `None` if `A` is not positive definite.
 pub fn log_det_pd<T: Real, const D: usize>(a: &SMatrix<T, D, D>) -> Option<T> {
     let chol = Cholesky::new(*a)?;

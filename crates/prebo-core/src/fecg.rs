@@ -158,7 +158,7 @@ fn row<const D: usize>(m: &Centres<D>, i: usize) -> [f64; 3] {
 fn pair<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>) -> Option<(T, SMatrix<T, D, D>, Centres<D, T>)> {
     let b = bra.a + ket.a;
     let chol = Cholesky::new(b)?;
-    let log_det = chol.l_dirty().diagonal().iter().fold(T::zero(), |acc, d| acc + d.ln()) * 2.0;
+    let log_det = crate::ecg::log_det_cholesky(&chol);
     let v = bra.a_s + ket.a_s;
     let rbar = chol.solve(&v);
     let delta = bra.s_a_s + ket.s_a_s - v.component_mul(&rbar).sum();

@@ -12,8 +12,9 @@ use num_dual::{Derivative, DualSVec64};
 use rayon::prelude::*;
 
 use crate::build::Matrices;
-use crate::ecg::Element;
-use crate::images::Images;
+use crate::ecg::{Element, Mat};
+use crate::error::Result;
+use crate::images::{Images, Transform};
 
 /// Most directions carried by one pass (a longer direction list is chunked).
 pub const MAX_LANES: usize = 16;
@@ -47,14 +48,23 @@ fn unpack<const W: usize>(e: &Element<Dual<W>>, p: usize, out: &mut [Element]) {
     }
 }
 
-/// One chunk: the trial (with its images, seeded with ≤ W directions) against the basis.
-/// Returns `(row, diag)` with `1 + p` entries per element (`p` directions in this chunk).
-pub fn chunk<G: Sync, const W: usize>(
-    trial: &Images<G>,
-    basis: &Images<G>,
+/// One chunk: the trial (seeded with ≤ W directions) with its images under `sym`, against the
+/// basis cast to dual numbers of zero derivative. Returns `(row, diag)` with `1 + p` entries per
+/// element (`p` directions in this chunk).
+pub fn chunk<F, G, Ctx, const D: usize, const W: usize>(
+    trial: G,
+    sym: &[(Mat<D>, f64)],
+    ctx: &Ctx,
+    basis: &Images<F>,
+    cast: impl Fn(&F) -> G,
     p: usize,
     el: impl Fn(&G, &G) -> Element<Dual<W>> + Sync,
-) -> (Vec<Vec<Element>>, Vec<Element>) {
+) -> Result<(Vec<Vec<Element>>, Vec<Element>)>
+where
+    G: Transform<D, Ctx> + Sync,
+{
+    let trial = Images::new(vec![trial], sym, ctx)?;
+    let basis = basis.map(cast);
     let bra = &trial.functions[0];
     let row = (0..basis.len())
         .into_par_iter()
@@ -66,7 +76,7 @@ pub fn chunk<G: Sync, const W: usize>(
         .collect();
     let mut diag = vec![Element::default(); 1 + p];
     unpack(&trial.element(bra, 0, &el), p, &mut diag);
-    (row, diag)
+    Ok((row, diag))
 }
 
 /// Runs `pass(first, count)` over chunks of at most `MAX_LANES` directions and gathers
@@ -74,8 +84,8 @@ pub fn chunk<G: Sync, const W: usize>(
 pub fn gather(
     nb: usize,
     n_dir: usize,
-    mut pass: impl FnMut(usize, usize) -> crate::error::Result<(Vec<Vec<Element>>, Vec<Element>)>,
-) -> crate::error::Result<(Matrices, Vec<Element>)> {
+    mut pass: impl FnMut(usize, usize) -> Result<(Vec<Vec<Element>>, Vec<Element>)>,
+) -> Result<(Matrices, Vec<Element>)> {
     let rows = 1 + n_dir;
     let z = vec![0.0; rows * nb];
     let mut m = Matrices { rows, cols: nb, s: z.clone(), t: z.clone(), t_ti: z.clone(), v: z };

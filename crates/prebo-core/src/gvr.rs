@@ -50,7 +50,7 @@ use std::f64::consts::PI;
 
 use nalgebra::{Cholesky, SMatrix, SVector};
 
-use crate::ecg::{re, Element, Mat, Operators, Real};
+use crate::ecg::{log_det_cholesky, re, Element, Mat, Operators, Real};
 use crate::error::{CoreError, Result};
 use crate::images::Transform;
 
@@ -99,12 +99,6 @@ impl<const D: usize> GvrOps<D> {
     }
 }
 
-/// `ln |B|` from a Cholesky factor.
-#[inline]
-fn log_det<T: Real, const D: usize>(chol: &Cholesky<T, nalgebra::Const<D>>) -> T {
-    chol.l_dirty().diagonal().iter().fold(T::zero(), |acc, d| acc + d.ln()) * 2.0
-}
-
 impl<const D: usize, T: Real> Gvr<D, T> {
     /// Checks `A` (positive definite), `u` (non-zero) and `K` (within the prepared range).
     pub fn new(a: SMatrix<T, D, D>, u: SVector<T, D>, k: u32, c_a: f64, go: &GvrOps<D>, index: usize) -> Result<Self> {
@@ -117,7 +111,7 @@ impl<const D: usize, T: Real> Gvr<D, T> {
         if !(x > T::zero()) || !x.is_finite() {
             return Err(CoreError::Unsupported(format!("function {index}: global vector u is zero")));
         }
-        let log_det_2a = log_det(&chol) + (D as f64) * 2f64.ln();
+        let log_det_2a = log_det_cholesky(&chol) + (D as f64) * 2f64.ln();
         let n = go.n_ang as f64;
         let (g, _, _, _) = series::<f64>(k, k, go.n_ang, 1.0);
         let log_s0 = (log_det_2a - D as f64 * PI.ln()) * -1.5;
@@ -222,7 +216,7 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     let Some(chol) = Cholesky::new(b_mat) else {
         return Element::nan();
     };
-    let log_det = log_det(&chol);
+    let log_det = log_det_cholesky(&chol);
     let binv = chol.inverse();
     let gi = binv * bra.u;
     let gj = binv * ket.u;
