@@ -8,7 +8,7 @@ from prebo.errors import IllConditionedError, InputError
 from prebo.integrals import laboratory
 from prebo.optimise import Optimiser, Sampler, State
 from prebo.polish import Joint, polish
-from prebo.refine import Objective, Parametrisation, refine_function
+from prebo.refine import Objective, Parametrisation, refine_function, regenerate_function
 from prebo.system import State as QState
 from prebo.system import System
 
@@ -79,12 +79,14 @@ def test_energy_gradient_matches_finite_differences(case):
     assert np.max(np.abs(g - fd)) < 1e-7 * np.max(np.abs(g)), (g, fd)
 
 
-def test_directions_beyond_one_pass_are_chunked():
-    """20 directions (two passes of the 16-lane kernel) equal the linear combinations of the θ derivatives."""
+@pytest.mark.parametrize("count", [5, 7, 11, 20])
+def test_any_number_of_directions_gives_the_same_derivatives(count):
+    """count directions — lane widths 5, 8 and 12, and 20 = two passes (16 + 4) — equal the linear
+    combinations of the θ derivatives computed at the function's own width (9)."""
     system, basis, p, theta = setup("gvr-H2")
     rep = laboratory(system)
     dA, du = p.directions(theta)
-    R = np.random.default_rng(0).standard_normal((20, len(theta)))
+    R = np.random.default_rng(count).standard_normal((count, len(theta)))
     f = p.function(theta)
     rows, diag = rep.row_gradient(f, dA, du, basis)
     rows_r, diag_r = rep.row_gradient(f, np.einsum("rp,pij->rij", R, dA), R @ du, basis)
@@ -104,6 +106,37 @@ def test_gradient_refinement_lowers_the_energy_and_keeps_the_matrices_exact():
     for k in fresh:
         assert np.array_equal(fresh[k], st.m[k]), k
     assert st.energy == eigen.solve(fresh["T_ti"] + fresh["V"], fresh["S"], 1e-13).energies[0]
+
+
+def test_regeneration_keeps_the_better_of_refined_newcomer_and_incumbent():
+    """A replacement that refinement cannot bring below the incumbent is undone, and the step is
+    then exactly a refinement of the incumbent; a good one is kept. Energies never rise and the
+    patched matrices equal a rebuild."""
+    system, basis, _, _ = setup("gvr-H2+", nb=15)
+    rep = laboratory(system)
+    i = 4
+    hopeless = basis.subset([i])
+    hopeless.A *= 1e-4  # a function ~100 times too diffuse
+    regenerated, refined = State(basis.subset(range(15)), rep, 1e-13), State(basis.subset(range(15)), rep, 1e-13)
+    before = regenerated.energy
+    _, rows, diag = regenerated.candidates(hopeless, exclude=i)
+    regenerate_function(regenerated, i, hopeless, {k: v[0] for k, v in rows.items()}, diag[0], 5)
+    refine_function(refined, i, 5)
+    assert regenerated.energy == refined.energy <= before
+    assert np.array_equal(regenerated.basis.A, refined.basis.A) and np.array_equal(regenerated.basis.u, refined.basis.u)
+
+    good = basis.subset([i])  # the other way round: the incumbent is hopeless, the newcomer good
+    worse = basis.subset(range(15))
+    worse.replace(i, hopeless)
+    regenerated, refined = State(worse.subset(range(15)), rep, 1e-13), State(worse.subset(range(15)), rep, 1e-13)
+    _, rows, diag = regenerated.candidates(good, exclude=i)
+    regenerate_function(regenerated, i, good, {k: v[0] for k, v in rows.items()}, diag[0], 5)
+    refine_function(refined, i, 5)
+    assert regenerated.energy < refined.energy
+    assert regenerated.basis.K[i] == good.K[0]
+    fresh = rep.matrices(regenerated.basis)
+    for k in fresh:
+        assert np.array_equal(fresh[k], regenerated.m[k]), k
 
 
 def test_unknown_refine_method_is_refused():

@@ -27,6 +27,7 @@ refine = 1
 refine_evaluations = 30
 polish = 2
 polish_iterations = 5
+cycles = 2
 seed = 7
 channels = "all"
 """
@@ -85,6 +86,16 @@ def test_cursor_schedule():
     assert seen == [("grow", 0, 0), ("grow", 0, 0), ("sweep", 0, 0), ("sweep", 0, 1),
                     ("refine", 0, 0), ("refine", 0, 1), ("refine", 1, 0), ("refine", 1, 1),
                     ("polish", 0, 0), ("polish", 1, 0)]
+
+
+def test_cursor_repeats_the_block_after_growth_in_cycles():
+    opts = Optimiser(size=1, sweeps=1, refine=0, polish=1, cycles=3)
+    c, seen = Cursor().advance(1, opts), []
+    while c.phase != "done":
+        seen.append((c.phase, c.sweep, c.index, c.cycle))
+        c = c.advance(1, opts)
+    assert seen == [(phase, 0, 0, cycle) for cycle in range(3) for phase in ("sweep", "polish")]
+    assert Cursor(**{"phase": "polish", "sweep": 0, "index": 0}).cycle == 0  # checkpoints before cycles
 
 
 def test_refinement_and_learning_lower_the_energy():

@@ -45,7 +45,7 @@ def from_dict(d: dict) -> Job:
     system_t = _table(d, "system", {"particles"})
     state_t = _table(d, "state", {"N", "parity", "spin"})
     basis_t = _table(d, "basis", {"type", "size", "c_A", "K_max"})
-    opt_t = _table(d, "optimiser", {"trials", "sweeps", "refine", "refine_evaluations", "refine_method", "polish", "polish_iterations", "seed", "channels",
+    opt_t = _table(d, "optimiser", {"trials", "sweeps", "refine", "refine_evaluations", "refine_method", "polish", "polish_iterations", "cycles", "seed", "channels",
                                     "length_range", "learned", "learn_after", "min_norm", "max_overlap"})
     if "particles" not in system_t:
         raise InputError("[system] needs 'particles'")

@@ -6,8 +6,12 @@ the Rust core (O(N_b) integrals), the new lowest eigenvalue from the secular
 equation (O(N_b^2), eigen.lowest_with_added_many), keep the best and, with `refine`,
 refine it (refine.py: L-BFGS on exact gradients, or Powell). Then `sweeps` random
 replacement sweeps (each function in turn competes with `trials` random replacements in
-the basis without it), `refine` refinement sweeps, and `polish` steps of
-`polish_iterations` joint L-BFGS iterations over all parameters (polish.py). After the first functions of a channel, a share `learned` of the trials
+the basis without it; with `refine`, the winner is refined and kept only if it then beats
+the incumbent, which is refined otherwise: refine.regenerate_function), `refine`
+refinement sweeps and `polish` steps of `polish_iterations` joint L-BFGS iterations over
+all parameters (polish.py); this sweep-refine-polish block is run `cycles` times
+(replacements reach new basins, joint refinement converges within one). After the first
+functions of a channel, a share `learned` of the trials
 is drawn from the distribution of the parameters selected so far in that channel.
 
 Functions are drawn in a coordinate set ("channel") or in pair form:
@@ -34,7 +38,7 @@ from .basis import Basis
 from .errors import IllConditionedError, InputError
 from .integrals import laboratory
 from .polish import polish
-from .refine import METHODS, Parametrisation, refine_function
+from .refine import METHODS, Parametrisation, refine_function, regenerate_function
 from .system import System
 
 
@@ -56,6 +60,7 @@ class Optimiser:
     refine_method: str = "gradient"
     polish: int = 0
     polish_iterations: int = 20
+    cycles: int = 1
     learned: float = 0.5
     learn_after: int = 5
     min_norm: float = 1e-8
@@ -94,6 +99,8 @@ class Optimiser:
             raise InputError(f"optimiser.refine must be a non-negative integer, got {self.refine!r}")
         if not (isinstance(self.polish, int) and self.polish >= 0):
             raise InputError(f"optimiser.polish must be a non-negative integer, got {self.polish!r}")
+        if not (isinstance(self.cycles, int) and self.cycles >= 1):
+            raise InputError(f"optimiser.cycles must be a positive integer, got {self.cycles!r}")
         if not (isinstance(self.polish_iterations, int) and self.polish_iterations >= 1):
             raise InputError(f"optimiser.polish_iterations must be a positive integer, got {self.polish_iterations!r}")
         if self.refine_method not in METHODS:
@@ -321,29 +328,32 @@ class State:
 class Cursor:
     """The next unit of work: one competitive step ("grow"), function `index` of
     replacement sweep / refinement sweep `sweep` ("sweep", "refine"), joint-refinement step
-    `sweep` ("polish"), or "done"."""
+    `sweep` ("polish") of the sweep-refine-polish block `cycle`, or "done"."""
 
     phase: str = "grow"
     sweep: int = 0
     index: int = 0
+    cycle: int = 0
 
     def advance(self, nb: int, opts: Optimiser) -> "Cursor":
         if self.phase == "grow":
             if nb < opts.size:
                 return self
             return Cursor("sweep").settle(opts)
-        nxt = Cursor(self.phase, self.sweep, self.index + 1)
+        nxt = Cursor(self.phase, self.sweep, self.index + 1, self.cycle)
         if nxt.index >= nb or self.phase == "polish":
-            nxt = Cursor(self.phase, self.sweep + 1, 0)
+            nxt = Cursor(self.phase, self.sweep + 1, 0, self.cycle)
         return nxt.settle(opts)
 
     def settle(self, opts: Optimiser) -> "Cursor":
-        """Skip phases whose sweeps are used up."""
+        """Skip phases whose sweeps are used up; after the last polish step, the next cycle."""
         if self.phase == "sweep" and self.sweep >= opts.sweeps:
-            return Cursor("refine").settle(opts)
+            return Cursor("refine", cycle=self.cycle).settle(opts)
         if self.phase == "refine" and self.sweep >= opts.refine:
-            return Cursor("polish").settle(opts)
+            return Cursor("polish", cycle=self.cycle).settle(opts)
         if self.phase == "polish" and self.sweep >= opts.polish:
+            if self.cycle + 1 < opts.cycles:
+                return Cursor("sweep", cycle=self.cycle + 1).settle(opts)
             return Cursor("done")
         return self
 
@@ -405,8 +415,11 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 energies, rows, diag = st.candidates(trials, exclude=i)
                 report.trials(len(trials))
                 best = int(np.argmin(energies))
-                if np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
-                    st.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
+                winner = (trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
+                if opts.refine and np.isfinite(energies[best]):
+                    regenerate_function(st, i, *winner, opts.refine_evaluations, opts.refine_method)
+                elif np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
+                    st.put(i, *winner)
             elif cursor.phase == "refine":
                 report.trials(1)
                 refine_function(st, cursor.index, opts.refine_evaluations, opts.refine_method)
@@ -474,8 +487,8 @@ class Reporter:
         if cursor.phase == "grow":
             self.progress.update(self.task, completed=len(st.basis), info=info)
         elif cursor.phase == "polish":
-            self.progress.update(self.task, description="polish", completed=cursor.sweep + 1, total=self.opts.polish,
+            self.progress.update(self.task, description=f"polish (cycle {cursor.cycle + 1})", completed=cursor.sweep + 1, total=self.opts.polish,
                                  info=info)
         else:
-            self.progress.update(self.task, description=f"{cursor.phase} {cursor.sweep + 1}",
+            self.progress.update(self.task, description=f"{cursor.phase} {cursor.sweep + 1} (cycle {cursor.cycle + 1})",
                                  completed=cursor.index + 1, total=len(st.basis), info=info)

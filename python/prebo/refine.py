@@ -198,3 +198,20 @@ def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gr
     rows, diag = state.rep.rows(obj.best_f, state.basis, i)  # oriented: patched matrices equal a rebuild
     state.put(i, obj.best_f, {k: v[0] for k, v in rows.items()}, diag[0])
     return True
+
+
+def regenerate_function(state, i: int, f: Basis, row: dict, d: np.ndarray, max_evaluations: int = 200,
+                        method: str = "gradient") -> bool:
+    """A replacement sweep's step with refinement: `f` (the competitive winner for position i, with
+    its oriented row and diagonal from State.candidates) takes the place of function i and is
+    refined; unless that lowers the energy, function i returns and is refined instead. A refined
+    newcomer can leave the basin the incumbent's refinement is confined to. True if it improved."""
+    before, old = state.energy, state.basis.subset([i])
+    state.put(i, f, row, d)
+    refine_function(state, i, max_evaluations, method)
+    if state.energy < before:
+        return True
+    rows, diag = state.rep.rows(old, state.basis, i)
+    state.put(i, old, {k: v[0] for k, v in rows.items()}, diag[0])
+    return refine_function(state, i, max_evaluations, method)
+

@@ -221,12 +221,18 @@ impl Directions<'_> {
     }
 }
 
-/// Calls `$f::<W>` with the narrowest lane count W ∈ {4, 8, 16} that holds `$count` directions.
+/// Calls `$f::<W>` with the narrowest lane count W that holds `$count` directions. The
+/// widths match the parameter counts of one function (GVR H2+ 5, pECG H2 6, GVR H2 and FECG
+/// of 3 particles 9, FECG of 4 particles 15): a dual element costs about W times an f64 one.
 macro_rules! lanes {
     ($count:expr, $f:ident ( $($arg:expr),* )) => {
         match $count {
             0..=4 => $f::<D, 4>($($arg),*),
-            5..=8 => $f::<D, 8>($($arg),*),
+            5 => $f::<D, 5>($($arg),*),
+            6 => $f::<D, 6>($($arg),*),
+            7..=8 => $f::<D, 8>($($arg),*),
+            9 => $f::<D, 9>($($arg),*),
+            10..=12 => $f::<D, 12>($($arg),*),
             _ => $f::<D, 16>($($arg),*),
         }
     };

@@ -1,0 +1,71 @@
+"""Late-stage optimisation moves, head to head on one optimised basis, for a fixed wall time each.
+
+- refine: refinement sweeps (each function in turn, L-BFGS on exact gradients, others fixed);
+- regenerate: replacement sweeps with refinement (refine.regenerate_function: the competitive
+  winner among `trials` random functions takes the function's place and is refined, and stays
+  only if it then beats the refined incumbent);
+- polish: joint L-BFGS steps of 50 iterations over all parameters (polish.py).
+
+Each method starts from the same basis and runs whole steps until `--seconds` have passed.
+
+    git show 2f2c3bb:examples/bases/h2plus-gvr/basis.json > /tmp/h2plus-2f2c3bb.json
+    python benchmarks/sweep_methods.py /tmp/h2plus-2f2c3bb.json --seconds 150
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+
+from prebo.basis import Basis
+from prebo.integrals import laboratory
+from prebo.optimise import Optimiser, Sampler, State
+from prebo.polish import polish
+from prebo.refine import refine_function, regenerate_function
+
+
+def run(basis: Basis, opts: Optimiser, method: str, seconds: float) -> tuple[float, float, float, int]:
+    st = State(basis.subset(np.arange(len(basis))), laboratory(basis.system), opts.threshold, opts.min_norm,
+               opts.max_overlap)
+    sampler = Sampler(basis.system, opts, np.random.default_rng(opts.seed))
+    sampler.learn(st.basis)
+    e0, t0, steps = st.energy, time.perf_counter(), 0
+    while time.perf_counter() - t0 < seconds:
+        i = steps % len(basis)
+        if method == "polish":
+            polish(st, 50)
+        elif method == "refine":
+            refine_function(st, i, opts.refine_evaluations)
+        else:
+            trials = Basis.concat([sampler.draw() for _ in range(opts.trials)])
+            energies, rows, diag = st.candidates(trials, exclude=i)
+            k = int(np.argmin(energies))
+            if np.isfinite(energies[k]):
+                regenerate_function(st, i, trials.subset([k]), {n: v[k] for n, v in rows.items()}, diag[k],
+                                    opts.refine_evaluations)
+                sampler.learn(st.basis)
+        steps += 1
+    return e0, st.energy, time.perf_counter() - t0, steps
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("basis", help="a run's basis.json (its [optimiser] settings are used)")
+    ap.add_argument("--seconds", type=float, default=240.0)
+    ap.add_argument("--methods", default="refine,regenerate,polish")
+    args = ap.parse_args()
+    d = json.loads(open(args.basis).read())
+    basis, opts = Basis.from_dict(d, args.basis), Optimiser.from_dict(d["optimiser"])
+    print(f"{args.basis}: {len(basis)} functions, {args.seconds:.0f} s per method")
+    print("| method | steps | E before | E after | gain | wall time (s) | gain per s |")
+    print("|---|---|---|---|---|---|---|")
+    for method in args.methods.split(","):
+        e0, e1, t, steps = run(basis, opts, method, args.seconds)
+        print(f"| {method} | {steps} | {e0:.12f} | {e1:.12f} | {e0 - e1:.3e} | {t:.1f} | {(e0 - e1) / t:.2e} |",
+              flush=True)
+
+
+if __name__ == "__main__":
+    main()
