@@ -70,6 +70,8 @@ def assert_clean_error(r, *words):
     ('["alpha", "e", "e", "e"]', "[state]\nspin = { e = 1 }\n", ["cannot couple to total spin 1"]),
     ('["p", "e", "e"]', "[state]\nspin = { e = 0.3 }\n", ["cannot couple"]),
     ('["p", "e"]', "[state]\nN = 1\n", ["N = 0"]),
+    ('["p", "e"]', "[optimiser]\ncycle = 2\n", ["unknown keys ['cycle']", "'cycles'"]),
+    ('["p", "e"]', "[optimiser]\ncycles = 0\n", ["cycles must be a positive integer"]),
 ])
 def test_bad_input_gives_a_clear_error(tmp_path, particles, state, words):
     f = tmp_path / "bad.toml"

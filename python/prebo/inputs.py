@@ -8,7 +8,7 @@
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 from .basis import read_text
@@ -17,6 +17,8 @@ from .optimise import Optimiser
 from .system import State, System
 
 BASIS_TYPES = ("pecg", "ecg-gvr", "fecg")
+#: every Optimiser setting but those [basis] gives
+OPTIMISER_KEYS = {f.name for f in fields(Optimiser)} - {"size", "c_A", "kind", "K_max"}
 
 
 @dataclass
@@ -45,8 +47,7 @@ def from_dict(d: dict) -> Job:
     system_t = _table(d, "system", {"particles"})
     state_t = _table(d, "state", {"N", "parity", "spin"})
     basis_t = _table(d, "basis", {"type", "size", "c_A", "K_max"})
-    opt_t = _table(d, "optimiser", {"trials", "sweeps", "refine", "refine_evaluations", "refine_method", "polish", "polish_iterations", "cycles", "seed", "channels",
-                                    "length_range", "learned", "learn_after", "min_norm", "max_overlap"})
+    opt_t = _table(d, "optimiser", OPTIMISER_KEYS)
     if "particles" not in system_t:
         raise InputError("[system] needs 'particles'")
     system = System(system_t["particles"], State(**state_t))
