@@ -412,12 +412,13 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
             elif cursor.phase == "sweep":
                 i = cursor.index
                 trials = draw(opts.trials)
-                energies, rows, diag = st.candidates(trials, exclude=i)
+                rest = st.without(i)
+                energies, rows, diag = st.candidates(trials, exclude=i, eig=rest)
                 report.trials(len(trials))
                 best = int(np.argmin(energies))
                 winner = (trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
                 if opts.refine and np.isfinite(energies[best]):
-                    regenerate_function(st, i, *winner, opts.refine_evaluations, opts.refine_method)
+                    regenerate_function(st, i, *winner, opts.refine_evaluations, opts.refine_method, rest)
                 elif np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
                     st.put(i, *winner)
             elif cursor.phase == "refine":

@@ -129,11 +129,11 @@ class Objective:
     leaves the valid region (an ill-conditioned 𝒜, elements failing `Representation.plausible`),
     or makes the function linearly dependent on the others, scores worse than the current energy (a finite value keeps the line searches sane)."""
 
-    def __init__(self, state, i: int):
+    def __init__(self, state, i: int, rest=None):
         self.state, self.i = state, i
         basis = state.basis
         self.keep = np.arange(len(basis)) != i
-        sub = state.without(i)
+        sub = state.without(i) if rest is None else rest
         self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
         self.rest = basis.subset(np.flatnonzero(self.keep))
         self.S_rest = np.diag(state.m["S"])[self.keep]
@@ -181,10 +181,11 @@ class Objective:
         return e, g
 
 
-def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gradient") -> bool:
+def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gradient", rest=None) -> bool:
     """Minimise the energy over the parameters of function i — Powell, or L-BFGS with exact
-    gradients — with at most `max_evaluations` energies; True if it improved."""
-    obj = Objective(state, i)
+    gradients — with at most `max_evaluations` energies; True if it improved. `rest`: the
+    eigen-solution of the basis without i (State.without), if already at hand."""
+    obj = Objective(state, i, rest)
     theta0 = obj.p.theta()
     if method == "gradient":
         minimize(obj.energy_and_gradient, theta0, jac=True, method="L-BFGS-B",
@@ -201,17 +202,19 @@ def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gr
 
 
 def regenerate_function(state, i: int, f: Basis, row: dict, d: np.ndarray, max_evaluations: int = 200,
-                        method: str = "gradient") -> bool:
+                        method: str = "gradient", rest=None) -> bool:
     """A replacement sweep's step with refinement: `f` (the competitive winner for position i, with
     its oriented row and diagonal from State.candidates) takes the place of function i and is
     refined; unless that lowers the energy, function i returns and is refined instead. A refined
-    newcomer can leave the basin the incumbent's refinement is confined to. True if it improved."""
+    newcomer can leave the basin the incumbent's refinement is confined to. True if it improved.
+    Both refinements share `rest`, the eigen-solution of the basis without i (State.without)."""
     before, old = state.energy, state.basis.subset([i])
+    rest = state.without(i) if rest is None else rest
     state.put(i, f, row, d)
-    refine_function(state, i, max_evaluations, method)
+    refine_function(state, i, max_evaluations, method, rest)
     if state.energy < before:
         return True
     rows, diag = state.rep.rows(old, state.basis, i)
     state.put(i, old, {k: v[0] for k, v in rows.items()}, diag[0])
-    return refine_function(state, i, max_evaluations, method)
+    return refine_function(state, i, max_evaluations, method, rest)
 
