@@ -26,14 +26,14 @@ from prebo.polish import polish
 from prebo.refine import refine_function, regenerate_function
 
 
-def run(basis: Basis, opts: Optimiser, method: str, seconds: float) -> tuple[float, float, float, int]:
+def run(basis: Basis, opts: Optimiser, method: str, seconds: float, start: int = 0) -> tuple[float, float, float, int]:
     st = State(basis.subset(np.arange(len(basis))), laboratory(basis.system), opts.threshold, opts.min_norm,
                opts.max_overlap)
     sampler = Sampler(basis.system, opts, np.random.default_rng(opts.seed))
     sampler.learn(st.basis)
     e0, t0, steps = st.energy, time.perf_counter(), 0
     while time.perf_counter() - t0 < seconds:
-        i = steps % len(basis)
+        i = (start + steps) % len(basis)
         if method == "polish":
             polish(st, 50)
         elif method == "refine":
@@ -56,16 +56,22 @@ def main():
     ap.add_argument("basis", help="a run's basis.json (its [optimiser] settings are used)")
     ap.add_argument("--seconds", type=float, default=240.0)
     ap.add_argument("--methods", default="refine,regenerate,polish")
+    ap.add_argument("--evaluations", default=None,
+                    help="comma-separated refine_evaluations to try for refine and regenerate (default: the run's)")
+    ap.add_argument("--start", type=int, default=0, help="function the sweeps start at")
     args = ap.parse_args()
     d = json.loads(open(args.basis).read())
     basis, opts = Basis.from_dict(d, args.basis), Optimiser.from_dict(d["optimiser"])
     print(f"{args.basis}: {len(basis)} functions, {args.seconds:.0f} s per method")
-    print("| method | steps | E before | E after | gain | wall time (s) | gain per s |")
-    print("|---|---|---|---|---|---|---|")
+    evaluations = [int(v) for v in args.evaluations.split(",")] if args.evaluations else [opts.refine_evaluations]
+    print("| method | evaluations | steps | E before | E after | gain | wall time (s) | gain per s |")
+    print("|---|---|---|---|---|---|---|---|")
     for method in args.methods.split(","):
-        e0, e1, t, steps = run(basis, opts, method, args.seconds)
-        print(f"| {method} | {steps} | {e0:.12f} | {e1:.12f} | {e0 - e1:.3e} | {t:.1f} | {(e0 - e1) / t:.2e} |",
-              flush=True)
+        for n in evaluations if method != "polish" else [None]:
+            o = opts if n is None else Optimiser.from_dict({**opts.to_dict(), "refine_evaluations": n})
+            e0, e1, t, steps = run(basis, o, method, args.seconds, args.start)
+            print(f"| {method} | {n or '—'} | {steps} | {e0:.12f} | {e1:.12f} | {e0 - e1:.3e} | {t:.1f} "
+                  f"| {(e0 - e1) / t:.2e} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -44,8 +44,9 @@
 //!     γ = (B^{-1}u)·w / √(2c),
 //! ```
 //!
-//! a polynomial of degree 2(K_I+K_J+N) in τ, integrated exactly by Gauss–Legendre with
-//! K_I+K_J+N+1 nodes.
+//! an even polynomial of degree 2(K_I+K_J+N) in τ, integrated exactly by the ⌊(K_I+K_J+N)/2⌋+1
+//! positive nodes of the Gauss–Legendre rule on [−1, 1] with twice as many nodes (exact to degree
+//! 4⌊(K_I+K_J+N)/2⌋+3; for an even integrand ∫_0^1 = ½∫_{−1}^1).
 use std::f64::consts::PI;
 
 use nalgebra::{Cholesky, SMatrix, SVector};
@@ -73,29 +74,29 @@ pub struct Gvr<const D: usize, T: Real = f64> {
 pub struct GvrOps<const D: usize> {
     pub ops: Operators<D>,
     pub n_ang: u32,
-    /// `legendre[n]` = nodes and weights of the n-point rule on [0, 1]
+    /// `legendre[d]` = the rule for the Coulomb integrand of K_I + K_J + N = d (`even_rule`)
     legendre: Vec<&'static [(f64, f64)]>,
 }
 
-/// Gauss–Legendre rules computed once per process (`legendre_rule`).
+/// Even Gauss–Legendre rules computed once per process (`legendre_rule`).
 static RULES: [std::sync::OnceLock<Vec<(f64, f64)>>; 512] = [const { std::sync::OnceLock::new() }; 512];
 
-/// The n-point rule on [0, 1], computed on first use (n < 512, i.e. K up to ~250).
-fn legendre_rule(n: usize) -> &'static [(f64, f64)] {
-    RULES[n].get_or_init(|| gauss_legendre_01(n))
+/// `even_rule(m)`, computed on first use (m < 512, i.e. K up to ~500).
+fn legendre_rule(m: usize) -> &'static [(f64, f64)] {
+    RULES[m].get_or_init(|| even_rule(m))
 }
 
 impl<const D: usize> GvrOps<D> {
     pub fn new(ops: Operators<D>, n_ang: u32, k_max: u32) -> Result<Self> {
-        let n_max = (2 * k_max + n_ang + 1) as usize;
-        if n_max >= RULES.len() {
-            return Err(CoreError::Unsupported(format!("2 K_max + N = {} (at most {})", n_max - 1, RULES.len() - 2)));
+        let d_max = (2 * k_max + n_ang) as usize;
+        if d_max / 2 + 1 >= RULES.len() {
+            return Err(CoreError::Unsupported(format!("2 K_max + N = {d_max} (at most {})", 2 * RULES.len() - 3)));
         }
-        Ok(Self { ops, n_ang, legendre: (0..=n_max).map(legendre_rule).collect() })
+        Ok(Self { ops, n_ang, legendre: (0..=d_max).map(|d| legendre_rule(d / 2 + 1)).collect() })
     }
 
     fn k_max(&self) -> u32 {
-        ((self.legendre.len() - 1) as u32 - self.n_ang - 1) / 2
+        ((self.legendre.len() - 1) as u32 - self.n_ang) / 2
     }
 }
 
@@ -253,7 +254,7 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     // Coulomb by exact Gauss–Legendre quadrature in τ. At a node, Ω(τ)/e^L =
     // (x_τ/x)^{K_I} (y_τ/y)^{K_J} (z_τ/√(xy))^N G(ρ_τ²): integer powers of ratios ≤ 1 and a
     // polynomial in ρ_τ² ≤ 1 with the coefficients ĉ_k computed once per element.
-    let rule = go.legendre[(bra.k + ket.k + n + 1) as usize];
+    let rule = go.legendre[(bra.k + ket.k + n) as usize];
     let coef = coefficients(bra.k, ket.k, n);
     let rt = (x * y).sqrt();
     let mut v = T::zero();
@@ -289,7 +290,14 @@ impl<const D: usize, T: Real> Transform<D, GvrOps<D>> for Gvr<D, T> {
 }
 
 /// Gauss–Legendre nodes and weights on [0, 1] (Newton on P_n, Golub–Welsch-free).
-pub fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
+/// The m positive nodes of the 2m-point Gauss–Legendre rule on [−1, 1] with their weights:
+/// `Σ w f(τ) = ∫_0^1 f(τ) dτ` for every even polynomial f of degree ≤ 4m − 1.
+pub fn even_rule(m: usize) -> Vec<(f64, f64)> {
+    gauss_legendre(2 * m).into_iter().filter(|&(x, _)| x > 0.0).collect()
+}
+
+/// The n-point Gauss–Legendre rule on [−1, 1] (Newton iteration on P_n).
+pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
         let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
@@ -310,7 +318,7 @@ pub fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
             }
         }
         let w = 2.0 / ((1.0 - x * x) * dp * dp);
-        out.push((0.5 * (1.0 - x), 0.5 * w));
+        out.push((x, w));
     }
     out
 }
@@ -322,11 +330,30 @@ mod tests {
     #[test]
     fn legendre_integrates_polynomials_exactly() {
         for n in 1..60 {
-            let rule = gauss_legendre_01(n);
+            let rule = gauss_legendre(n);
             for deg in 0..(2 * n) {
                 let integral: f64 = rule.iter().map(|(x, w)| w * x.powi(deg as i32)).sum();
-                assert!((integral - 1.0 / (deg as f64 + 1.0)).abs() < 1e-13, "n={n} deg={deg}");
+                let exact = if deg % 2 == 0 { 2.0 / (deg as f64 + 1.0) } else { 0.0 };
+                assert!((integral - exact).abs() < 1e-13, "n={n} deg={deg}");
             }
+        }
+    }
+
+    #[test]
+    fn even_rule_integrates_even_polynomials_exactly() {
+        for m in 1..40 {
+            let rule = even_rule(m);
+            assert_eq!(rule.len(), m);
+            for deg in (0..4 * m).step_by(2) {
+                let integral: f64 = rule.iter().map(|(t, w)| w * t.powi(deg as i32)).sum();
+                assert!((integral - 1.0 / (deg as f64 + 1.0)).abs() < 1e-13, "m={m} deg={deg}");
+            }
+        }
+        // two degrees further the rule is no longer exact: the bound is sharp (the error of
+        // τ^{4m} shrinks like 16^{-2m}, so it is visible for small m)
+        for m in 1..6 {
+            let integral: f64 = even_rule(m).iter().map(|(t, w)| w * t.powi(4 * m as i32)).sum();
+            assert!((integral - 1.0 / (4 * m + 1) as f64).abs() > 1e-8, "m={m}");
         }
     }
 
