@@ -41,11 +41,10 @@ def run(basis: Basis, opts: Optimiser, method: str, seconds: float, start: int =
         else:
             trials = Basis.concat([sampler.draw() for _ in range(opts.trials)])
             rest = st.without(i)
-            energies, rows, diag = st.candidates(trials, exclude=i, eig=rest)
+            energies, _, _ = st.candidates(trials, exclude=i, eig=rest)
             k = int(np.argmin(energies))
             if np.isfinite(energies[k]):
-                regenerate_function(st, i, trials.subset([k]), {n: v[k] for n, v in rows.items()}, diag[k],
-                                    opts.refine_evaluations, rest=rest)
+                regenerate_function(st, i, trials.subset([k]), opts.refine_evaluations, rest=rest)
                 sampler.learn(st.basis)
         steps += 1
     return e0, st.energy, time.perf_counter() - t0, steps

@@ -119,8 +119,7 @@ def test_regeneration_keeps_the_better_of_refined_newcomer_and_incumbent():
     hopeless.A *= 1e-4  # a function ~100 times too diffuse
     regenerated, refined = State(basis.subset(range(15)), rep, 1e-13), State(basis.subset(range(15)), rep, 1e-13)
     before = regenerated.energy
-    _, rows, diag = regenerated.candidates(hopeless, exclude=i)
-    regenerate_function(regenerated, i, hopeless, {k: v[0] for k, v in rows.items()}, diag[0], 5)
+    regenerate_function(regenerated, i, hopeless, 5)
     refine_function(refined, i, 5)
     assert regenerated.energy == refined.energy <= before
     assert np.array_equal(regenerated.basis.A, refined.basis.A) and np.array_equal(regenerated.basis.u, refined.basis.u)
@@ -129,8 +128,7 @@ def test_regeneration_keeps_the_better_of_refined_newcomer_and_incumbent():
     worse = basis.subset(range(15))
     worse.replace(i, hopeless)
     regenerated, refined = State(worse.subset(range(15)), rep, 1e-13), State(worse.subset(range(15)), rep, 1e-13)
-    _, rows, diag = regenerated.candidates(good, exclude=i)
-    regenerate_function(regenerated, i, good, {k: v[0] for k, v in rows.items()}, diag[0], 5)
+    regenerate_function(regenerated, i, good, 5)
     refine_function(refined, i, 5)
     assert regenerated.energy < refined.energy
     assert regenerated.basis.K[i] == good.K[0]

@@ -158,13 +158,21 @@ class Sampler:
         groups: dict[str, list[int]] = {}
         for i, ch in enumerate(basis.channels):
             groups.setdefault(ch, []).append(i)
+        seen, known = {}, getattr(self, "_thetas", {})
         for ch, idx in groups.items():
             if len(idx) < self.opts.learn_after:
                 continue
-            ps = [Parametrisation.of(basis.subset([i])) for i in idx]
-            thetas = np.array([p.theta() for p in ps])
+            thetas = []
+            for i in idx:  # θ of a function is remembered while it stays in the basis (a sweep step changes one)
+                key = (ch, basis.c_A[i], *(v[i].tobytes() for v in (basis.A, *basis.parameters.values())))
+                if key not in seen:
+                    seen[key] = known[key] if key in known else Parametrisation.of(basis.subset([i])).theta()
+                thetas.append(seen[key])
+            thetas = np.array(thetas)
             Ks = basis.K[idx] if basis.kind == "ecg-gvr" else None
-            self.learned[ch] = (ps[0], thetas.mean(axis=0), thetas.std(axis=0), Ks, len(idx))
+            self.learned[ch] = (Parametrisation.of(basis.subset(idx[:1])), thetas.mean(axis=0), thetas.std(axis=0),
+                                Ks, len(idx))
+        self._thetas = seen
 
     def draw(self) -> Basis:
         """One function: with probability `opts.learned` from the learned per-channel
@@ -416,11 +424,11 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 energies, rows, diag = st.candidates(trials, exclude=i, eig=rest)
                 report.trials(len(trials))
                 best = int(np.argmin(energies))
-                winner = (trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
                 if opts.refine and np.isfinite(energies[best]):
-                    regenerate_function(st, i, *winner, opts.refine_evaluations, opts.refine_method, rest)
+                    regenerate_function(st, i, trials.subset([best]), opts.refine_evaluations, opts.refine_method,
+                                        rest)
                 elif np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
-                    st.put(i, *winner)
+                    st.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
             elif cursor.phase == "refine":
                 report.trials(1)
                 refine_function(st, cursor.index, opts.refine_evaluations, opts.refine_method)

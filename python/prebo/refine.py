@@ -127,9 +127,11 @@ class Objective:
     """The energy as a function of θ of function i, all others fixed: the lowest root of the
     secular equation against the basis without i. Remembers the best function seen. A θ that
     leaves the valid region (an ill-conditioned 𝒜, elements failing `Representation.plausible`),
-    or makes the function linearly dependent on the others, scores worse than the current energy (a finite value keeps the line searches sane)."""
+    or makes the function linearly dependent on the others, scores worse than the current energy (a finite value keeps the line searches sane).
+    `f`: parametrise this function (a newcomer for slot i) instead of function i; the state is
+    not changed, and the best seen starts at f's own energy."""
 
-    def __init__(self, state, i: int, rest=None):
+    def __init__(self, state, i: int, rest=None, f: Basis | None = None):
         self.state, self.i = state, i
         basis = state.basis
         self.keep = np.arange(len(basis)) != i
@@ -137,9 +139,12 @@ class Objective:
         self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
         self.rest = basis.subset(np.flatnonzero(self.keep))
         self.S_rest = np.diag(state.m["S"])[self.keep]
-        self.p = Parametrisation.of(basis.subset([i]))
+        self.p = Parametrisation.of(basis.subset([i]) if f is None else f)
         self.worse = state.energy + 1.0
         self.best_E, self.best_f = state.energy, None
+        if f is not None:
+            self.best_E = np.inf
+            self.energy(self.p.theta())
 
     def _seen(self, e: float, f: Basis) -> None:
         if e < self.best_E:
@@ -181,11 +186,9 @@ class Objective:
         return e, g
 
 
-def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gradient", rest=None) -> bool:
-    """Minimise the energy over the parameters of function i — Powell, or L-BFGS with exact
-    gradients — with at most `max_evaluations` energies; True if it improved. `rest`: the
-    eigen-solution of the basis without i (State.without), if already at hand."""
-    obj = Objective(state, i, rest)
+def minimise(obj: Objective, max_evaluations: int, method: str) -> None:
+    """Powell's method, or L-BFGS with exact gradients, from the objective's function, with at
+    most `max_evaluations` energies; the best function seen is kept in the objective."""
     theta0 = obj.p.theta()
     if method == "gradient":
         minimize(obj.energy_and_gradient, theta0, jac=True, method="L-BFGS-B",
@@ -194,6 +197,10 @@ def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gr
     else:
         minimize(obj.energy, theta0, method="Powell",
                  options={"maxfev": max_evaluations, "xtol": 1e-4, "ftol": 1e-14, "direc": 0.1 * np.eye(len(theta0))})
+
+
+def accept(state, i: int, obj: Objective) -> bool:
+    """Put the objective's best function in slot i if it lowers the energy; True if it did."""
     if obj.best_f is None or not obj.best_E < state.energy - 1e-15 * abs(state.energy):
         return False
     rows, diag = state.rep.rows(obj.best_f, state.basis, i)  # oriented: patched matrices equal a rebuild
@@ -201,20 +208,23 @@ def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gr
     return True
 
 
-def regenerate_function(state, i: int, f: Basis, row: dict, d: np.ndarray, max_evaluations: int = 200,
-                        method: str = "gradient", rest=None) -> bool:
-    """A replacement sweep's step with refinement: `f` (the competitive winner for position i, with
-    its oriented row and diagonal from State.candidates) takes the place of function i and is
-    refined; unless that lowers the energy, function i returns and is refined instead. A refined
-    newcomer can leave the basin the incumbent's refinement is confined to. True if it improved.
-    Both refinements share `rest`, the eigen-solution of the basis without i (State.without)."""
-    before, old = state.energy, state.basis.subset([i])
-    rest = state.without(i) if rest is None else rest
-    state.put(i, f, row, d)
-    refine_function(state, i, max_evaluations, method, rest)
-    if state.energy < before:
-        return True
-    rows, diag = state.rep.rows(old, state.basis, i)
-    state.put(i, old, {k: v[0] for k, v in rows.items()}, diag[0])
-    return refine_function(state, i, max_evaluations, method, rest)
+def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gradient", rest=None) -> bool:
+    """Minimise the energy over the parameters of function i — Powell, or L-BFGS with exact
+    gradients — with at most `max_evaluations` energies; True if it improved. `rest`: the
+    eigen-solution of the basis without i (State.without), if already at hand."""
+    obj = Objective(state, i, rest)
+    minimise(obj, max_evaluations, method)
+    return accept(state, i, obj)
 
+
+def regenerate_function(state, i: int, f: Basis, max_evaluations: int = 200, method: str = "gradient",
+                        rest=None) -> bool:
+    """A replacement sweep's step with refinement: `f` (the competitive winner for position i) is
+    refined in slot i and takes it if it then lowers the energy; otherwise function i is refined.
+    A refined newcomer can leave the basin the incumbent's refinement is confined to. True if it
+    improved. Both refinements share `rest`, the eigen-solution of the basis without i
+    (State.without), and the state is changed (and its eigenproblem solved) once at most."""
+    rest = state.without(i) if rest is None else rest
+    newcomer = Objective(state, i, rest, f)
+    minimise(newcomer, max_evaluations, method)
+    return accept(state, i, newcomer) or refine_function(state, i, max_evaluations, method, rest)
