@@ -289,7 +289,6 @@ impl<const D: usize, T: Real> Transform<D, GvrOps<D>> for Gvr<D, T> {
     }
 }
 
-/// Gauss–Legendre nodes and weights on [0, 1] (Newton on P_n, Golub–Welsch-free).
 /// The m positive nodes of the 2m-point Gauss–Legendre rule on [−1, 1] with their weights:
 /// `Σ w f(τ) = ∫_0^1 f(τ) dτ` for every even polynomial f of degree ≤ 4m − 1.
 pub fn even_rule(m: usize) -> Vec<(f64, f64)> {
