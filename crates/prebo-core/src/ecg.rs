@@ -15,13 +15,58 @@ pub type Vector<const D: usize> = SVector<f64, D>;
 /// A real scalar the generic kernels run on: `f64`, or a forward-mode dual number of
 /// num-dual (`DualSVec64<W>`) that carries W directional derivatives through every operation.
 pub trait Real:
-    RealField + Copy + From<f64> + Add<f64, Output = Self> + Sub<f64, Output = Self> + Mul<f64, Output = Self> + Div<f64, Output = Self>
+    RealField
+    + Copy
+    + From<f64>
+    + Add<f64, Output = Self>
+    + Sub<f64, Output = Self>
+    + Mul<f64, Output = Self>
+    + Div<f64, Output = Self>
+    + Value
 {
 }
 
 impl<T> Real for T where
-    T: RealField + Copy + From<f64> + Add<f64, Output = T> + Sub<f64, Output = T> + Mul<f64, Output = T> + Div<f64, Output = T>
+    T: RealField
+        + Copy
+        + From<f64>
+        + Add<f64, Output = T>
+        + Sub<f64, Output = T>
+        + Mul<f64, Output = T>
+        + Div<f64, Output = T>
+        + Value
 {
+}
+
+/// The `f64` value of a scalar, and whether it carries derivatives: a kernel whose inner loop
+/// depends on a few scalars can run that loop in `f64` with hand-derived partial derivatives
+/// and chain them onto the dual numbers (`chain`).
+pub trait Value {
+    const DUAL: bool;
+    fn value(&self) -> f64;
+}
+
+impl Value for f64 {
+    const DUAL: bool = false;
+    #[inline(always)]
+    fn value(&self) -> f64 {
+        *self
+    }
+}
+
+impl<const W: usize> Value for num_dual::DualSVec64<W> {
+    const DUAL: bool = true;
+    #[inline(always)]
+    fn value(&self) -> f64 {
+        self.re
+    }
+}
+
+/// `f` at the inputs `x_k`, given its value `f0` and partial derivatives `∂f/∂x_k` there:
+/// `f0 + Σ_k ∂f/∂x_k (x_k − value(x_k))` carries the inputs' derivatives by the chain rule.
+#[inline]
+pub fn chain<T: Real, const K: usize>(f0: f64, inputs: [T; K], partials: [f64; K]) -> T {
+    inputs.iter().zip(partials).fold(re(f0), |acc, (x, p)| acc + (*x - x.value()) * p)
 }
 
 /// `x` as a `T` (a constant: zero derivatives).
@@ -55,6 +100,49 @@ impl<const D: usize> Gaussian<D> {
 #[inline]
 pub fn log_det_cholesky<T: Real, const D: usize>(chol: &Cholesky<T, nalgebra::Const<D>>) -> T {
     chol.l_dirty().diagonal().iter().fold(T::zero(), |acc, d| acc + d.ln()) * 2.0
+}
+
+/// `B^{-1}` and `ln|B|` of a positive-definite `B`; `None` when `B` has no Cholesky factor in
+/// floating point. Dual numbers are expanded to first order (exact for them) around the value
+/// `B_0`: `B^{-1} = B_0^{-1} − B_0^{-1}(B − B_0)B_0^{-1}`, `ln|B| = ln|B_0| + Tr(B_0^{-1}(B − B_0))`,
+/// so the factorisation and the inverse run in `f64`.
+#[inline]
+pub fn inverse_log_det<T: Real, const D: usize>(b: &SMatrix<T, D, D>) -> Option<(SMatrix<T, D, D>, T)> {
+    let b0: Mat<D> = b.map(|x| x.value());
+    let chol = Cholesky::new(b0)?;
+    let (binv0, log_det0) = (chol.inverse(), log_det_cholesky(&chol));
+    if !T::DUAL {
+        return Some((binv0.map(re), re(log_det0)));
+    }
+    let db = SMatrix::<T, D, D>::from_fn(|i, j| b[(i, j)] - b0[(i, j)]);
+    let x = mul_f(&binv0, &db); // B_0^{-1}(B − B_0)
+    let binv = SMatrix::from_fn(|i, j| (0..D).fold(re(binv0[(i, j)]), |acc, k| acc - x[(i, k)] * binv0[(k, j)]));
+    Some((binv, (0..D).fold(re(log_det0), |acc, k| acc + x[(k, k)])))
+}
+
+/// `a b` by plain sums (nalgebra's generic product also multiplies every term by α = 1, which
+/// costs a dual-number product per term).
+#[inline]
+pub fn mul<T: Real, const R: usize, const K: usize, const C: usize>(
+    a: &SMatrix<T, R, K>,
+    b: &SMatrix<T, K, C>,
+) -> SMatrix<T, R, C> {
+    SMatrix::from_fn(|i, j| (0..K).fold(T::zero(), |acc, k| acc + a[(i, k)] * b[(k, j)]))
+}
+
+/// `a b` for a constant `a`.
+#[inline]
+pub fn mul_f<T: Real, const R: usize, const K: usize, const C: usize>(
+    a: &SMatrix<f64, R, K>,
+    b: &SMatrix<T, K, C>,
+) -> SMatrix<T, R, C> {
+    SMatrix::from_fn(|i, j| (0..K).fold(T::zero(), |acc, k| acc + b[(k, j)] * a[(i, k)]))
+}
+
+/// `v^T w` for a constant `w`.
+#[inline]
+pub fn dot_f<T: Real, const D: usize>(v: &SVector<T, D>, w: &Vector<D>) -> T {
+    (0..D).fold(T::zero(), |acc, k| acc + v[k] * w[k])
 }
 
 /// `ln|A|` from the Cholesky factor, `None` if `A` is not positive definite.
@@ -115,5 +203,34 @@ impl<T: Real> std::ops::AddAssign<(f64, Element<T>)> for Element<T> {
         self.t += e.t * c;
         self.t_ti += e.t_ti * c;
         self.v += e.v * c;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gradient::{seed_matrix, Dual};
+
+    #[test]
+    fn inverse_log_det_matches_dual_cholesky() {
+        let b = Mat::<3>::new(2.0, 0.3, -0.4, 0.3, 1.5, 0.2, -0.4, 0.2, 0.9);
+        let dirs = [
+            Mat::<3>::new(1.0, 0.5, 0.0, 0.5, 0.0, -0.2, 0.0, -0.2, 0.3),
+            Mat::<3>::new(0.0, 0.0, 1.0, 0.0, 2.0, 0.0, 1.0, 0.0, -1.0),
+        ];
+        let bd: SMatrix<Dual<2>, 3, 3> = seed_matrix(&b, &dirs);
+        let (binv, log_det) = inverse_log_det(&bd).unwrap();
+        let chol = Cholesky::new(bd).unwrap();
+        let (binv_ref, log_det_ref) = (chol.inverse(), log_det_cholesky(&chol));
+        let close = |a: &Dual<2>, r: &Dual<2>| {
+            let (da, dr) = (
+                a.eps.unwrap_generic(nalgebra::Const::<2>, nalgebra::U1),
+                r.eps.unwrap_generic(nalgebra::Const::<2>, nalgebra::U1),
+            );
+            (a.re - r.re).abs() < 1e-14 && (da - dr).norm() < 1e-13
+        };
+        assert!(close(&log_det, &log_det_ref));
+        assert!(binv.iter().zip(binv_ref.iter()).all(|(a, r)| close(a, r)));
+        assert!(inverse_log_det(&Mat::<2>::new(1.0, 2.0, 2.0, 1.0)).is_none(), "indefinite B has no factor");
     }
 }

@@ -51,7 +51,7 @@ use std::f64::consts::PI;
 
 use nalgebra::{Cholesky, SMatrix, SVector};
 
-use crate::ecg::{log_det_cholesky, re, Element, Mat, Operators, Real};
+use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, mul_f, re, Element, Mat, Operators, Real};
 use crate::error::{CoreError, Result};
 use crate::images::Transform;
 
@@ -155,19 +155,102 @@ fn series<T: Real>(ki: u32, kj: u32, n: u32, r2: T) -> (T, T, T, T) {
     (g, gx, gy, gz)
 }
 
-/// `ĉ_k`, k = 0..=min(K_I, K_J) (module docs).
-#[inline]
-fn coefficients(ki: u32, kj: u32, n: u32) -> Vec<f64> {
-    let alpha = n as f64 + 0.5;
-    let mut c = Vec::with_capacity(ki.min(kj) as usize + 1);
-    let mut ck = 1.0;
-    for k in 0..=ki.min(kj) {
-        c.push(ck);
-        ck *= ((ki - k) as f64) * ((kj - k) as f64) / (((k + 1) as f64) * (k as f64 + 1.0 + alpha));
-    }
-    c
+/// `ĉ_k`, k = 0..=min(K_I, K_J) (module docs), and the series of the Coulomb integrand's partial
+/// derivatives (`quadrature_partials`), for one pair (K_I, K_J) and N.
+struct Coefficients {
+    ki: u32,
+    kj: u32,
+    n: u32,
+    /// `ĉ_k`
+    c: Vec<f64>,
+    /// `ĉ_k (K_I − k)`, `ĉ_k (K_J − k)`
+    cx: Vec<f64>,
+    cy: Vec<f64>,
+    /// `ĉ_k (N + 2k)`; for N = 0 shifted by one, `ĉ_{k+1} 2(k+1)` (the ζ-derivative over ζ)
+    cz: Vec<f64>,
 }
 
+impl Coefficients {
+    fn new(ki: u32, kj: u32, n: u32) -> Self {
+        let alpha = n as f64 + 0.5;
+        let mut c = Vec::with_capacity(ki.min(kj) as usize + 1);
+        let mut ck = 1.0;
+        for k in 0..=ki.min(kj) {
+            c.push(ck);
+            ck *= ((ki - k) as f64) * ((kj - k) as f64) / (((k + 1) as f64) * (k as f64 + 1.0 + alpha));
+        }
+        let scaled = |f: &dyn Fn(u32) -> f64| c.iter().enumerate().map(|(k, ck)| ck * f(k as u32)).collect::<Vec<_>>();
+        let (cx, cy) = (scaled(&|k| (ki - k) as f64), scaled(&|k| (kj - k) as f64));
+        let cz = if n == 0 { scaled(&|k| (2 * k) as f64)[1..].to_vec() } else { scaled(&|k| (n + 2 * k) as f64) };
+        Self { ki, kj, n, c, cx, cy, cz }
+    }
+}
+
+/// `Σ_k coef_k r^k` (Horner).
+#[inline]
+fn horner<T: Real>(coef: &[f64], r: T) -> T {
+    coef.iter().rev().fold(T::zero(), |acc, ck| acc * r + *ck)
+}
+
+/// `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ / e^L` (module docs) for the inputs
+/// `[x, y, z, γ_I, γ_J]`. At a node the integrand is, with `a = x_τ/x`, `b = y_τ/y`,
+/// `ζ = z_τ/√(xy)`, `P(a, b, ζ) = Σ ĉ_k a^{K_I−k} b^{K_J−k} ζ^{N+2k} = a^{K_I} b^{K_J} ζ^N G(ζ²/(ab))`:
+/// integer powers of ratios ≤ 1 and a polynomial in `ζ²/(ab)` ≤ 1.
+fn quadrature<T: Real>(inputs: [T; 5], rule: &[(f64, f64)], series: &Coefficients) -> T {
+    let [x, y, z, gam_i, gam_j] = inputs;
+    let rt = (x * y).sqrt();
+    let mut integral = T::zero();
+    for &(tau, weight) in rule {
+        let t2 = tau * tau;
+        // x_τ, y_τ >= 0 analytically (covariances of B + t² w w^T); clamp rounding
+        let xt = (x - gam_i * t2 * gam_i).max(T::zero());
+        let yt = (y - gam_j * t2 * gam_j).max(T::zero());
+        let zt = z - gam_i * t2 * gam_j;
+        let r2 = if xt * yt > T::zero() { (zt * zt / (xt * yt)).min(T::one()) } else { T::one() };
+        let g = horner(&series.c, r2);
+        integral += (xt / x).powi(series.ki as i32)
+            * weight
+            * (yt / y).powi(series.kj as i32)
+            * (zt / rt).powi(series.n as i32)
+            * g;
+    }
+    integral
+}
+
+/// `quadrature` in `f64` with its partial derivatives with respect to `[x, y, z, γ_I, γ_J]`,
+/// for dual numbers (`chain`): `P_a = a^{K_I−1} b^{K_J} ζ^N Σ ĉ_k(K_I−k) r^k`, likewise `P_b`,
+/// `P_ζ = a^{K_I} b^{K_J} ζ^{N−1} Σ ĉ_k(N+2k) r^k` (`r = ζ²/(ab)`; for N = 0
+/// `a^{K_I−1} b^{K_J−1} ζ Σ ĉ_{k+1} 2(k+1) r^k`), through `a = 1 − γ_I²τ²/x`, `b = 1 − γ_J²τ²/y`,
+/// `ζ = (z − γ_Iγ_Jτ²)/√(xy)`. Every node has τ < 1, so `a, b ≥ 1 − τ² > 0`.
+fn quadrature_partials(inputs: [f64; 5], rule: &[(f64, f64)], series: &Coefficients) -> (f64, [f64; 5]) {
+    let [x, y, z, gam_i, gam_j] = inputs;
+    let (ki, kj, n) = (series.ki as i32, series.kj as i32, series.n as i32);
+    let rt = (x * y).sqrt();
+    let (mut f, mut d) = (0.0, [0.0; 5]);
+    for &(tau, weight) in rule {
+        let t2 = tau * tau;
+        let a = (1.0 - gam_i * gam_i * t2 / x).max(0.0);
+        let b = (1.0 - gam_j * gam_j * t2 / y).max(0.0);
+        let zeta = (z - gam_i * gam_j * t2) / rt;
+        let r = if a * b > 0.0 { (zeta * zeta / (a * b)).min(1.0) } else { 1.0 };
+        let (pa, pb, pz) = (a.powi(ki), b.powi(kj), zeta.powi(n));
+        f += weight * pa * pb * pz * horner(&series.c, r);
+        let p_a = if ki > 0 { weight * a.powi(ki - 1) * pb * pz * horner(&series.cx, r) } else { 0.0 };
+        let p_b = if kj > 0 { weight * pa * b.powi(kj - 1) * pz * horner(&series.cy, r) } else { 0.0 };
+        let p_z = match n {
+            0 if ki > 0 && kj > 0 => weight * a.powi(ki - 1) * b.powi(kj - 1) * zeta * horner(&series.cz, r),
+            0 => 0.0,
+            _ => weight * pa * pb * zeta.powi(n - 1) * horner(&series.cz, r),
+        };
+        // a(x, γ_I), b(y, γ_J), ζ(x, y, z, γ_I, γ_J)
+        d[0] += p_a * gam_i * gam_i * t2 / (x * x) - p_z * zeta / (2.0 * x);
+        d[1] += p_b * gam_j * gam_j * t2 / (y * y) - p_z * zeta / (2.0 * y);
+        d[2] += p_z / rt;
+        d[3] += -p_a * 2.0 * gam_i * t2 / x - p_z * gam_j * t2 / rt;
+        d[4] += -p_b * 2.0 * gam_j * t2 / y - p_z * gam_i * t2 / rt;
+    }
+    (f, d)
+}
 /// Ω and its derivatives divided by `e^L`, `L = (K_I+N/2) ln x + (K_J+N/2) ln y`:
 /// returns `(L, ω, ω_x, ω_y, ω_z)`.
 #[inline]
@@ -211,16 +294,13 @@ fn cm_kinetic<T: Real>(ci: f64, cj: f64, ui: T, uj: T, m: f64, w: (T, T, T, T)) 
 pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
     let ops = &go.ops;
     let n = go.n_ang;
-    let b_mat = bra.a + ket.a;
     // A_I + A_J is positive definite, but for near-singular functions its factorisation can
     // fail in floating point: the element is then NaN and the caller rejects the function
-    let Some(chol) = Cholesky::new(b_mat) else {
+    let Some((binv, log_det)) = inverse_log_det(&(bra.a + ket.a)) else {
         return Element::nan();
     };
-    let log_det = log_det_cholesky(&chol);
-    let binv = chol.inverse();
-    let gi = binv * bra.u;
-    let gj = binv * ket.u;
+    let gi = mul(&binv, &bra.u);
+    let gj = mul(&binv, &ket.u);
     let x = bra.u.dot(&gi) * 0.5;
     let y = ket.u.dot(&gj) * 0.5;
     let z = bra.u.dot(&gj) * 0.5;
@@ -230,52 +310,44 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     let s = scale * om;
 
     // kinetic with Λ
-    let lam: SMatrix<T, D, D> = ops.lambda.map(re);
-    let lam_ui = lam * bra.u;
-    let lam_uj = lam * ket.u;
-    let zl = ket.a * lam_ui; // A_J Λ u_I
-    let zr = bra.a * lam_uj; // A_I Λ u_J
-    let w = bra.a * lam * ket.a; // A_I Λ A_J
+    let lam_ui = mul_f(&ops.lambda, &bra.u);
+    let lam_uj = mul_f(&ops.lambda, &ket.u);
+    let zl = mul(&ket.a, &lam_ui); // A_J Λ u_I
+    let zr = mul(&bra.a, &lam_uj); // A_I Λ u_J
+    let w = mul(&bra.a, &mul_f(&ops.lambda, &ket.a)); // A_I Λ A_J
     let tr_wc = binv.component_mul(&w.transpose()).sum() * 0.5;
     let (hi, hj) = (gi * re::<T>(0.5), gj * re::<T>(0.5)); // C u
+    let (w_hi, w_hj) = (mul(&w, &hi), mul(&w, &hj));
     // (written as `a * 4.0 * b` to keep the rounding of the f64 kernel's `4.0 * a * b`)
-    let t = bra.u.dot(&lam_uj) * oz - zl.dot(&hi) * 4.0 * ox - zl.dot(&hj) * 2.0 * oz - zr.dot(&hj) * 4.0 * oy
+    let t = bra.u.dot(&lam_uj) * oz
+        - zl.dot(&hi) * 4.0 * ox
+        - zl.dot(&hj) * 2.0 * oz
+        - zr.dot(&hj) * 4.0 * oy
         - zr.dot(&hi) * 2.0 * oz
         + tr_wc * 12.0 * om
-        + hi.dot(&(w * hi)) * 8.0 * ox
-        + (hi.dot(&(w * hj)) + hj.dot(&(w * hi))) * 4.0 * oz
-        + hj.dot(&(w * hj)) * 8.0 * oy;
+        + hi.dot(&w_hi) * 8.0 * ox
+        + (hi.dot(&w_hj) + hj.dot(&w_hi)) * 4.0 * oz
+        + hj.dot(&w_hj) * 8.0 * oy;
     let t = scale * t;
     let t_ti = match ops.cm_mass {
         Some(m) => t - scale * cm_kinetic(bra.c_a, ket.c_a, bra.c_u, ket.c_u, m, (om, ox, oy, oz)),
         None => t,
     };
 
-    // Coulomb by exact Gauss–Legendre quadrature in τ. At a node, Ω(τ)/e^L =
-    // (x_τ/x)^{K_I} (y_τ/y)^{K_J} (z_τ/√(xy))^N G(ρ_τ²): integer powers of ratios ≤ 1 and a
-    // polynomial in ρ_τ² ≤ 1 with the coefficients ĉ_k computed once per element.
+    // Coulomb by exact Gauss–Legendre quadrature in τ (`quadrature`)
     let rule = go.legendre[(bra.k + ket.k + n) as usize];
-    let coef = coefficients(bra.k, ket.k, n);
-    let rt = (x * y).sqrt();
+    let series = Coefficients::new(bra.k, ket.k, n);
     let mut v = T::zero();
     for (wv, q) in &ops.pairs {
-        let wv: SVector<T, D> = wv.map(re);
-        let bw = binv * wv;
-        let c = wv.dot(&bw);
+        let c = dot_f(&mul_f(&wv.transpose(), &binv).transpose(), wv); // w^T B^{-1} w
         let sq = (c * 2.0).sqrt();
-        let gam_i = gi.dot(&wv) / sq;
-        let gam_j = gj.dot(&wv) / sq;
-        let mut integral = T::zero();
-        for &(tau, weight) in rule {
-            let t2 = tau * tau;
-            // x_τ, y_τ >= 0 analytically (covariances of B + t² w w^T); clamp rounding
-            let xt = (x - gam_i * t2 * gam_i).max(T::zero());
-            let yt = (y - gam_j * t2 * gam_j).max(T::zero());
-            let zt = z - gam_i * t2 * gam_j;
-            let r2 = if xt * yt > T::zero() { (zt * zt / (xt * yt)).min(T::one()) } else { T::one() };
-            let g = coef.iter().rev().fold(T::zero(), |acc, ck| acc * r2 + *ck);
-            integral += (xt / x).powi(bra.k as i32) * weight * (yt / y).powi(ket.k as i32) * (zt / rt).powi(n as i32) * g;
-        }
+        let inputs = [x, y, z, dot_f(&gi, wv) / sq, dot_f(&gj, wv) / sq];
+        let integral = if T::DUAL {
+            let (f0, partials) = quadrature_partials(inputs.map(|s| s.value()), rule, &series);
+            chain(f0, inputs, partials)
+        } else {
+            quadrature(inputs, rule, &series)
+        };
         v += re::<T>(*q * 2.0) / (c * PI).sqrt() * integral;
     }
     Element { s, t, t_ti, v: scale * v }
@@ -353,6 +425,32 @@ mod tests {
         for m in 1..6 {
             let integral: f64 = even_rule(m).iter().map(|(t, w)| w * t.powi(4 * m as i32)).sum();
             assert!((integral - 1.0 / (4 * m + 1) as f64).abs() > 1e-8, "m={m}");
+        }
+    }
+
+    #[test]
+    fn quadrature_partials_match_dual_numbers() {
+        use crate::gradient::{seed, Dual};
+        // inputs of a valid covariance structure: x = |p|², y = |q|², z = p·q, γ_I = p·e,
+        // γ_J = q·e for a unit vector e (then x_τ, y_τ, x_τ y_τ − z_τ² >= 0 for τ <= 1)
+        let (p, q, e) = ([0.9, -0.3, 0.4], [0.2, 0.7, -0.5], [0.6, 0.0, 0.8]);
+        let dot = |a: &[f64; 3], b: &[f64; 3]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let inputs = [dot(&p, &p), dot(&q, &q), dot(&p, &q), dot(&p, &e), dot(&q, &e)];
+        let duals: [Dual<5>; 5] = std::array::from_fn(|k| seed(inputs[k], (0..5).map(|l| f64::from(k == l))));
+        for (ki, kj, n) in
+            [(0, 0, 0), (1, 0, 0), (0, 3, 0), (2, 2, 0), (7, 4, 0), (0, 0, 1), (3, 0, 2), (5, 9, 1), (30, 24, 0)]
+        {
+            let series = Coefficients::new(ki, kj, n);
+            let rule = legendre_rule(((ki + kj + n) / 2 + 1) as usize);
+            let (f, d) = quadrature_partials(inputs, rule, &series);
+            let reference = quadrature(duals, rule, &series);
+            let scale = reference.re.abs().max(1e-300);
+            assert!((f - reference.re).abs() < 1e-13 * scale, "K=({ki},{kj}) N={n}: value");
+            let eps = reference.eps.unwrap_generic(nalgebra::Const::<5>, nalgebra::U1);
+            for k in 0..5 {
+                let tol = 1e-12 * (eps[k].abs() + scale);
+                assert!((d[k] - eps[k]).abs() < tol, "K=({ki},{kj}) N={n}: ∂/∂input {k}: {} vs {}", d[k], eps[k]);
+            }
         }
     }
 
