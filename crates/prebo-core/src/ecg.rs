@@ -115,25 +115,16 @@ pub fn inverse_log_det<T: Real, const D: usize>(b: &SMatrix<T, D, D>) -> Option<
         return Some((binv0.map(re), re(log_det0)));
     }
     let db = SMatrix::<T, D, D>::from_fn(|i, j| b[(i, j)] - b0[(i, j)]);
-    let x = mul_f(&binv0, &db); // B_0^{-1}(B − B_0)
+    let x = mul(&binv0, &db); // B_0^{-1}(B − B_0)
     let binv = SMatrix::from_fn(|i, j| (0..D).fold(re(binv0[(i, j)]), |acc, k| acc - x[(i, k)] * binv0[(k, j)]));
     Some((binv, (0..D).fold(re(log_det0), |acc, k| acc + x[(k, k)])))
 }
 
-/// `a b` by plain sums (nalgebra's generic product also multiplies every term by α = 1, which
-/// costs a dual-number product per term).
+/// `a b` by plain sums, for `a` of `T` or of constants (`f64`); nalgebra's generic product also
+/// multiplies every term by α = 1, which costs a dual-number product per term.
 #[inline]
-pub fn mul<T: Real, const R: usize, const K: usize, const C: usize>(
-    a: &SMatrix<T, R, K>,
-    b: &SMatrix<T, K, C>,
-) -> SMatrix<T, R, C> {
-    SMatrix::from_fn(|i, j| (0..K).fold(T::zero(), |acc, k| acc + a[(i, k)] * b[(k, j)]))
-}
-
-/// `a b` for a constant `a`.
-#[inline]
-pub fn mul_f<T: Real, const R: usize, const K: usize, const C: usize>(
-    a: &SMatrix<f64, R, K>,
+pub fn mul<S: nalgebra::Scalar + Copy, T: Real + Mul<S, Output = T>, const R: usize, const K: usize, const C: usize>(
+    a: &SMatrix<S, R, K>,
     b: &SMatrix<T, K, C>,
 ) -> SMatrix<T, R, C> {
     SMatrix::from_fn(|i, j| (0..K).fold(T::zero(), |acc, k| acc + b[(k, j)] * a[(i, k)]))

@@ -51,7 +51,7 @@ use std::f64::consts::PI;
 
 use nalgebra::{Cholesky, SMatrix, SVector};
 
-use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, mul_f, re, Element, Mat, Operators, Real};
+use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real};
 use crate::error::{CoreError, Result};
 use crate::images::Transform;
 
@@ -310,11 +310,11 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     let s = scale * om;
 
     // kinetic with Λ
-    let lam_ui = mul_f(&ops.lambda, &bra.u);
-    let lam_uj = mul_f(&ops.lambda, &ket.u);
+    let lam_ui = mul(&ops.lambda, &bra.u);
+    let lam_uj = mul(&ops.lambda, &ket.u);
     let zl = mul(&ket.a, &lam_ui); // A_J Λ u_I
     let zr = mul(&bra.a, &lam_uj); // A_I Λ u_J
-    let w = mul(&bra.a, &mul_f(&ops.lambda, &ket.a)); // A_I Λ A_J
+    let w = mul(&bra.a, &mul(&ops.lambda, &ket.a)); // A_I Λ A_J
     let tr_wc = binv.component_mul(&w.transpose()).sum() * 0.5;
     let (hi, hj) = (gi * re::<T>(0.5), gj * re::<T>(0.5)); // C u
     let (w_hi, w_hj) = (mul(&w, &hi), mul(&w, &hj));
@@ -339,7 +339,7 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     let series = Coefficients::new(bra.k, ket.k, n);
     let mut v = T::zero();
     for (wv, q) in &ops.pairs {
-        let c = dot_f(&mul_f(&wv.transpose(), &binv).transpose(), wv); // w^T B^{-1} w
+        let c = dot_f(&mul(&wv.transpose(), &binv).transpose(), wv); // w^T B^{-1} w
         let sq = (c * 2.0).sqrt();
         let inputs = [x, y, z, dot_f(&gi, wv) / sq, dot_f(&gj, wv) / sq];
         let integral = if T::DUAL {
