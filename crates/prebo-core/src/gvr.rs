@@ -114,7 +114,7 @@ impl<const D: usize, T: Real> Gvr<D, T> {
         }
         let log_det_2a = log_det_cholesky(&chol) + (D as f64) * 2f64.ln();
         let n = go.n_ang as f64;
-        let (g, _, _, _) = series::<f64>(k, k, go.n_ang, 1.0);
+        let g = horner(&Coefficients::new(k, k, go.n_ang).c, 1.0);
         let log_s0 = (log_det_2a - D as f64 * PI.ln()) * -1.5;
         let log_norm = (log_s0 + x.ln() * (2.0 * k as f64 + n) + g.ln()) * 0.5;
         Ok(Self { a, u, k, c_a, c_u: u.sum(), log_norm })
@@ -136,27 +136,10 @@ impl<const D: usize, T: Real> Gvr<D, T> {
     }
 }
 
-/// `G = Σ ĉ_k ρ^{2k}`, `G_x = Σ ĉ_k (K_I−k) ρ^{2k}`, `G_y = Σ ĉ_k (K_J−k) ρ^{2k}`,
-/// `G_z = Σ ĉ_k (N+2k) ρ^{2k}` at `r2 = ρ²`; all terms non-negative.
-#[inline]
-fn series<T: Real>(ki: u32, kj: u32, n: u32, r2: T) -> (T, T, T, T) {
-    let alpha = n as f64 + 0.5;
-    let (mut c, mut p) = (1.0, T::one());
-    let (mut g, mut gx, mut gy, mut gz) = (T::zero(), T::zero(), T::zero(), T::zero());
-    for k in 0..=ki.min(kj) {
-        let term = p * c;
-        g += term;
-        gx += term * (ki - k) as f64;
-        gy += term * (kj - k) as f64;
-        gz += term * (n + 2 * k) as f64;
-        c *= ((ki - k) as f64) * ((kj - k) as f64) / (((k + 1) as f64) * (k as f64 + 1.0 + alpha));
-        p *= r2;
-    }
-    (g, gx, gy, gz)
-}
-
-/// `ĉ_k`, k = 0..=min(K_I, K_J) (module docs), and the series of the Coulomb integrand's partial
-/// derivatives (`quadrature_partials`), for one pair (K_I, K_J) and N.
+/// `ĉ_k`, k = 0..=min(K_I, K_J) (module docs), and the coefficients of the series of Ω's
+/// derivatives (`omega`, `quadrature_partials`), for one pair (K_I, K_J) and N; all non-negative.
+/// At `r = ρ²`: `G = Σ ĉ_k r^k`, `G_x = Σ ĉ_k (K_I−k) r^k`, `G_y = Σ ĉ_k (K_J−k) r^k`,
+/// `G_z = Σ ĉ_k (N+2k) r^k`, for N = 0 divided by r (its k = 0 term vanishes).
 struct Coefficients {
     ki: u32,
     kj: u32,
@@ -166,7 +149,7 @@ struct Coefficients {
     /// `ĉ_k (K_I − k)`, `ĉ_k (K_J − k)`
     cx: Vec<f64>,
     cy: Vec<f64>,
-    /// `ĉ_k (N + 2k)`; for N = 0 shifted by one, `ĉ_{k+1} 2(k+1)` (the ζ-derivative over ζ)
+    /// `ĉ_k (N + 2k)`; for N = 0 shifted by one, `ĉ_{k+1} 2(k+1)` (G_z / r)
     cz: Vec<f64>,
 }
 
@@ -254,30 +237,20 @@ fn quadrature_partials(inputs: [f64; 5], rule: &[(f64, f64)], series: &Coefficie
 /// Ω and its derivatives divided by `e^L`, `L = (K_I+N/2) ln x + (K_J+N/2) ln y`:
 /// returns `(L, ω, ω_x, ω_y, ω_z)`.
 #[inline]
-fn omega<T: Real>(ki: u32, kj: u32, n: u32, x: T, y: T, z: T) -> (T, T, T, T, T) {
+fn omega<T: Real>(series: &Coefficients, x: T, y: T, z: T) -> (T, T, T, T, T) {
+    let (ki, kj, n) = (series.ki, series.kj, series.n);
     let nf = n as f64;
     let rt = (x * y).sqrt();
     let rho = (z / rt).clamp(re(-1.0), re(1.0));
-    let (g, gx, gy, gz) = series(ki, kj, n, rho * rho);
+    let r2 = rho * rho;
+    let (g, gx, gy, gz) =
+        (horner(&series.c, r2), horner(&series.cx, r2), horner(&series.cy, r2), horner(&series.cz, r2));
     let rho_n = rho.powi(n as i32);
     let l = x.ln() * (ki as f64 + 0.5 * nf) + y.ln() * (kj as f64 + 0.5 * nf);
     // Ω_z = x^{K_I} y^{K_J} Σ ĉ_k (N+2k) z^{N+2k-1} (xy)^{-k} = e^L Σ ĉ_k (N+2k) ρ^{N+2k-1} / √(xy);
-    // for N = 0 the k = 0 term vanishes, so divide G_z by ρ only when N = 0 (ρ^{2k-1} = ρ^{2k}/ρ).
-    let omega_z = if n == 0 { rho * series_shifted(ki, kj, rho * rho) / rt } else { rho.powi(n as i32 - 1) * gz / rt };
+    // for N = 0, G_z is stored divided by ρ² (`Coefficients::cz`), so ρ^{2k-1} = ρ · ρ^{2(k-1)}.
+    let omega_z = if n == 0 { rho * gz / rt } else { rho.powi(n as i32 - 1) * gz / rt };
     (l, rho_n * g, rho_n * gx / x, rho_n * gy / y, omega_z)
-}
-
-/// For N = 0: `Σ_{k>=1} ĉ_k 2k ρ^{2k-2}` (the z-derivative series divided by ρ).
-#[inline]
-fn series_shifted<T: Real>(ki: u32, kj: u32, r2: T) -> T {
-    let alpha = 0.5;
-    let (mut c, mut p, mut gz) = (1.0, T::one(), T::zero());
-    for k in 0..ki.min(kj) {
-        c *= ((ki - k) as f64) * ((kj - k) as f64) / (((k + 1) as f64) * (k as f64 + 1.0 + alpha));
-        gz += p * c * (2 * (k + 1)) as f64;
-        p *= r2;
-    }
-    gz
 }
 
 /// Closed form of the kinetic element with `Λ = 1 1^T/(2 m_tot)` over `e^L S_0` (docs/gvr.md):
@@ -305,7 +278,8 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     let y = ket.u.dot(&gj) * 0.5;
     let z = bra.u.dot(&gj) * 0.5;
     let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
-    let (l, om, ox, oy, oz) = omega(bra.k, ket.k, n, x, y, z);
+    let series = Coefficients::new(bra.k, ket.k, n);
+    let (l, om, ox, oy, oz) = omega(&series, x, y, z);
     let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
     let s = scale * om;
 
@@ -336,7 +310,6 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
 
     // Coulomb by exact Gauss–Legendre quadrature in τ (`quadrature`)
     let rule = go.legendre[(bra.k + ket.k + n) as usize];
-    let series = Coefficients::new(bra.k, ket.k, n);
     let mut v = T::zero();
     for (wv, q) in &ops.pairs {
         let c = dot_f(&mul(&wv.transpose(), &binv).transpose(), wv); // w^T B^{-1} w
@@ -457,7 +430,9 @@ mod tests {
     #[test]
     fn series_matches_hand_values() {
         // K_I = K_J = 1, N = 0: G = ĉ_0 + ĉ_1 ρ² with ĉ_1 = 1/(1·3/2) = 2/3
-        let (g, gx, gy, gz) = series(1, 1, 0, 0.25f64);
+        let series = Coefficients::new(1, 1, 0);
+        let (g, gx, gy) = (horner(&series.c, 0.25f64), horner(&series.cx, 0.25f64), horner(&series.cy, 0.25f64));
+        let gz = 0.25 * horner(&series.cz, 0.25f64); // stored divided by r for N = 0
         assert!((g - (1.0 + 0.25 * 2.0 / 3.0)).abs() < 1e-15);
         assert!((gx - 1.0).abs() < 1e-15 && (gy - 1.0).abs() < 1e-15);
         assert!((gz - 2.0 * 0.25 * 2.0 / 3.0).abs() < 1e-15);
