@@ -117,6 +117,8 @@ class Sampler:
     opts: Optimiser
     rng: np.random.Generator
     sets: list = field(default_factory=list)
+    # θ of the functions at the last `learn`, by channel and parameters (a sweep step changes one)
+    _thetas: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
         s, m, q = self.system, self.system.masses, self.system.charges
@@ -158,7 +160,7 @@ class Sampler:
         groups: dict[str, list[int]] = {}
         for i, ch in enumerate(basis.channels):
             groups.setdefault(ch, []).append(i)
-        seen, known = {}, getattr(self, "_thetas", {})
+        seen, known = {}, self._thetas
         for ch, idx in groups.items():
             if len(idx) < self.opts.learn_after:
                 continue
