@@ -18,9 +18,9 @@
 //!   `<N_TI²> = 4 [(Σ_i r̄_i × t_{I,i})·(Σ_k r̄_k × t_{J,k}) + 2 Σ_ik C_ik t_{I,i}·t_{J,k}] S`.
 use std::f64::consts::PI;
 
-use nalgebra::{Cholesky, SMatrix};
+use nalgebra::SMatrix;
 
-use crate::ecg::{re, Element, Mat, Operators, Real, Vector};
+use crate::ecg::{dot_f, inverse_log_det, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
 use crate::images::Transform;
 
@@ -156,25 +156,22 @@ fn row<const D: usize>(m: &Centres<D>, i: usize) -> [f64; 3] {
 /// elements are then NaN and the caller rejects them).
 #[inline]
 fn pair<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>) -> Option<(T, SMatrix<T, D, D>, Centres<D, T>)> {
-    let b = bra.a + ket.a;
-    let chol = Cholesky::new(b)?;
-    let log_det = crate::ecg::log_det_cholesky(&chol);
+    let (binv, log_det) = inverse_log_det(&(bra.a + ket.a))?;
     let v = bra.a_s + ket.a_s;
-    let rbar = chol.solve(&v);
+    let rbar = mul(&binv, &v);
     let delta = bra.s_a_s + ket.s_a_s - v.component_mul(&rbar).sum();
     let s = (((bra.log_det + ket.log_det) * 0.5 + D as f64 * 2f64.ln() - log_det) * 1.5 - delta).exp();
-    Some((s, chol.inverse(), rbar))
+    Some((s, binv, rbar))
 }
 
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised floating ECGs.
 pub fn element<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops: &Operators<D>) -> Element<T> {
     let Some((s, binv, rbar)) = pair(bra, ket) else { return Element::nan() };
-    let lam: SMatrix<T, D, D> = ops.lambda.map(re);
-    let w = bra.a * lam * ket.a;
+    let w = mul(&bra.a, &mul(&ops.lambda, &ket.a)); // A_I Λ A_J
     let r = binv.component_mul(&w.transpose()).sum();
     let di = rbar - bra.s;
     let dj = rbar - ket.s;
-    let q = di.component_mul(&(w * dj)).sum() * 4.0;
+    let q = di.component_mul(&mul(&w, &dj)).sum() * 4.0;
     let t = (r * 6.0 + q) * s;
     let t_ti = match ops.cm_mass {
         Some(m) => {
@@ -198,9 +195,8 @@ pub fn element<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops:
     };
     let mut v = T::zero();
     for (wv, qq) in &ops.pairs {
-        let wv: nalgebra::SVector<T, D> = wv.map(re);
-        let c = wv.dot(&(binv * wv));
-        let m = rbar.transpose() * wv; // 3-vector w^T r̄
+        let c = dot_f(&mul(&wv.transpose(), &binv).transpose(), wv); // w^T B^{-1} w
+        let m = mul(&wv.transpose(), &rbar); // 3-vector w^T r̄
         v += coulomb_factor(m.norm_squared(), c) * *qq;
     }
     Element { s, t, t_ti, v: v * s }
