@@ -1,8 +1,13 @@
 """Energy gained per second of a run, from its checkpoint's history (one entry per improving step:
 basis size, E, phase, elapsed seconds): per block of consecutive steps of one phase, and per
-window of `--window` seconds, with the distance to a reference energy.
+window of `--window` seconds, with the distance to a reference energy. With `--target`, a
+power law E − E_ref = a t^(−p) fitted (least squares in logs) to the history from each of the
+`--fit-from` seconds on, and the elapsed time at which it reaches E_target − E_ref: an
+extrapolation, not a measurement.
 
     python benchmarks/run_rates.py benchmarks/checkpoints/h2-cycles/basis.json --reference -1.164025030884 --since 5400
+    python benchmarks/run_rates.py benchmarks/checkpoints/h2-cycles/basis.json --reference -1.164025030884 \
+        --since 16000 --target -1.164025020 --fit-from 8000,12000,16000
 """
 from __future__ import annotations
 
@@ -18,6 +23,8 @@ def main():
     ap.add_argument("--reference", type=float, required=True, help="reference energy (Eh)")
     ap.add_argument("--window", type=float, default=600.0, help="seconds per window")
     ap.add_argument("--since", type=float, default=0.0, help="first elapsed second shown")
+    ap.add_argument("--target", type=float, default=None, help="target energy (Eh) for the power-law extrapolation")
+    ap.add_argument("--fit-from", default="0", help="comma-separated first elapsed seconds of the fits")
     args = ap.parse_args()
     history = json.loads(open(args.basis).read())["history"]
     t = np.array([h[3] for h in history])
@@ -45,6 +52,14 @@ def main():
         names = ", ".join(sorted({phase[i] for i in inside}))
         print(f"| {a:.0f}–{a + args.window:.0f} | {names} | {(e0 - E[inside[-1]]) / args.window:.2e} | "
               f"{E[inside[-1]] - args.reference:.3e} |")
+
+    if args.target is not None:
+        print(f"\n| fit from (s) | points | p | E − E_ref reaches {args.target - args.reference:.3e} after (h) |\n|---|---|---|---|")
+        for lo in (float(v) for v in args.fit_from.split(",")):
+            m = (t >= lo) & (E > args.reference)
+            slope, icpt = np.polyfit(np.log(t[m]), np.log(E[m] - args.reference), 1)
+            reach = np.exp((np.log(args.target - args.reference) - icpt) / slope)
+            print(f"| {lo:.0f} | {m.sum()} | {-slope:.2f} | {reach / 3600:.0f} |")
 
 
 if __name__ == "__main__":
