@@ -7,6 +7,7 @@ pub mod api;
 pub mod assemble;
 pub mod build;
 pub mod ecg;
+pub mod eigenpair;
 pub mod error;
 pub mod fecg;
 pub mod gradient;

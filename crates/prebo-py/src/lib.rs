@@ -425,6 +425,40 @@ fn lowest_with_added<'py>(
     Ok(numpy::ndarray::Array1::from_vec(out).into_pyarray(py))
 }
 
+/// Refined lowest `roots` eigenpairs of H c = E S c (prebo_core::eigenpair): from `e` (kept,
+/// ascending) and `c` (nb x kept, S-orthonormal columns) of a double-precision solver. Returns
+/// the energies (roots), the S-normalised vectors (nb x roots), the iterations and whether
+/// each root converged.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn refine_eigenpairs<'py>(
+    py: Python<'py>,
+    h: PyReadonlyArray2<f64>,
+    s: PyReadonlyArray2<f64>,
+    e: PyReadonlyArray1<f64>,
+    c: PyReadonlyArray2<f64>,
+    roots: usize,
+) -> PyResult<(Bound<'py, numpy::PyArray1<f64>>, Arr2<'py>, Vec<usize>, Vec<bool>)> {
+    let nb = h.as_array().nrows();
+    let kept = e.len()?;
+    if h.as_array().ncols() != nb || s.as_array().dim() != (nb, nb) || c.as_array().dim() != (nb, kept) {
+        return Err(ShapeError::new_err("H, S (nb x nb) and the eigenvectors (nb x kept) do not fit together"));
+    }
+    let (h, s) = (slice(&h, "h")?.to_vec(), slice(&s, "s")?.to_vec());
+    let (e, c) = (slice(&e, "e")?.to_vec(), slice(&c, "c")?.to_vec());
+    let out = py.allow_threads(|| prebo_core::eigenpair::refine_lowest(&h, &s, &e, &c, roots));
+    let energies = numpy::ndarray::Array1::from_iter(out.iter().map(|r| r.energy)).into_pyarray(py);
+    let mut vectors = vec![0.0; nb * out.len()];
+    for (m, r) in out.iter().enumerate() {
+        for (i, v) in r.vector.iter().enumerate() {
+            vectors[i * out.len() + m] = *v;
+        }
+    }
+    let iterations = out.iter().map(|r| r.iterations).collect();
+    let converged = out.iter().map(|r| r.converged).collect();
+    Ok((energies, matrix(py, nb, out.len(), vectors), iterations, converged))
+}
+
 /// Number of rayon worker threads in use.
 #[pyfunction]
 fn num_threads() -> usize {
@@ -443,6 +477,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fecg_row_gradient, m)?)?;
     m.add_function(wrap_pyfunction!(fecg_angular, m)?)?;
     m.add_function(wrap_pyfunction!(lowest_with_added, m)?)?;
+    m.add_function(wrap_pyfunction!(refine_eigenpairs, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add("MAX_DIM", api::MAX_DIM)?;
     Ok(())
