@@ -1,14 +1,21 @@
-"""Generalised eigenproblem: oracle checks against scipy, S-orthonormality, the secular update."""
+"""Generalised eigenproblem: oracle checks against scipy and mpmath, S-orthonormality, the secular
+update, the extended-precision refinement and the energy's uncertainty."""
+import json
+import subprocess
+import sys
+
+import mpmath
 import numpy as np
 import pytest
 import scipy.linalg
 
 import prebo
 from prebo import eigen
-from prebo.errors import NotPositiveDefiniteError
+from prebo.basis import Basis
+from prebo.errors import NotPositiveDefiniteError, PreboError
 from prebo.integrals import laboratory
 
-from conftest import random_basis
+from conftest import ROOT, random_basis
 
 
 @pytest.fixture(scope="module")
@@ -73,3 +80,94 @@ def test_indefinite_overlap_is_refused():
     S = np.array([[1.0, 2.0], [2.0, 1.0]])
     with pytest.raises(NotPositiveDefiniteError, match="not positive definite"):
         eigen.solve(np.eye(2), S)
+
+
+@pytest.fixture(scope="module")
+def h2plus_pecg():
+    """H2+ with 60 plain ECGs, overlap condition 4.7e12: LAPACK's lowest eigenvalue is 5e-9 off."""
+    basis = Basis.load(ROOT / "examples" / "bases" / "h2plus-pecg" / "basis.json")
+    return laboratory(basis.system).matrices(basis)
+
+
+def mp_eigenvalues(H, S, k, digits=50):
+    """The lowest k eigenvalues of H c = E S c in mpmath (Cholesky of S, then eigsy)."""
+    with mpmath.workdps(digits):
+        L = mpmath.cholesky(mpmath.matrix(S.tolist()))
+        Li = mpmath.inverse(L)
+        A = Li * mpmath.matrix(H.tolist()) * Li.T
+        return sorted(mpmath.eigsy((A + A.T) / 2, eigvals_only=True))[:k]
+
+
+def test_refinement_matches_mpmath_where_lapack_is_off(h2plus_pecg):
+    m = h2plus_pecg
+    H, S = m["T_ti"] + m["V"], m["S"]
+    exact = [float(e) for e in mp_eigenvalues(H, S, 2)]
+    lapack = eigen.solve(H, S, roots=0)
+    assert abs(lapack.energies[0] - exact[0]) > 1e-10  # double precision alone is off here
+    sol = eigen.solve(H, S, roots=2)
+    assert sol.energies[:2] == pytest.approx(exact, rel=1e-15, abs=0)
+    assert sol.energies[0] >= exact[0]  # a Rayleigh quotient: variational
+    C = sol.vectors[:, :2]
+    assert np.allclose(C.T @ S @ C, np.eye(2), atol=1e-6)  # S-normalised, (nearly) S-orthogonal
+
+
+def test_refinement_is_a_fixed_point(h2plus_pecg):
+    """Refining an already refined pair changes nothing."""
+    m = h2plus_pecg
+    H, S = m["T_ti"] + m["V"], m["S"]
+    sol = eigen.solve(H, S)
+    again = eigen.refine(H, S, sol)
+    assert again.energies[0] == sol.energies[0]
+
+
+@pytest.mark.parametrize("matrix", ["H", "S"])
+def test_non_finite_element_is_refused(problem, matrix):
+    _, _, _, m = problem
+    M = {"H": m["T_ti"] + m["V"], "S": m["S"].copy()}
+    M[matrix][2, 5] = M[matrix][5, 2] = np.nan
+    with pytest.raises(PreboError, match=rf"non-finite element {matrix}\[2, 5\] = nan"):
+        eigen.solve(M["H"], M["S"])
+
+
+def test_non_finite_energy_is_an_error_of_prebo_energy(tmp_path):
+    """A function whose exponent overflows the kinetic integral: one line on stderr, exit 2, no JSON."""
+    he = prebo.System(["alpha", "e", "e"], spin={"e": 0})
+    basis = random_basis(he, 3, np.random.default_rng(1), c_A=1.0)
+    A, c_A = basis.A.copy(), basis.c_A.copy()
+    A[0] *= 1e200  # with its c_A, so that the CM still separates
+    c_A[0] *= 1e200
+    Basis(he, A, c_A).save(tmp_path / "basis.json")
+    r = subprocess.run([sys.executable, "-m", "prebo", "energy", str(tmp_path / "basis.json"), "--json"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.count("\n") == 1 and "non-finite element H[0, 0] = nan" in r.stderr
+
+
+def test_uncertainty_matches_a_perturbation_experiment(h2plus_pecg):
+    """Every element of S, T_TI and V perturbed by an independent symmetric relative error of
+    ELEMENT_ERROR: the spread of the re-solved energies is the estimate (first-order theory)."""
+    m = h2plus_pecg
+    sol = eigen.solve(m["T_ti"] + m["V"], m["S"])
+    e0 = sol.energies[0]
+    estimate = eigen.energy_uncertainty(sol.vectors[:, 0], e0, m["S"], m["T_ti"], m["V"])
+    rng = np.random.default_rng(3)
+    n = len(m["S"])
+
+    def noisy(M):
+        Z = np.triu(rng.normal(size=(n, n)))
+        return M * (1.0 + eigen.ELEMENT_ERROR * (Z + np.triu(Z, 1).T))
+
+    energies = []
+    for _ in range(60):
+        T, V = noisy(m["T_ti"]), noisy(m["V"])
+        energies.append(eigen.solve(T + V, noisy(m["S"])).energies[0])
+    assert 0.7 < np.std(energies, ddof=1) / estimate < 1.4
+    assert estimate > 1e-9  # this basis is resolved no better than ~1e-8 relative
+
+
+def test_optimiser_energy_is_a_fresh_evaluation(tmp_path):
+    """The energy the optimiser checkpoints is the one `prebo.evaluate` finds for its basis, bit for bit."""
+    he = prebo.System(["alpha", "e", "e"], spin={"e": 0})
+    basis = prebo.optimise(he, prebo.Optimiser(size=8, trials=5, sweeps=1, seed=2), out=tmp_path, progress=False)
+    checkpoint = json.loads((tmp_path / "basis.json").read_text())
+    assert checkpoint["energy"] == prebo.evaluate(basis)["energy"]

@@ -1,9 +1,16 @@
 """Energies of a basis: translation-free and laboratory-frame, with the virial coefficient.
 
-result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_lab
-(with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential, n_basis,
-basis_type, particles, state, symmetry, coordinates, overlap_condition, kept; for
+result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_uncertainty
+(Eh, below), energy_lab (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential,
+n_basis, basis_type, particles, state, symmetry, coordinates, overlap_condition, kept; for
 floating ECGs also n2 = <N²>_TI (their functions are not angular-momentum eigenfunctions).
+
+The energy is the lowest eigenvalue of the stored matrices refined in extended precision
+(`eigen.solve`), the same to ~1e-15 relative on every machine. energy_uncertainty is the standard
+deviation that element errors of a few ulp (4 u each, independent) of S, T_TI and V give it,
+ε (2 Σ_ij w_ij − Σ_i w_ii)^½ with w_ij = c_i² c_j² (T_ij² + V_ij² + E² S_ij²) (`eigen.energy_uncertainty`;
+docs/conventions.md compares it with Monte-Carlo perturbations): an ill-conditioned basis resolves
+its energy no better than this. A non-finite energy or element is an error, never a number.
 """
 from __future__ import annotations
 
@@ -11,6 +18,7 @@ import numpy as np
 
 from . import eigen
 from .basis import Basis
+from .errors import PreboError
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
 
 
@@ -31,6 +39,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
     c = ti.vectors[:, 0]
     kinetic, potential = float(c @ m["T_ti"] @ c), float(c @ m["V"] @ c)
     energy = float(ti.energies[0])
+    uncertainty = eigen.energy_uncertainty(c, energy, m["S"], m["T_ti"], m["V"])
     if energy_lab is None:
         energy_lab = energy + 1.5 * c_A / system.m_total
     extra = {}
@@ -39,6 +48,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
         extra["n2"] = float(c @ n2 @ c)
     return extra | {
         "energy": energy,
+        "energy_uncertainty": uncertainty,
         "energy_lab": energy_lab,
         "virial": abs(1.0 + potential / (2.0 * kinetic)),
         "kinetic": kinetic,
@@ -56,5 +66,10 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
 
 
 def public(result: dict) -> dict:
-    """The JSON-ready part of a result (no arrays)."""
-    return {k: v for k, v in result.items() if not isinstance(v, np.ndarray)}
+    """The JSON-ready part of a result (no arrays); a non-finite number is a PreboError, since
+    JSON has none."""
+    out = {k: v for k, v in result.items() if not isinstance(v, np.ndarray)}
+    for k, v in out.items():
+        if isinstance(v, float) and not np.isfinite(v):
+            raise PreboError(f"the result's {k} is {v}, not a finite number")
+    return out
