@@ -12,7 +12,7 @@ import scipy.linalg
 import prebo
 from prebo import eigen
 from prebo.basis import Basis
-from prebo.errors import NotPositiveDefiniteError, PreboError
+from prebo.errors import LinearDependenceError, NotPositiveDefiniteError, PreboError
 from prebo.integrals import laboratory
 
 from conftest import ROOT, random_basis
@@ -118,6 +118,18 @@ def test_refinement_is_a_fixed_point(h2plus_pecg):
     sol = eigen.solve(H, S)
     again = eigen.refine(H, S, sol)
     assert again.energies[0] == sol.energies[0]
+
+
+def test_refinement_that_does_not_converge_is_refused(problem):
+    """An eigenbasis too poor to converge from (every other root at E_0 + 1e-12) gives an error
+    naming the overlap condition, never a number."""
+    _, _, _, m = problem
+    H, S = m["T_ti"] + m["V"], m["S"]
+    sol = eigen.solve(H, S)
+    poor = eigen.Eigen(np.full_like(sol.energies, sol.energies[0] + 1e-12), sol.vectors, sol.kept,
+                       sol.overlap_condition)
+    with pytest.raises(LinearDependenceError, match="cannot resolve this basis \\(overlap condition"):
+        eigen.refine(H, S, poor)
 
 
 @pytest.mark.parametrize("matrix", ["H", "S"])
