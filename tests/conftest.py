@@ -1,10 +1,10 @@
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import prebo
+from prebo.inputs import tomllib  # tomli before Python 3.11
 
 ROOT = Path(__file__).resolve().parents[1]
 

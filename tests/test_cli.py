@@ -65,13 +65,13 @@ def assert_clean_error(r, *words):
 
 @pytest.mark.parametrize("particles, state, words", [
     ('["p", "xyz"]', "", ["unknown particle 'xyz'"]),
-    ('[{name = "p", mass = -3.0}, "e"]', "", ["mass must be a positive"]),
-    ('[{name = "p", mass = 0}, "e"]', "", ["mass must be a positive"]),
+    ('[{name = "p", mass = -3.0}, "e"]', "", ["mass = -3.0: must be a finite positive number"]),
+    ('[{name = "p", mass = 0}, "e"]', "", ["mass = 0: must be a finite positive number"]),
     ('["alpha", "e", "e", "e"]', "[state]\nspin = { e = 1 }\n", ["cannot couple to total spin 1"]),
-    ('["p", "e", "e"]', "[state]\nspin = { e = 0.3 }\n", ["cannot couple"]),
+    ('["p", "e", "e"]', "[state]\nspin = { e = 0.3 }\n", ["spin of 'e' = 0.3: must be a spin 0, 1/2, 1"]),
     ('["p", "e"]', "[state]\nN = 1\n", ["N = 0"]),
     ('["p", "e"]', "[optimiser]\ncycle = 2\n", ["unknown keys ['cycle']", "'cycles'"]),
-    ('["p", "e"]', "[optimiser]\ncycles = 0\n", ["cycles must be a positive integer"]),
+    ('["p", "e"]', "[optimiser]\ncycles = 0\n", ["[optimiser] cycles = 0: must be an integer ≥ 1"]),
 ])
 def test_bad_input_gives_a_clear_error(tmp_path, particles, state, words):
     f = tmp_path / "bad.toml"

@@ -15,12 +15,14 @@ import json
 import os
 import tempfile
 from dataclasses import dataclass, field
+from glob import escape as glob_escape
 from pathlib import Path
 
 import numpy as np
 
-from .errors import BasisFileError, InputError, NotPositiveDefiniteError, PreboError, SeparabilityError
+from .errors import BasisFileError, InputError, NotPositiveDefiniteError, OutputError, PreboError, SeparabilityError
 from .system import System
+from .validation import BASIS_TYPES, SETTINGS, check_kind
 
 FORMAT = "prebo-basis"
 VERSION = 1
@@ -38,7 +40,8 @@ PARAMETERS = {
     "ecg-gvr": {"u": ("n",), "K": ()},
     "fecg": {"s": ("n", 3)},
 }
-KINDS = tuple(PARAMETERS)
+KINDS = BASIS_TYPES  # the keys of PARAMETERS
+K_LIMIT = SETTINGS["K_max"].rule.hi
 
 
 @dataclass
@@ -65,14 +68,15 @@ class Basis:
             raise InputError(f"basis: {nb} exponent matrices but {len(self.c_A)} values of c_A")
         if self.kind not in KINDS:
             raise InputError(f"basis type {self.kind!r} is not one of {', '.join(KINDS)}")
+        check_kind(self.kind, self.system.state)
         for name, shape in PARAMETERS[self.kind].items():
             value = getattr(self, name)
             if value is None:
                 raise InputError(f"a {self.kind} basis needs the parameters {name!r}")
             value = np.asarray(value)
             if name == "K":
-                if np.any(value < 0) or np.any(value != np.round(value)):
-                    raise InputError("basis: every K must be a non-negative integer")
+                if not np.all((value >= 0) & (value <= K_LIMIT) & (value == np.round(value))):
+                    raise InputError(f"basis: every K must be an integer in 0..{K_LIMIT}")
                 value = value.astype(np.uint32)
             else:
                 value = value.astype(float)
@@ -183,7 +187,9 @@ class Basis:
         write_json_atomic(path, self.to_dict(extra))
 
     @classmethod
-    def from_dict(cls, d: dict, where: str = "basis") -> "Basis":
+    def from_dict(cls, d: dict, where: str = "basis", empty: bool = False) -> "Basis":
+        """The basis of a basis.json mapping; BasisFileError naming `where` for anything wrong,
+        including no functions at all (unless `empty`: a checkpoint before the first one)."""
         if not isinstance(d, dict) or d.get("format") != FORMAT:
             raise BasisFileError(f"{where}: not a prebo basis file (format must be {FORMAT!r})")
         if d.get("version") != VERSION:
@@ -206,8 +212,10 @@ class Basis:
             raise BasisFileError(f"{where}: {exc}") from exc
         except (KeyError, TypeError, ValueError) as exc:
             raise BasisFileError(f"{where}: malformed basis data ({type(exc).__name__}: {exc})") from exc
-        if coef is not None and coef.shape != (len(A),):
-            raise BasisFileError(f"{where}: {coef.size} coefficients for {len(A)} functions")
+        if not (empty or len(A)):
+            raise BasisFileError(f"{where}: the basis has no functions")
+        if coef is not None and (coef.shape != (len(A),) or not np.all(np.isfinite(coef))):
+            raise BasisFileError(f"{where}: coefficients must be {len(A)} finite numbers, one per function")
         try:
             basis.validate()
         except PreboError as exc:
@@ -235,21 +243,40 @@ def read_text(path: Path, error: type[PreboError]) -> str:
         raise error(f"{path}: not a text file ({exc.reason})") from exc
 
 
-def write_json_atomic(path, obj) -> None:
-    """json.dump to a temporary file in the same folder, fsync, then os.replace."""
+def write_atomic(path, text: str) -> None:
+    """Write `text` to a temporary file in the same folder (PATH.*.tmp), fsync, then os.replace:
+    a killed writer leaves the old file or the new one, never half of one. OutputError naming
+    the path if it cannot be written."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write ({exc.strerror})") from exc
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 would hide results from other users
     try:
         with os.fdopen(fd, "w") as f:
-            json.dump(obj, f, indent=1)
+            f.write(text)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise OutputError(f"{path}: cannot write ({exc.strerror})") from exc
         raise
+
+
+def write_json_atomic(path, obj) -> None:
+    """`write_atomic` of strict JSON (ValueError on NaN or infinity, which JSON cannot hold)."""
+    write_atomic(path, json.dumps(obj, indent=1, allow_nan=False))
+
+
+def remove_stale_temporaries(path) -> None:
+    """Delete the temporary files a killed `write_atomic` of `path` left behind."""
+    path = Path(path)
+    for f in path.parent.glob(glob_escape(path.name) + ".*.tmp"):
+        f.unlink(missing_ok=True)

@@ -3,11 +3,22 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import os
 import sys
 import time
 from pathlib import Path
 
-from .errors import PreboError
+from .errors import NonFiniteError, OutputError, PreboError
+
+
+def _finite(r: dict) -> dict:
+    """The result `r`, or NonFiniteError naming the keys that are not finite numbers."""
+    bad = [f"{k} = {v}" for k, v in r.items() if isinstance(v, float) and not math.isfinite(v)]
+    if bad:
+        raise NonFiniteError(f"the result is not finite ({', '.join(bad)}): the basis's integrals "
+                             "overflow or lost their digits")
+    return r
 
 
 def _print_result(r: dict) -> None:
@@ -28,24 +39,36 @@ def _print_result(r: dict) -> None:
 def cmd_run(args) -> int:
     from . import inputs
     from .basis import write_json_atomic
-    from .errors import InputError
+    from .errors import InputError, StalledError
     from .optimise import optimise, resume_from
     from .results import evaluate, public
 
     t0 = time.perf_counter()
     if args.resume:
         out = Path(args.resume)
-        basis, _ = resume_from(out, progress=not args.quiet)
-        title, source = basis.system.label(), str(out / "basis.json")
+        title, source = None, str(out / "basis.json")
     else:
         if args.input is None:
             raise InputError("give an input file, or --resume DIR")
         job = inputs.load(args.input)
         out = Path(args.out or Path("runs") / Path(args.input).stem)
-        out.mkdir(parents=True, exist_ok=True)
-        basis = optimise(job.system, job.optimiser, out=out, progress=not args.quiet)
         title, source = job.title, str(args.input)
-    r = public(evaluate(basis))
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise OutputError(f"--out {out}: cannot create the output folder ({exc.strerror})") from exc
+    try:
+        if args.resume:
+            basis, _ = resume_from(out, progress=not args.quiet)
+        else:
+            basis = optimise(job.system, job.optimiser, out=out, progress=not args.quiet)
+    except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
+        raise StalledError(f"{source}: {exc}") from exc
+    title = title or basis.system.label()
+    try:
+        r = _finite(public(evaluate(basis)))
+    except PreboError as exc:
+        raise type(exc)(f"{out / 'basis.json'}: {exc}") from exc
     r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source}
     write_json_atomic(out / "result.json", r)
     if not args.quiet:
@@ -56,8 +79,9 @@ def cmd_run(args) -> int:
 
 def cmd_import(args) -> int:
     from .ecgpack import read_inout
+    from .validation import check
 
-    basis = read_inout(args.file, c_A=args.c_A)
+    basis = read_inout(args.file, c_A=check("c_A", args.c_A, "--c-A"))
     out = Path(args.out or str(args.file).removesuffix(".txt").removesuffix(".inout") + ".json")
     basis.save(out)
     print(f"wrote {out} ({len(basis)} {basis.kind} functions, {basis.system.label()})")
@@ -80,7 +104,11 @@ def cmd_export(args) -> int:
 def cmd_plot(args) -> int:
     from .plot import convergence
 
-    png = convergence(args.runs, args.out or Path(args.runs[0]) / "convergence.png", args.reference)
+    png = args.out or Path(args.runs[0]) / "convergence.png"
+    try:
+        convergence(args.runs, png, args.reference)
+    except OSError as exc:
+        raise OutputError(f"{png}: cannot write ({exc.strerror})") from exc
     print(f"wrote {png}")
     return 0
 
@@ -99,16 +127,26 @@ def cmd_energy(args) -> int:
     from .results import evaluate, public
 
     basis = load_basis(args.basis)
-    r = public(evaluate(basis, coordinates=args.coordinates))
+    try:
+        r = _finite(public(evaluate(basis, coordinates=args.coordinates)))
+    except PreboError as exc:
+        raise type(exc)(f"{args.basis}: {exc}") from exc
     if args.json:
-        print(json.dumps(r))
+        print(json.dumps(r, allow_nan=False))
     else:
         _print_result(r)
     return 0
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse with the one-line errors of every other failure (exit 2)."""
+
+    def error(self, message):
+        self.exit(2, f"prebo: error: {self.prog}: {message} (see {self.prog} --help)\n")
+
+
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="prebo", description="pre-Born–Oppenheimer ECG solver")
+    p = Parser(prog="prebo", description="pre-Born–Oppenheimer ECG solver")
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="optimise a basis for the system of a TOML input")
     run.add_argument("input", nargs="?", help="TOML input file")
@@ -143,9 +181,15 @@ def parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     args = parser().parse_args(argv)
     try:
-        return args.func(args)
+        status = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, not at exit
+        return status
     except PreboError as exc:
-        print(f"prebo: error: {exc}", file=sys.stderr)
+        print("prebo: error: " + " ".join(str(exc).split("\n")), file=sys.stderr)  # one line, always
+        return 2
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit
+        print("prebo: error: standard output was closed before the result was written", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("prebo: interrupted (the last accepted step is saved)", file=sys.stderr)

@@ -89,6 +89,7 @@ def jacobi(masses: np.ndarray, order=None) -> CoordinateSet:
 def heavy_particle_centred(masses: np.ndarray, centre: int) -> CoordinateSet:
     """Heavy-particle-centred set (paper eq. HPC-TICC): x_i = r_i - r_centre for i != centre."""
     n = len(masses)
+    _particle_index(centre, n, "hpc")
     U = np.zeros((n, n))
     for row, i in enumerate(k for k in range(n) if k != centre):
         U[row, i], U[row, centre] = 1.0, -1.0
@@ -104,12 +105,18 @@ def cm_centred(masses: np.ndarray, dropped: int | None = None) -> CoordinateSet:
     """
     n = len(masses)
     dropped = n - 1 if dropped is None else dropped
+    _particle_index(dropped, n, "cmc")
     U = np.zeros((n, n))
     for row, i in enumerate(k for k in range(n) if k != dropped):
         U[row] = -masses / masses.sum()
         U[row, i] += 1.0
     U[-1] = masses / masses.sum()
     return CoordinateSet(f"cmc:{dropped}", U)
+
+
+def _particle_index(i: int, n: int, kind: str) -> None:
+    if not 0 <= i < n:
+        raise InputError(f"coordinate set {kind}:{i}: particle {i} is not one of 0..{n - 1}")
 
 
 def all_sets(masses: np.ndarray, labels=None) -> list[CoordinateSet]:
@@ -139,14 +146,16 @@ def all_sets(masses: np.ndarray, labels=None) -> list[CoordinateSet]:
 
 def by_name(masses: np.ndarray, name: str) -> CoordinateSet:
     """The set named as in `CoordinateSet.name` ("jacobi:0-1-2", "hpc:0", "cmc:2")."""
-    kind, _, arg = name.partition(":")
+    kind, _, arg = str(name).partition(":")
     try:
-        if kind == "jacobi":
-            return jacobi(masses, [int(k) for k in arg.split("-")] if arg else None)
-        if kind == "hpc":
-            return heavy_particle_centred(masses, int(arg))
-        if kind == "cmc":
-            return cm_centred(masses, int(arg) if arg else None)
-    except ValueError as exc:
-        raise InputError(f"malformed coordinate set name {name!r}") from exc
-    raise InputError(f"unknown coordinate set {name!r} (jacobi:ORDER, hpc:I or cmc:I)")
+        numbers = [int(k) for k in arg.split("-")] if arg else []
+    except ValueError:
+        raise InputError(f"malformed coordinate set name {name!r}") from None
+    if kind == "jacobi":
+        return jacobi(masses, numbers or None)
+    if kind == "hpc" and len(numbers) == 1:
+        return heavy_particle_centred(masses, numbers[0])
+    if kind == "cmc" and len(numbers) <= 1:
+        return cm_centred(masses, numbers[0] if numbers else None)
+    raise InputError(f"unknown coordinate set {name!r} (jacobi:ORDER, hpc:I or cmc:I with particles "
+                     f"0..{len(masses) - 1})")

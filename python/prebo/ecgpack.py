@@ -93,12 +93,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .basis import Basis, read_text
+from .basis import Basis, read_text, write_atomic
 from .coordinates import heavy_particle_centred
 from .errors import BasisFileError, PreboError, UnsupportedError
 from .particles import KNOWN
 from .symmetry import Group, Symmetriser
 from .system import State, System
+from .validation import check
 
 __all__ = [
     "read_inout", "write_inout", "parse_inout", "InoutFile", "YoungSystem", "system_with_symmetry",
@@ -626,8 +627,7 @@ def _system(f: InoutFile) -> System:
 
 
 def _basis(f: InoutFile, c_A: float) -> Basis:
-    if not c_A > 0:
-        raise ValueError(f"c_A must be positive, got {c_A!r}")
+    c_A = check("c_A", c_A)
     system = _system(f)
     hpc = heavy_particle_centred(system.masses, 0)
     A_int = f.exponents()
@@ -707,10 +707,7 @@ def write_inout(basis: Basis, path, energy: float | None = None) -> None:
     the energy of a nearly linearly dependent basis such as He-490 by ~1e-12 relative.) The header gives the masses
     and charges in the basis's particle order, the SYMMETRY string (`young_string`) and
     CURRENT_ENERGY: `energy` if given, else the translation-free energy prebo.evaluate
-    computes. The file is written atomically (temporary file, then rename)."""
-    import os
-    import tempfile
-
+    computes. The file is written atomically (basis.write_atomic)."""
     system = basis.system
     n = system.n
     if n < 2:
@@ -756,14 +753,4 @@ def write_inout(basis: Basis, path, energy: float | None = None) -> None:
         " ==============================",
     ]
     out += [f" {k + 1:6d}" + "".join(_fmt(x) for x in v) for k, v in enumerate(vech)]
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write("\n".join(out) + "\n")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    write_atomic(path, "\n".join(out) + "\n")

@@ -39,3 +39,15 @@ class UnsupportedError(PreboError):
 
 class SeparabilityError(PreboError):
     """A basis that does not factor into CM x internal parts where that is required."""
+
+
+class OutputError(PreboError):
+    """An output file or folder that cannot be written."""
+
+
+class NonFiniteError(PreboError):
+    """A result that is not a finite number (NaN or infinite)."""
+
+
+class StalledError(PreboError):
+    """An optimisation that cannot proceed with its settings (every trial rejected)."""

@@ -4,21 +4,30 @@
     [state]      N = 0, parity = 1, spin = {e = 0}                                          -> State
     [basis]      type = "pecg" | "ecg-gvr" | "fecg", size = 100, c_A = 1.0, K_max = 20               -> Optimiser.kind, .size, .c_A, .K_max
     [optimiser]  trials = 20, sweeps = 1, seed = 1, channels = "pairs", length_range = [0.01, 15]
+
+Every value is checked against validation.SETTINGS, the basis type against the state and the
+coordinate sets against the particles before anything runs; errors name the file and the key.
 """
 from __future__ import annotations
 
-import tomllib
-from dataclasses import dataclass, fields
+import sys
+from dataclasses import dataclass
 from pathlib import Path
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # Python 3.10: the same parser as a package
+    import tomli as tomllib
 
 from .basis import read_text
 from .errors import InputError
-from .optimise import Optimiser
+from .optimise import Optimiser, coordinate_sets
 from .system import State, System
+from .validation import SETTINGS, check, check_kind
 
-BASIS_TYPES = ("pecg", "ecg-gvr", "fecg")
-#: every Optimiser setting but those [basis] gives
-OPTIMISER_KEYS = {f.name for f in fields(Optimiser)} - {"size", "c_A", "kind", "K_max"}
+#: [basis] key -> Optimiser setting; [optimiser] takes every other setting
+BASIS_KEYS = {"type": "kind", "size": "size", "c_A": "c_A", "K_max": "K_max"}
+OPTIMISER_KEYS = set(SETTINGS) - set(BASIS_KEYS.values())
 
 
 @dataclass
@@ -46,22 +55,19 @@ def from_dict(d: dict) -> Job:
         raise InputError(f"unknown tables {sorted(unknown)}")
     system_t = _table(d, "system", {"particles"})
     state_t = _table(d, "state", {"N", "parity", "spin"})
-    basis_t = _table(d, "basis", {"type", "size", "c_A", "K_max"})
+    basis_t = _table(d, "basis", set(BASIS_KEYS))
     opt_t = _table(d, "optimiser", OPTIMISER_KEYS)
     if "particles" not in system_t:
         raise InputError("[system] needs 'particles'")
+    title = d.get("title")
+    if title is not None and not isinstance(title, str):
+        raise InputError(f"title = {title!r}: must be a string")
     system = System(system_t["particles"], State(**state_t))
-    kind = basis_t.get("type", "pecg")
-    if kind not in BASIS_TYPES:
-        raise InputError(f"[basis] type {kind!r} is not available (available: {', '.join(BASIS_TYPES)})")
-    if kind == "pecg" and (system.state.N != 0 or system.state.parity != 1):
-        raise InputError("plain ECGs describe N = 0, parity +1 states only")
-    if kind == "ecg-gvr" and system.state.parity != (-1) ** system.state.N:
-        raise InputError(f"ECG-GVR functions have natural parity (-1)^N = {(-1) ** system.state.N:+d}, "
-                         f"not {system.state.parity:+d}")
-    kw = {k: basis_t[k] for k in ("size", "c_A", "K_max") if k in basis_t} | opt_t | {"kind": kind}
-    opts = Optimiser.from_dict(kw)
-    return Job(str(d.get("title", system.label())), system, opts, kind)
+    settings = {BASIS_KEYS[k]: v for k, v in basis_t.items()} | opt_t
+    opts = Optimiser(**{name: check(name, v, SETTINGS[name].key) for name, v in settings.items()})
+    check_kind(opts.kind, system.state)
+    coordinate_sets(system, opts.channels)
+    return Job(title or system.label(), system, opts, opts.kind)
 
 
 def load(path) -> Job:

@@ -22,10 +22,14 @@ Functions are drawn in a coordinate set ("channel") or in pair form:
   A^(r) = U_x^T blockdiag(𝒜, c_A) U_x.
 With an output folder, the basis, the random-number state and the position in the
 schedule are written atomically after every step: a killed run loses at most the step
-in flight, and `prebo run --resume` continues it bit for bit.
+in flight, and `prebo run --resume` continues it bit for bit; every start removes the
+temporary files (basis.json.*.tmp) a write killed in flight left. Growth never hangs: after
+`STALL_STEPS` steps in a row whose every trial was rejected, the run stops (StalledError)
+naming the settings to change.
 """
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,17 +38,20 @@ import numpy as np
 
 from . import coordinates as coords
 from . import eigen
-from .basis import Basis
-from .errors import IllConditionedError, InputError
+from .basis import Basis, remove_stale_temporaries
+from .errors import BasisFileError, IllConditionedError, InputError, PreboError, StalledError
 from .integrals import laboratory
 from .polish import polish
-from .refine import METHODS, Parametrisation, refine_function, regenerate_function
+from .refine import Parametrisation, refine_function, regenerate_function
 from .system import System
+from .validation import check_settings, number, strict_keywords
 
 
+@strict_keywords
 @dataclass
 class Optimiser:
-    """Settings of `optimise` (TOML table [optimiser]; `size`, `c_A`, `kind`, `K_max` come from [basis])."""
+    """Settings of `optimise` (TOML table [optimiser]; `size`, `c_A`, `kind`, `K_max` come from [basis]);
+    types, ranges and meanings: validation.SETTINGS."""
 
     size: int = 50
     trials: int = 20
@@ -72,41 +79,28 @@ class Optimiser:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Optimiser":
-        d = dict(d)
-        d["length_range"] = tuple(d.get("length_range", cls.length_range))
-        try:
-            return cls(**d)
-        except TypeError as exc:
-            raise InputError(f"optimiser settings: {exc}") from exc
+        if not isinstance(d, dict):
+            raise InputError(f"optimiser settings must be a table, got {d!r}")
+        return cls(**d)
 
     def __post_init__(self):
-        if not (isinstance(self.size, int) and self.size >= 1):
-            raise InputError(f"basis size must be a positive integer, got {self.size!r}")
-        if not (isinstance(self.trials, int) and self.trials >= 1):
-            raise InputError(f"optimiser.trials must be a positive integer, got {self.trials!r}")
-        if not (isinstance(self.sweeps, int) and self.sweeps >= 0):
-            raise InputError(f"optimiser.sweeps must be a non-negative integer, got {self.sweeps!r}")
-        lo, hi = self.length_range
-        if not 0 < lo < hi:
-            raise InputError(f"optimiser.length_range must be 0 < lo < hi, got {self.length_range!r}")
-        if not self.c_A > 0:
-            raise InputError(f"basis.c_A must be positive, got {self.c_A!r}")
-        if self.kind not in ("pecg", "ecg-gvr", "fecg"):
-            raise InputError(f"basis.type must be 'pecg', 'ecg-gvr' or 'fecg', got {self.kind!r}")
-        if not 0.0 <= self.learned <= 1.0:
-            raise InputError(f"optimiser.learned must be a probability in [0, 1], got {self.learned!r}")
-        if not (isinstance(self.refine, int) and self.refine >= 0):
-            raise InputError(f"optimiser.refine must be a non-negative integer, got {self.refine!r}")
-        if not (isinstance(self.polish, int) and self.polish >= 0):
-            raise InputError(f"optimiser.polish must be a non-negative integer, got {self.polish!r}")
-        if not (isinstance(self.cycles, int) and self.cycles >= 1):
-            raise InputError(f"optimiser.cycles must be a positive integer, got {self.cycles!r}")
-        if not (isinstance(self.polish_iterations, int) and self.polish_iterations >= 1):
-            raise InputError(f"optimiser.polish_iterations must be a positive integer, got {self.polish_iterations!r}")
-        if self.refine_method not in METHODS:
-            raise InputError(f"optimiser.refine_method must be one of {', '.join(METHODS)}, got {self.refine_method!r}")
-        if not (isinstance(self.K_max, int) and 0 <= self.K_max <= 60):
-            raise InputError(f"basis.K_max must be an integer in 0..60, got {self.K_max!r}")
+        check_settings(self, "Optimiser")
+
+
+def coordinate_sets(system: System, channels) -> list[coords.CoordinateSet]:
+    """The coordinate sets of the `channels` setting ([] for "pairs"), checked against the system."""
+    m = system.masses
+    if channels == "pairs":
+        return []
+    if channels == "all":
+        return coords.all_sets(m, [p.name for p in system.particles])
+    try:
+        sets = [coords.by_name(m, name) for name in channels]
+        for x in sets:
+            x.check(m)
+    except InputError as exc:
+        raise InputError(f"channels: {exc}") from exc
+    return sets
 
 
 @dataclass
@@ -129,17 +123,7 @@ class Sampler:
                 if i != j:
                     mu = m[i] * m[j] / (m[i] + m[j])
                     self.length[i, j] = 1.0 / (min(mu, 1.0) * max(abs(q[i] * q[j]), 1.0))
-        ch = self.opts.channels
-        if ch == "pairs":
-            self.sets = []
-        elif ch == "all":
-            self.sets = coords.all_sets(m, [p.name for p in s.particles])
-        elif isinstance(ch, (list, tuple)):
-            self.sets = [coords.by_name(m, name) for name in ch]
-        else:
-            raise InputError(f"optimiser.channels must be 'pairs', 'all' or a list of coordinate sets, not {ch!r}")
-        for x in self.sets:
-            x.check(m)
+        self.sets = coordinate_sets(s, self.opts.channels)
         self.pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
 
     def _b(self, a, size=None):
@@ -334,6 +318,9 @@ class State:
         self.solve()
 
 
+PHASES = ("grow", "sweep", "refine", "polish", "done")
+
+
 @dataclass
 class Cursor:
     """The next unit of work: one competitive step ("grow"), function `index` of
@@ -344,6 +331,12 @@ class Cursor:
     sweep: int = 0
     index: int = 0
     cycle: int = 0
+
+    def __post_init__(self):
+        counts = (self.sweep, self.index, self.cycle)
+        if self.phase not in PHASES or not all(type(k) is int and k >= 0 for k in counts):
+            raise InputError(f"progress {vars(self)}: phase must be one of {', '.join(PHASES)}, "
+                             "sweep, index and cycle non-negative integers")
 
     def advance(self, nb: int, opts: Optimiser) -> "Cursor":
         if self.phase == "grow":
@@ -369,6 +362,7 @@ class Cursor:
 
 
 CHECKPOINT = "basis.json"
+STALL_STEPS = 100  # growth steps in a row without an accepted trial before the run stops (StalledError)
 
 
 def optimise(system: System, opts: Optimiser, out: Path | None = None, progress: bool = True,
@@ -377,16 +371,19 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     sweeps, `opts.refine` refinement sweeps and `opts.polish` joint steps. With `out`, the basis, the random-number state and the
     position in this schedule are written atomically after every step (out/basis.json); `resume`
     (that file's content) continues such a run exactly where it stopped."""
+    if not isinstance(system, System):
+        raise InputError(f"optimise: system = {system!r}: must be a prebo.System")
+    if not isinstance(opts, Optimiser):
+        raise InputError(f"optimise: opts = {opts!r}: must be a prebo.Optimiser")
     rng = np.random.default_rng(opts.seed)
     sampler = Sampler(system, opts, rng)
     rep = laboratory(system)
     if resume is None:
         basis, cursor, history, elapsed = Basis.empty(system, opts.kind), Cursor().advance(0, opts), [], 0.0
     else:
-        basis = Basis.from_dict(resume, "checkpoint")
-        rng.bit_generator.state = resume["rng"]
-        cursor, history = Cursor(**resume["progress"]), resume["history"]
-        elapsed = float(resume.get("elapsed", 0.0))
+        basis, cursor, history, elapsed = _resumed(resume, opts, rng, "checkpoint")
+    if out is not None:
+        remove_stale_temporaries(Path(out) / CHECKPOINT)
     t_start = time.perf_counter()
 
     def wall() -> float:
@@ -400,13 +397,15 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     def checkpoint():
         if out is not None:
             st.basis.coefficients = st.eig.vectors[:, 0] if st.eig is not None else None
+            energy = st.energy if np.isfinite(st.energy) else None  # inf before the first function
             st.basis.save(Path(out) / CHECKPOINT, {
-                "energy": st.energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
+                "energy": energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
                 "rng": rng.bit_generator.state, "history": history, "elapsed": wall()})
 
     def draw(k) -> Basis:
         return Basis.concat([sampler.draw() for _ in range(k)])
 
+    stalled = 0  # growth steps in a row that added nothing
     with report:
         while cursor.phase != "done":
             old = st.energy
@@ -417,8 +416,17 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 report.trials(len(trials))
                 if np.isfinite(energies[best]) and energies[best] < st.energy:
                     st.put(len(st.basis), trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
+                    stalled = 0
                     if opts.refine:  # competitive selection, then Powell refinement of the winner
                         refine_function(st, len(st.basis) - 1, opts.refine_evaluations, opts.refine_method)
+                else:
+                    stalled += 1
+                    if stalled == STALL_STEPS:
+                        raise StalledError(
+                            f"optimiser: every trial of the last {stalled} growth steps was rejected at "
+                            f"{len(st.basis)} functions (linearly dependent on the basis or implausible); raise "
+                            f"max_overlap (now {opts.max_overlap:g}), lower min_norm (now {opts.min_norm:g}) "
+                            f"or change length_range (now {list(opts.length_range)})")
             elif cursor.phase == "sweep":
                 i = cursor.index
                 trials = draw(opts.trials)
@@ -446,22 +454,53 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     return st.basis
 
 
-def resume_from(folder: Path, progress: bool = True) -> tuple[Basis, Optimiser]:
-    """Continue the run whose checkpoint is folder/basis.json."""
-    import json
+def _resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> tuple:
+    """The basis, cursor, history and elapsed seconds of checkpoint content `d` (`rng` takes its
+    state); BasisFileError naming `where` for anything that does not fit."""
+    basis = Basis.from_dict(d, where, empty=True)
+    if basis.kind != opts.kind:
+        raise BasisFileError(f"{where}: a {basis.kind} basis, but the optimiser's kind is {opts.kind}")
+    try:
+        cursor = Cursor(**d["progress"])
+        rng.bit_generator.state = d["rng"]
+        history, elapsed = d["history"], number(d.get("elapsed", 0.0), "elapsed")
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
+        raise BasisFileError(f"{where}: malformed run state ({exc})") from exc
+    if not (isinstance(history, list) and all(isinstance(h, list) and len(h) >= 3 for h in history)):
+        raise BasisFileError(f"{where}: history must be a list of [size, energy, phase, seconds] rows")
+    nb = len(basis)
+    if (cursor.phase != "grow" and nb == 0) or (cursor.phase in ("sweep", "refine") and cursor.index >= nb):
+        raise BasisFileError(f"{where}: progress {vars(cursor)} does not fit a basis of {nb} functions")
+    return basis, cursor, history, elapsed
 
-    from .errors import BasisFileError
+
+def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
+    """The content of folder/basis.json with its system and settings, checked as a whole
+    (BasisFileError naming the file)."""
     path = Path(folder) / CHECKPOINT
     try:
-        d = json.loads(path.read_text())
+        text = path.read_text()
     except OSError as exc:
         raise BasisFileError(f"{path}: no checkpoint to resume ({exc.strerror})") from exc
+    except UnicodeDecodeError as exc:
+        raise BasisFileError(f"{path}: not a text file ({exc.reason})") from exc
+    try:
+        d = json.loads(text)
     except json.JSONDecodeError as exc:
         raise BasisFileError(f"{path}: corrupt checkpoint (line {exc.lineno}: {exc.msg})") from exc
-    if not {"optimiser", "progress", "rng", "history"} <= set(d):
+    if not (isinstance(d, dict) and {"optimiser", "progress", "rng", "history"} <= set(d)):
         raise BasisFileError(f"{path}: not a run checkpoint (no optimiser state)")
-    opts = Optimiser.from_dict(d["optimiser"])
-    system = Basis.from_dict(d, str(path)).system
+    try:
+        opts = Optimiser.from_dict(d["optimiser"])
+    except PreboError as exc:
+        raise BasisFileError(f"{path}: {exc}") from exc
+    basis, *_ = _resumed(d, opts, np.random.default_rng(), str(path))
+    return d, basis.system, opts
+
+
+def resume_from(folder: Path, progress: bool = True) -> tuple[Basis, Optimiser]:
+    """Continue the run whose checkpoint is folder/basis.json."""
+    d, system, opts = load_checkpoint(folder)
     return optimise(system, opts, out=Path(folder), progress=progress, resume=d), opts
 
 

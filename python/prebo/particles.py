@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from .errors import InputError
+from .validation import half_integer, number
 
 
 @dataclass(frozen=True)
@@ -21,14 +22,12 @@ class Particle:
     spin: Fraction
 
     def __post_init__(self):
-        if not isinstance(self.mass, (int, float)) or not self.mass > 0 or self.mass == float("inf"):
-            raise InputError(f"particle {self.name!r}: mass must be a positive finite number, got {self.mass!r}")
-        spin = Fraction(self.spin).limit_denominator(2)
-        if spin < 0 or spin.denominator not in (1, 2) or abs(float(spin) - float(self.spin)) > 1e-12:
-            raise InputError(f"particle {self.name!r}: spin must be 0, 1/2, 1, 3/2, ..., got {self.spin!r}")
-        object.__setattr__(self, "spin", spin)
-        object.__setattr__(self, "mass", float(self.mass))
-        object.__setattr__(self, "charge", float(self.charge))
+        if not isinstance(self.name, str) or not self.name:
+            raise InputError(f"particle name {self.name!r}: must be a non-empty string")
+        label = f"particle {self.name!r}"
+        object.__setattr__(self, "mass", number(self.mass, f"{label}: mass", positive=True))
+        object.__setattr__(self, "charge", number(self.charge, f"{label}: charge"))
+        object.__setattr__(self, "spin", half_integer(self.spin, f"{label}: spin"))
 
     @property
     def fermion(self) -> bool:
@@ -66,12 +65,12 @@ def particle(spec) -> Particle:
         return spec
     if isinstance(spec, str):
         spec = {"name": spec}
-    if not isinstance(spec, dict) or "name" not in spec:
-        raise InputError(f"a particle is a name or a table with a 'name' key, got {spec!r}")
+    if not isinstance(spec, dict) or not isinstance(spec.get("name"), str):
+        raise InputError(f"a particle is a name or a table with a 'name' string, got {spec!r}")
     unknown_keys = set(spec) - {"name", "mass", "charge", "spin"}
     if unknown_keys:
         raise InputError(f"particle {spec['name']!r}: unknown keys {sorted(unknown_keys)}")
-    name = str(spec["name"])
+    name = spec["name"]
     key = ALIASES.get(name, name)
     if key in KNOWN:
         mass, charge, spin = KNOWN[key]
@@ -84,4 +83,4 @@ def particle(spec) -> Particle:
             )
         mass, charge, spin = spec["mass"], spec["charge"], spec["spin"]
         key = name
-    return Particle(key, spec.get("mass", mass), spec.get("charge", charge), Fraction(spec.get("spin", spin)))
+    return Particle(key, spec.get("mass", mass), spec.get("charge", charge), spec.get("spin", spin))

@@ -25,6 +25,7 @@ from . import coordinates as coords
 from . import eigen
 from .basis import Basis
 from .errors import IllConditionedError, PreboError
+from .validation import REFINE_METHODS
 
 
 @dataclass
@@ -120,7 +121,7 @@ class Parametrisation:
 
 LOG_DIAG = (-8.0, 10.0)  # ln L_kk: exponents within ~1e-7..5e8
 MAX_CONDITION = 1e8  # of 𝒜 (module docstring)
-METHODS = ("powell", "gradient")
+METHODS = REFINE_METHODS
 
 
 class Objective:

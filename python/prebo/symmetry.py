@@ -186,6 +186,12 @@ class Symmetriser:
             raise SpinError(f"malformed symmetry operator ({exc})") from exc
         if len(perms) != len(coefs) or not perms:
             raise SpinError("symmetry operator: permutations and coefficients do not match")
+        k = len(perms[0])
+        if any(sorted(p) != list(range(k)) for p in perms) or not all(np.isfinite(coefs)):
+            raise SpinError(f"symmetry operator: every permutation must reorder 0..{k - 1} and every "
+                            "coefficient be finite")
+        if not dict(zip(perms, coefs)).get(tuple(range(k)), 0.0) > 0:
+            raise SpinError("symmetry operator: the identity needs a positive coefficient")
         return cls(perms, coefs)
 
     def equivalent(self, other: "Symmetriser", tol: float = 1e-10) -> bool:

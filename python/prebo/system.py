@@ -2,15 +2,16 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from fractions import Fraction
 
 import numpy as np
 
 from .errors import InputError
 from .particles import Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
+from .validation import MAX_PARTICLES, half_integer, strict_keywords
 
 
+@strict_keywords
 @dataclass(frozen=True)
 class State:
     """Total orbital angular momentum `N`, `parity` (+1/-1) and the total spin of each identical group."""
@@ -20,10 +21,14 @@ class State:
     spin: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        if not isinstance(self.N, int) or self.N < 0:
-            raise InputError(f"state: N must be a non-negative integer, got {self.N!r}")
-        if self.parity not in (1, -1):
-            raise InputError(f"state: parity must be +1 or -1, got {self.parity!r}")
+        if isinstance(self.N, bool) or not isinstance(self.N, int) or self.N < 0:
+            raise InputError(f"state: N = {self.N!r}: must be a non-negative integer")
+        if isinstance(self.parity, bool) or not isinstance(self.parity, int) or self.parity not in (1, -1):
+            raise InputError(f"state: parity = {self.parity!r}: must be +1 or -1")
+        if not isinstance(self.spin, dict) or not all(isinstance(k, str) for k in self.spin):
+            raise InputError(f"state: spin = {self.spin!r}: must map particle names to total spins, e.g. {{e = 0}}")
+        for name, S in self.spin.items():
+            half_integer(S, f"state: spin of {name!r}")
 
 
 class System:
@@ -35,9 +40,12 @@ class System:
 
     def __init__(self, particles, state: State | None = None, symmetriser: Symmetriser | None = None,
                  **state_kw):
+        if not isinstance(particles, (list, tuple)) or not 2 <= len(particles) <= MAX_PARTICLES:
+            raise InputError(f"system: particles = {particles!r}: must be a list of 2 to {MAX_PARTICLES} "
+                             "particle names or tables")
         self.particles: list[Particle] = [particle(p) for p in particles]
-        if len(self.particles) < 2:
-            raise InputError("a system needs at least two particles")
+        if state is not None and not isinstance(state, State):
+            raise InputError(f"system: state = {state!r}: must be a prebo.State")
         self.state = state if state is not None else State(**state_kw)
         self.groups = self._groups()
         if symmetriser is not None:
@@ -59,11 +67,11 @@ class System:
             if any(self.particles[i] != first for i in idx):
                 raise InputError(f"particles named {name!r} differ in mass, charge or spin; give them distinct names")
             if len(idx) == 1:
-                if name in self.state.spin and Fraction(self.state.spin[name]) != first.spin:
+                if name in self.state.spin and half_integer(self.state.spin[name], name) != first.spin:
                     raise InputError(f"a single {name!r} has spin {first.spin}, not {self.state.spin[name]}")
                 continue
             if name in self.state.spin:
-                S = Fraction(self.state.spin[name]).limit_denominator(2)
+                S = half_integer(self.state.spin[name], name)
             else:  # lowest total spin: singlet / doublet / para
                 S = lowest_total_spin(first.spin, len(idx))
             coupling_path(first.spin, len(idx), S)  # raises SpinError if impossible
@@ -82,8 +90,8 @@ class System:
         if identity not in sym.permutations:
             raise InputError("symmetry operator: the identity permutation is missing")
         for p in sym.permutations:
-            if sorted(p) != list(identity) or any(self.particles[i].name != self.particles[p[i]].name
-                                                  for i in range(self.n)):
+            if len(p) != self.n or sorted(p) != list(identity) or any(
+                    self.particles[i].name != self.particles[p[i]].name for i in range(self.n)):
                 raise InputError(f"symmetry operator: {list(p)} permutes particles that are not identical")
 
     # --- masses and charges --------------------------------------------------
@@ -143,8 +151,10 @@ class System:
     def from_dict(cls, d: dict, symmetry: dict | None = None) -> "System":
         """The system of `to_dict`; `symmetry` (`Symmetriser.as_dict`) is honoured when it is not
         the spin state's own operator (an explicit Young operator, e.g. imported from ecgpack)."""
-        if "particles" not in d:
+        if not isinstance(d, dict) or "particles" not in d:
             raise InputError("system: missing 'particles'")
+        if not isinstance(d.get("state", {}), dict):
+            raise InputError(f"state = {d['state']!r}: must be a table of N, parity and spin")
         st = dict(d.get("state", {}))
         unknown = set(st) - {"N", "parity", "spin"}
         if unknown:

@@ -1,0 +1,248 @@
+"""Validation of every input in one place.
+
+- `SETTINGS`: the optimiser's settings as one table (name -> type and range, meaning, TOML key),
+  used by `Optimiser.__post_init__` (Python API and checkpoints) and by the TOML reader;
+- the limits: `MAX_PARTICLES` (what the Rust core is compiled for) and `MAX_SIZE`, the largest
+  basis whose matrices fit in this machine's memory: 16 dense nb x nb float64 matrices (S, T,
+  T_ti, V, their copies while a function is appended or replaced, and the eigensolver's
+  working matrices), i.e. nb <= sqrt(memory / 128 bytes);
+- `number`, `half_integer`: the checks of one real parameter (masses, charges; spins);
+- `check_kind`: a basis type against the state (plain ECGs: N = 0, parity +1; ECG-GVR: natural
+  parity (-1)^N), called wherever a Basis meets a System.
+
+Every refusal is an `InputError` whose message names the argument or TOML key, the value and what
+is allowed; readers of files prefix the file's name.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import numbers
+import os
+from dataclasses import dataclass, fields
+from fractions import Fraction
+
+import numpy as np
+
+from . import _core
+from .errors import InputError
+
+BASIS_TYPES = ("pecg", "ecg-gvr", "fecg")
+REFINE_METHODS = ("powell", "gradient")
+MAX_PARTICLES = int(_core.MAX_DIM)
+MATRICES = 16  # dense nb x nb float64 matrices held at once (module docstring)
+
+
+def memory_bytes() -> int:
+    """Physical memory, or the cgroup limit where that is lower (8 GiB where neither is known)."""
+    try:
+        total = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        total = 8 << 30
+    try:
+        with open("/sys/fs/cgroup/memory.max") as f:
+            total = min(total, int(f.read()))
+    except (OSError, ValueError):  # no cgroup v2 limit, or "max"
+        pass
+    return total
+
+
+MAX_SIZE = math.isqrt(memory_bytes() // (MATRICES * 8))
+
+
+class Refused(Exception):
+    """A value a rule does not accept (turned into an InputError by `check`)."""
+
+
+def _real(v) -> float:
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+        raise Refused
+    v = float(v)
+    if not math.isfinite(v):
+        raise Refused
+    return v
+
+
+@dataclass(frozen=True)
+class Integer:
+    lo: int
+    hi: int | None = None
+
+    @property
+    def allowed(self) -> str:
+        return f"an integer ≥ {self.lo}" if self.hi is None else f"an integer in {self.lo}..{self.hi}"
+
+    def __call__(self, v) -> int:
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
+            raise Refused
+        if v < self.lo or (self.hi is not None and v > self.hi):
+            raise Refused
+        return int(v)
+
+
+@dataclass(frozen=True)
+class Real:
+    """A finite number x with lo < x (or ≤ with `lo_closed`) and x < hi (or ≤ with `hi_closed`)."""
+
+    lo: float
+    hi: float = math.inf
+    lo_closed: bool = False
+    hi_closed: bool = False
+
+    @property
+    def allowed(self) -> str:
+        if self.hi == math.inf:
+            return f"a finite number {'≥' if self.lo_closed else '>'} {self.lo:g}"
+        return (f"a number x with {self.lo:g} {'≤' if self.lo_closed else '<'} x "
+                f"{'≤' if self.hi_closed else '<'} {self.hi:g}")
+
+    def __call__(self, v) -> float:
+        x = _real(v)
+        if x < self.lo or (x == self.lo and not self.lo_closed) or x > self.hi or (x == self.hi and not self.hi_closed):
+            raise Refused
+        return x
+
+
+@dataclass(frozen=True)
+class Choice:
+    values: tuple
+
+    @property
+    def allowed(self) -> str:
+        return "one of " + ", ".join(map(repr, self.values))
+
+    def __call__(self, v) -> str:
+        if not isinstance(v, str) or v not in self.values:
+            raise Refused
+        return v
+
+
+class Lengths:
+    allowed = "two finite numbers [lo, hi] with 0 < lo < hi"
+
+    def __call__(self, v) -> tuple:
+        if isinstance(v, (str, bytes, dict)) or not hasattr(v, "__len__") or len(v) != 2:
+            raise Refused
+        lo, hi = _real(v[0]), _real(v[1])
+        if not 0 < lo < hi:
+            raise Refused
+        return lo, hi
+
+
+class Channels:
+    allowed = ("'pairs', 'all' or a non-empty list of coordinate-set names "
+               "('jacobi:0-1-2', 'hpc:0', 'cmc:2', ...)")
+
+    def __call__(self, v):
+        if v in ("pairs", "all"):
+            return v
+        if isinstance(v, (list, tuple)) and v and all(isinstance(c, str) for c in v):
+            return list(v)
+        raise Refused
+
+
+@dataclass(frozen=True)
+class Setting:
+    rule: object
+    meaning: str
+    key: str  # in a TOML input
+
+
+SETTINGS = {
+    "size": Setting(Integer(1, MAX_SIZE), f"basis functions; at most {MAX_SIZE}, what {MATRICES} nb x nb "
+                    "matrices in this machine's memory allow", "[basis] size"),
+    "trials": Setting(Integer(1, MAX_SIZE), "competitive trials per step", "[optimiser] trials"),
+    "sweeps": Setting(Integer(0), "random replacement sweeps per cycle", "[optimiser] sweeps"),
+    "seed": Setting(Integer(0), "seed of the random numbers", "[optimiser] seed"),
+    "channels": Setting(Channels(), "coordinate sets the functions are drawn in", "[optimiser] channels"),
+    "length_range": Setting(Lengths(), "range of the drawn lengths in bohr, scaled per pair",
+                            "[optimiser] length_range"),
+    "c_A": Setting(Real(0.0), "exponent of the centre-of-mass coordinate", "[basis] c_A"),
+    "kind": Setting(Choice(BASIS_TYPES), "basis type", "[basis] type"),
+    "K_max": Setting(Integer(0, 60), "largest power K of an ECG-GVR function", "[basis] K_max"),
+    "refine": Setting(Integer(0), "refinement sweeps per cycle", "[optimiser] refine"),
+    "refine_evaluations": Setting(Integer(1), "energies per refinement of one function",
+                                  "[optimiser] refine_evaluations"),
+    "refine_method": Setting(Choice(REFINE_METHODS), "refinement minimiser", "[optimiser] refine_method"),
+    "polish": Setting(Integer(0), "joint refinement steps per cycle", "[optimiser] polish"),
+    "polish_iterations": Setting(Integer(1), "L-BFGS iterations per joint step", "[optimiser] polish_iterations"),
+    "cycles": Setting(Integer(1), "repetitions of the sweep-refine-polish block", "[optimiser] cycles"),
+    "learned": Setting(Real(0.0, 1.0, True, True), "share of trials from the learned distributions",
+                       "[optimiser] learned"),
+    "learn_after": Setting(Integer(1), "functions of a channel before its distribution is learned",
+                           "[optimiser] learn_after"),
+    "min_norm": Setting(Real(0.0, 1.0), "smallest part of a trial orthogonal to the basis, relative to its norm",
+                        "[optimiser] min_norm"),
+    "max_overlap": Setting(Real(0.0, 1.0, hi_closed=True), "largest normalised overlap of a trial with a function",
+                           "[optimiser] max_overlap"),
+    "threshold": Setting(Real(0.0, 1.0), "relative overlap eigenvalue below which directions are dropped",
+                         "[optimiser] threshold"),
+}
+
+
+def check(name: str, value, label: str | None = None):
+    """`value` of setting `name`, normalised (ints, floats, a tuple for length_range); InputError
+    naming `label` (default: the name), the value and what is allowed."""
+    s = SETTINGS[name]
+    try:
+        return s.rule(value)
+    except (Refused, TypeError, ValueError):
+        raise InputError(f"{label or name} = {value!r}: must be {s.rule.allowed} ({s.meaning})") from None
+
+
+def check_settings(obj, owner: str) -> None:
+    """Check and normalise every field of a settings dataclass (`Optimiser`) in place."""
+    for f in fields(obj):
+        setattr(obj, f.name, check(f.name, getattr(obj, f.name), f"{owner} {f.name}"))
+
+
+def strict_keywords(cls):
+    """Class decorator: unknown keyword (or surplus positional) arguments of a dataclass raise
+    InputError naming them and the known ones, instead of TypeError."""
+    init = cls.__init__
+    names = [f.name for f in fields(cls) if f.init]
+
+    @functools.wraps(init)
+    def __init__(self, *args, **kw):
+        unknown = sorted(set(kw) - set(names))
+        if unknown or len(args) > len(names):
+            what = f"unknown arguments {unknown}" if unknown else f"{len(args)} positional arguments"
+            raise InputError(f"{cls.__name__}: {what} (allowed: {', '.join(names)})")
+        init(self, *args, **kw)
+
+    cls.__init__ = __init__
+    return cls
+
+
+def number(value, label: str, positive: bool = False) -> float:
+    """A finite real number (bools and strings refused), positive if asked; InputError otherwise."""
+    try:
+        x = _real(value)
+        if positive and not x > 0:
+            raise Refused
+    except Refused:
+        raise InputError(f"{label} = {value!r}: must be a finite{' positive' if positive else ''} number") from None
+    return x
+
+
+def half_integer(value, label: str) -> Fraction:
+    """A spin: 0, 1/2, 1, 3/2, ... (as a number); InputError otherwise."""
+    try:
+        x = _real(value)
+        if x < 0 or abs(2 * x - round(2 * x)) > 1e-12:
+            raise Refused
+    except Refused:
+        raise InputError(f"{label} = {value!r}: must be a spin 0, 1/2, 1, 3/2, ... (a number)") from None
+    return Fraction(round(2 * x), 2)
+
+
+def check_kind(kind: str, state) -> None:
+    """Refuse a basis type that cannot describe the state: plain ECGs are N = 0, parity +1
+    functions, ECG-GVR functions have natural parity (-1)^N (floating ECGs are no
+    angular-momentum eigenfunctions and take any label)."""
+    if kind == "pecg" and (state.N, state.parity) != (0, 1):
+        raise InputError(f"plain ECGs (pecg) describe N = 0, parity +1 states only, not N = {state.N}, "
+                         f"parity {state.parity:+d} (use ecg-gvr)")
+    if kind == "ecg-gvr" and state.parity != (-1) ** state.N:
+        raise InputError(f"ECG-GVR functions have natural parity (-1)^N = {(-1) ** state.N:+d}, "
+                         f"not parity {state.parity:+d} with N = {state.N}")
