@@ -1,0 +1,270 @@
+"""Fuzzing (issue 13): random corruptions of basis.json files, run checkpoints, TOML inputs and API
+arguments. Whatever the corruption, prebo either takes the input (a finite result, strict JSON)
+or refuses it with one line and exit 2 (CLI) or a PreboError (API) — never a traceback, a NaN
+or a hang. Derandomised, so CI sees the same examples; the CLI runs in-process. The last tests
+run real processes: a closed output pipe, and a kill during a checkpoint write."""
+import json
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+from unittest import mock
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import prebo
+from prebo.cli import main
+from prebo.errors import PreboError
+from prebo.validation import SETTINGS
+from test_validation import h_input, toml_text
+
+OPTIMISE = sys.modules["prebo.optimise"]  # the module (prebo.optimise is the function)
+
+FUZZ = settings(max_examples=100, deadline=None, derandomize=True, database=None,
+                suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+
+#: values at the edges of what prebo takes: empty, zero, negative, huge, non-finite, of the wrong type
+EDGES = st.sampled_from([[], {}, "", 0, 1, -1, 2, 9, 10**9, 0.0, -1.0, 0.5, 1e300, 1e-300, float("nan"), float("inf"),
+                         "1", "x", True, [1.0], [0.1, float("inf")], ["hpc:9"], "pecg", "ecg-gvr", "all", "e"])
+SCALARS = (st.none() | st.booleans() | st.integers(-10, 10) | st.integers(-2**70, 2**70)
+           | st.floats(allow_nan=True, allow_infinity=True) | st.text(max_size=4))
+JSON = EDGES | EDGES | st.recursive(SCALARS, lambda inner: st.lists(inner, max_size=3)
+                                    | st.dictionaries(st.text(max_size=3), inner, max_size=3), max_leaves=6)
+TOML = EDGES | EDGES | st.recursive(SCALARS.filter(lambda v: v is not None),
+                                    lambda inner: st.lists(inner, max_size=3)
+                                    | st.dictionaries(st.text("abcNe", min_size=1, max_size=3), inner, max_size=2),
+                                    max_leaves=4)
+
+
+#: positions a corruption most often matters at (the state, the particles, the functions, the symmetry)
+SENSITIVE = [("system", "state", "N"), ("system", "state", "parity"), ("system", "state", "spin"),
+             ("system", "particles"), ("system", "particles", 0, "charge"), ("system", "particles", 1, "mass"),
+             ("system", "particles", 0, "spin"), ("functions",), ("functions", 0), ("functions", 0, "A"),
+             ("functions", 0, "c_A"), ("functions", 0, "K"), ("functions", 0, "u"), ("basis_type",),
+             ("symmetry", "permutations", 0), ("symmetry", "coefficients"), ("coefficients",)]
+
+
+def mutate(doc, data):
+    """Replace, delete or grow one position of `doc` (a deep copy) with values drawn from `data`:
+    a `SENSITIVE` one, or one found by descending from the root into random children."""
+    doc = json.loads(json.dumps(doc))
+    parent, key = {"doc": doc}, "doc"
+    target = data.draw(st.sampled_from(SENSITIVE) | st.none())
+    try:
+        for k in target or ():
+            parent, key = parent[key], k
+            parent[key]
+    except (KeyError, IndexError, TypeError):
+        parent, key = {"doc": doc}, "doc"
+    while isinstance(parent[key], (dict, list)) and parent[key] and (key == "doc" or not target and
+                                                                      data.draw(st.booleans())):
+        node = parent[key]
+        parent, key = node, data.draw(st.sampled_from(sorted(node) if isinstance(node, dict) else range(len(node))))
+    action = data.draw(st.sampled_from(["replace"] * 4 + ["delete", "append"]))
+    if action == "delete":
+        del parent[key]
+    elif action == "append" and isinstance(parent[key], list):
+        parent[key].append(data.draw(JSON))
+    else:
+        parent[key] = data.draw(JSON)
+    return doc
+
+
+def assert_clean(rc, out, err):
+    """Exit 0 with strict JSON, a finite energy and a state the basis type can describe, or exit 2
+    with one `prebo: error:` line."""
+    if rc == 0:
+        r = json.loads(out, parse_constant=lambda c: pytest.fail(f"{c} in the JSON output"))
+        assert np.isfinite(r["energy"])
+        N, parity = r["state"]["N"], r["state"]["parity"]
+        assert {"pecg": (N, parity) == (0, 1), "ecg-gvr": parity == (-1) ** N}.get(r["basis_type"], True), r["state"]
+    else:
+        assert rc == 2 and out == "", (rc, out, err)
+        assert err.startswith("prebo: error: ") and err.count("\n") == 1 and "Traceback" not in err, err
+
+
+@pytest.fixture(scope="module")
+def checkpoints(tmp_path_factory):
+    """Run checkpoints (basis.json with optimiser state) of three basis types."""
+    d = tmp_path_factory.mktemp("checkpoints")
+    runs = {
+        "pecg": (prebo.System(["p", "e", "e"], spin={"e": 0}), prebo.Optimiser(size=3, trials=3, seed=2, sweeps=1)),
+        "gvr": (prebo.System(["p", "e"], N=1, parity=-1),
+                prebo.Optimiser(size=3, trials=3, seed=2, kind="ecg-gvr", K_max=2, channels=["jacobi:0-1"])),
+        "fecg": (prebo.System(["p", "e"]), prebo.Optimiser(size=2, trials=3, seed=2, kind="fecg")),
+    }
+    for name, (system, opts) in runs.items():
+        prebo.optimise(system, opts, out=d / name, progress=False)
+    return {name: json.loads((d / name / "basis.json").read_text()) for name in runs}
+
+
+BASIS_KEYS = ("format", "version", "system", "symmetry", "basis_type", "functions", "coefficients")
+
+
+@FUZZ
+@given(data=st.data())
+def test_corrupted_basis_files(checkpoints, tmp_path, capsys, data):
+    doc = checkpoints[data.draw(st.sampled_from(sorted(checkpoints)))]
+    doc = mutate({k: doc[k] for k in BASIS_KEYS}, data)
+    f = tmp_path / "basis.json"
+    f.write_text(json.dumps(doc))
+    assert_clean(main(["energy", str(f), "--json"]), *capsys.readouterr())
+
+
+@FUZZ
+@given(data=st.data())
+def test_truncated_or_garbled_basis_files(checkpoints, tmp_path, capsys, data):
+    text = json.dumps(checkpoints[data.draw(st.sampled_from(sorted(checkpoints)))])
+    cut = data.draw(st.integers(0, len(text)))
+    junk = data.draw(st.text(max_size=3) | st.binary(max_size=3).map(lambda b: b.decode("latin-1")))
+    f = tmp_path / "basis.json"
+    f.write_bytes((text[:cut] + junk + text[cut + len(junk):]).encode("utf-8", "surrogateescape"))
+    assert_clean(main(["energy", str(f), "--json"]), *capsys.readouterr())
+
+
+class Accepted(Exception):
+    """Raised in place of the optimisation once an input has passed every check."""
+
+
+def accept(system, opts, *args, **kwargs):
+    assert isinstance(system, prebo.System) and isinstance(opts, prebo.Optimiser)
+    for name, s in SETTINGS.items():  # what was accepted is within the table
+        assert s.rule(getattr(opts, name)) == getattr(opts, name)
+    raise Accepted
+
+
+@FUZZ
+@given(data=st.data())
+def test_corrupted_checkpoints_on_resume(checkpoints, tmp_path, capsys, data):
+    doc = checkpoints[data.draw(st.sampled_from(sorted(checkpoints)))]
+    part = data.draw(st.sampled_from(["optimiser", "progress", "rng", "history", "elapsed", "functions"]))
+    doc = mutate(doc, data) if part == "functions" else doc | {
+        part: mutate({"x": doc[part]}, data).get("x") if data.draw(st.booleans()) else data.draw(JSON)}
+    run = tmp_path / "run"
+    run.mkdir(exist_ok=True)
+    (run / "basis.json").write_text(json.dumps(doc))
+    with mock.patch.object(OPTIMISE, "optimise", accept):
+        try:
+            rc = main(["run", "--resume", str(run), "--quiet"])
+        except Accepted:
+            return
+    out, err = capsys.readouterr()
+    assert rc == 2 and str(run / "basis.json") in err
+    assert_clean(rc, out, err)
+
+
+TOML_KEYS = {"system": ["particles"], "state": ["N", "parity", "spin"], "basis": ["type", "size", "c_A", "K_max"],
+             "optimiser": sorted(s.key.partition(" ")[2] for s in SETTINGS.values() if s.key.startswith("[optimiser]"))}
+
+
+@FUZZ
+@given(data=st.data())
+def test_corrupted_toml_inputs(tmp_path, capsys, data):
+    doc = h_input() | {"state": {"N": 0}}
+    action = data.draw(st.sampled_from(["set"] * 6 + ["unknown key", "delete", "replace table"]))
+    table = data.draw(st.sampled_from(sorted(TOML_KEYS) + ["title", "extra"] * (action == "replace table")))
+    if action == "set":
+        doc[table][data.draw(st.sampled_from(TOML_KEYS[table]))] = data.draw(TOML)
+    elif action == "unknown key":
+        doc[table][data.draw(st.text("abcNe_", min_size=1, max_size=4))] = data.draw(TOML)
+    elif action == "delete":
+        doc[table].pop(data.draw(st.sampled_from(sorted(doc[table]) or ["x"])), None)
+    else:
+        doc[table] = data.draw(TOML)
+    f = tmp_path / "in.toml"
+    f.write_text(toml_text(doc))
+    with mock.patch.object(OPTIMISE, "optimise", accept):
+        try:
+            rc = main(["run", str(f), "--out", str(tmp_path / "out"), "--quiet"])
+        except Accepted:
+            return
+    out, err = capsys.readouterr()
+    assert_clean(rc, out, err)
+    assert rc == 2 and str(f) in err
+
+
+@FUZZ
+@given(name=st.sampled_from(sorted(SETTINGS)), value=TOML | st.just(None))
+def test_optimiser_arguments(name, value):
+    try:
+        opts = prebo.Optimiser(**{name: value})
+    except PreboError as exc:
+        assert f"{name} = {value!r}" in str(exc)
+    else:
+        assert SETTINGS[name].rule(getattr(opts, name)) == getattr(opts, name)
+
+
+@FUZZ
+@given(particles=st.lists(st.sampled_from(["p", "e", "e+", "alpha", "mu"]) | st.dictionaries(
+    st.sampled_from(["name", "mass", "charge", "spin", "x"]), SCALARS, max_size=4), max_size=4),
+    state=st.dictionaries(st.sampled_from(["N", "parity", "spin", "L"]), JSON, max_size=3))
+def test_system_arguments(particles, state):
+    try:
+        system = prebo.System(particles, **state)
+    except PreboError:
+        return
+    assert all(np.isfinite([p.mass, p.charge]).all() and p.mass > 0 for p in system.particles)
+
+
+# --- real processes ---------------------------------------------------------------------
+def prebo_process(*args, **kw):
+    return subprocess.run([sys.executable, "-m", "prebo", *map(str, args)], capture_output=True, text=True,
+                          timeout=120, **kw)
+
+
+def test_closed_output_pipe(tmp_path, checkpoints):
+    """`prebo energy --json | true`: one line and exit 2, no BrokenPipeError traceback."""
+    f = tmp_path / "basis.json"
+    f.write_text(json.dumps(checkpoints["pecg"]))
+    read, write = os.pipe()
+    os.close(read)
+    try:
+        r = subprocess.run([sys.executable, "-m", "prebo", "energy", str(f), "--json"], stdout=write,
+                           stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(write)
+    assert r.returncode == 2 and "Traceback" not in r.stderr and r.stderr.count("\n") == 1, r.stderr
+    assert r.stderr.startswith("prebo: error: standard output was closed")
+
+
+KILL_IN_SECOND_WRITE = """
+import os, signal, sys
+from prebo.cli import main
+writes = 0
+fsync = os.fsync
+def killing_fsync(fd):
+    global writes
+    writes += 1
+    if writes == 2:  # the second checkpoint: its temporary file is written but not yet renamed
+        os.kill(os.getpid(), signal.SIGKILL)
+    fsync(fd)
+os.fsync = killing_fsync
+main(sys.argv[1:])
+"""
+
+
+def test_a_kill_during_a_checkpoint_write_leaves_nothing_behind_after_resume(tmp_path):
+    (tmp_path / "h.toml").write_text(toml_text(h_input()))
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, "-c", KILL_IN_SECOND_WRITE, "run", tmp_path / "h.toml", "--out", out, "--quiet"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == -signal.SIGKILL, r.stderr
+    assert list(out.glob("basis.json.*.tmp")), "the kill left no temporary file: nothing tested"
+    resumed = prebo_process("run", "--resume", out, "--quiet")
+    assert resumed.returncode == 0, resumed.stderr
+    assert not list(out.glob("*.tmp")) and (out / "result.json").exists()
+    assert len(json.loads((out / "basis.json").read_text())["functions"]) == 3
+
+
+def test_killed_run_started_anew_leaves_nothing_behind(tmp_path):
+    (tmp_path / "h.toml").write_text(toml_text(h_input()))
+    out = tmp_path / "out"
+    args = ["run", tmp_path / "h.toml", "--out", out, "--quiet"]
+    r = subprocess.run([sys.executable, "-c", KILL_IN_SECOND_WRITE, *map(str, args)], capture_output=True, timeout=120)
+    assert r.returncode == -signal.SIGKILL and list(out.glob("basis.json.*.tmp"))
+    assert main(list(map(str, args))) == 0
+    assert not list(out.glob("*.tmp"))
