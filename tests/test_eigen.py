@@ -137,7 +137,7 @@ def test_non_finite_element_is_refused(problem, matrix):
     _, _, _, m = problem
     M = {"H": m["T_ti"] + m["V"], "S": m["S"].copy()}
     M[matrix][2, 5] = M[matrix][5, 2] = np.nan
-    with pytest.raises(PreboError, match=rf"non-finite element {matrix}\[2, 5\] = nan"):
+    with pytest.raises(PreboError, match=rf"matrix is not finite: {matrix}\[2, 5\] = nan \(2 of 100 elements\)"):
         eigen.solve(M["H"], M["S"])
 
 
@@ -152,7 +152,7 @@ def test_non_finite_energy_is_an_error_of_prebo_energy(tmp_path):
     r = subprocess.run([sys.executable, "-m", "prebo", "energy", str(tmp_path / "basis.json"), "--json"],
                        capture_output=True, text=True)
     assert r.returncode == 2 and r.stdout == ""
-    assert r.stderr.count("\n") == 1 and "non-finite element H[0, 0] = nan" in r.stderr
+    assert r.stderr.count("\n") == 1 and "Hamiltonian matrix is not finite: H[0, 0] = nan" in r.stderr
 
 
 def test_uncertainty_matches_a_perturbation_experiment(h2plus_pecg):

@@ -77,8 +77,8 @@ def require_finite(M: np.ndarray, name: str, symbol: str) -> None:
     bad = np.argwhere(~np.isfinite(M))
     if len(bad):
         i, j = (int(k) for k in bad[0])
-        raise PreboError(f"the {name} matrix has a non-finite element {symbol}[{i}, {j}] = {M[i, j]} "
-                         f"({len(bad)} in all): an integral overflowed or lost every digit")
+        raise PreboError(f"the {name} matrix is not finite: {symbol}[{i}, {j}] = {M[i, j]} ({len(bad)} of {M.size} "
+                         "elements): an integral overflowed or lost every digit")
 
 
 def refine(H: np.ndarray, S: np.ndarray, eig: Eigen, roots: int = 1) -> Eigen:

@@ -10,7 +10,7 @@ The energy is the lowest eigenvalue of the stored matrices refined in extended p
 deviation that element errors of a few ulp (4 u each, independent) of S, T_TI and V give it,
 ε (2 Σ_ij w_ij − Σ_i w_ii)^½ with w_ij = c_i² c_j² (T_ij² + V_ij² + E² S_ij²) (`eigen.energy_uncertainty`;
 docs/conventions.md compares it with Monte-Carlo perturbations): an ill-conditioned basis resolves
-its energy no better than this. A non-finite energy or element is an error, never a number.
+its energy no better than this. A non-finite element of H or S is an error (`eigen.solve`), never a number.
 """
 from __future__ import annotations
 
@@ -18,7 +18,6 @@ import numpy as np
 
 from . import eigen
 from .basis import Basis
-from .errors import PreboError
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
 
 
@@ -66,10 +65,5 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
 
 
 def public(result: dict) -> dict:
-    """The JSON-ready part of a result (no arrays); a non-finite number is a PreboError, since
-    JSON has none."""
-    out = {k: v for k, v in result.items() if not isinstance(v, np.ndarray)}
-    for k, v in out.items():
-        if isinstance(v, float) and not np.isfinite(v):
-            raise PreboError(f"the result's {k} is {v}, not a finite number")
-    return out
+    """The JSON-ready part of a result (no arrays)."""
+    return {k: v for k, v in result.items() if not isinstance(v, np.ndarray)}
