@@ -116,6 +116,20 @@ def test_corrupted_basis_files(checkpoints, tmp_path, capsys, data):
 
 
 @FUZZ
+@given(name=st.sampled_from(["pecg", "gvr", "fecg"]), kind=st.sampled_from(["pecg", "ecg-gvr", "fecg"]),
+       N=st.integers(0, 3), parity=st.sampled_from([1, -1]))
+def test_basis_files_relabelled_to_another_state_or_type(checkpoints, tmp_path, capsys, name, kind, N, parity):
+    """Never a number for a state the basis type cannot describe (plain ECGs: N = 0, parity +1;
+    ECG-GVR: parity (-1)^N), whatever a file says."""
+    doc = json.loads(json.dumps(checkpoints[name]))
+    doc["system"]["state"].update(N=N, parity=parity)
+    doc["basis_type"] = kind
+    f = tmp_path / "basis.json"
+    f.write_text(json.dumps(doc))
+    assert_clean(main(["energy", str(f), "--json"]), *capsys.readouterr())
+
+
+@FUZZ
 @given(data=st.data())
 def test_truncated_or_garbled_basis_files(checkpoints, tmp_path, capsys, data):
     text = json.dumps(checkpoints[data.draw(st.sampled_from(sorted(checkpoints)))])
