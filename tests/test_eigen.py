@@ -12,7 +12,7 @@ import scipy.linalg
 import prebo
 from prebo import eigen
 from prebo.basis import Basis
-from prebo.errors import LinearDependenceError, NotPositiveDefiniteError, PreboError
+from prebo.errors import LinearDependenceError, NonFiniteError, NotPositiveDefiniteError
 from prebo.integrals import laboratory
 
 from conftest import ROOT, random_basis
@@ -137,7 +137,7 @@ def test_non_finite_element_is_refused(problem, matrix):
     _, _, _, m = problem
     M = {"H": m["T_ti"] + m["V"], "S": m["S"].copy()}
     M[matrix][2, 5] = M[matrix][5, 2] = np.nan
-    with pytest.raises(PreboError, match=rf"matrix is not finite: {matrix}\[2, 5\] = nan \(2 of 100 elements\)"):
+    with pytest.raises(NonFiniteError, match=rf"matrix is not finite: {matrix}\[2, 5\] = nan \(2 of 100 elements\)"):
         eigen.solve(M["H"], M["S"])
 
 

@@ -315,6 +315,9 @@ def test_a_new_start_removes_temporary_checkpoints_of_a_killed_run(tmp_path):
     lambda: prebo.particle({"name": "x", "mass": 1.0, "charge": 1.0, "spin": "1/2"}),
     lambda: prebo.heavy_particle_centred(np.ones(3), 3),
     lambda: prebo.cm_centred(np.ones(3), -1),
+    lambda: prebo.evaluate(None),
+    lambda: prebo.evaluate(prebo.Basis.empty(prebo.System(["p", "e"]))),
+    lambda: prebo.evaluate(prebo.optimise(prebo.System(["p", "e"]), prebo.Optimiser(size=2), progress=False), "x"),
 ])
 def test_api_misuse_raises_prebo_errors(call):
     with pytest.raises(PreboError):

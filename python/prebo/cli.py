@@ -27,6 +27,7 @@ def _print_result(r: dict) -> None:
 
     t = Table(show_header=False, box=None)
     t.add_row("energy (translation-free)", f"{r['energy']:.12f} Eh")
+    t.add_row("numerical uncertainty", f"{r['energy_uncertainty']:.1e} Eh")
     if r.get("energy_lab") is not None:
         t.add_row("energy (laboratory frame)", f"{r['energy_lab']:.12f} Eh")
     t.add_row("virial η_TI", f"{r['virial']:.2e}")

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from .errors import LinearDependenceError, NotPositiveDefiniteError, PreboError
+from .errors import LinearDependenceError, NonFiniteError, NotPositiveDefiniteError
 
 #: relative error assumed for every stored matrix element: 4 unit roundoffs (a few ulp)
 ELEMENT_ERROR = 4 * 2.0**-53
@@ -73,11 +73,11 @@ def solve(H: np.ndarray, S: np.ndarray, threshold: float = 1e-13, roots: int = 1
 
 
 def require_finite(M: np.ndarray, name: str, symbol: str) -> None:
-    """Refuse a matrix with a NaN or infinite element (PreboError naming the first one)."""
+    """Refuse a matrix with a NaN or infinite element (NonFiniteError naming the first one)."""
     bad = np.argwhere(~np.isfinite(M))
     if len(bad):
         i, j = (int(k) for k in bad[0])
-        raise PreboError(f"the {name} matrix is not finite: {symbol}[{i}, {j}] = {M[i, j]} ({len(bad)} of {M.size} "
+        raise NonFiniteError(f"the {name} matrix is not finite: {symbol}[{i}, {j}] = {M[i, j]} ({len(bad)} of {M.size} "
                          "elements): an integral overflowed or lost every digit")
 
 

@@ -46,7 +46,7 @@ class OutputError(PreboError):
 
 
 class NonFiniteError(PreboError):
-    """A result that is not a finite number (NaN or infinite)."""
+    """A matrix element or result that is not a finite number (NaN or infinite)."""
 
 
 class StalledError(PreboError):

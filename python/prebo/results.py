@@ -18,11 +18,18 @@ import numpy as np
 
 from . import eigen
 from .basis import Basis
+from .errors import InputError
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
 
 
 def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -> dict:
-    """Evaluate a basis; `coordinates="ti"` uses TICC (only for one shared c_A)."""
+    """Evaluate a basis; `coordinates="ti"` uses TICC (only for one shared c_A).
+
+    Returns the keys of the module docstring (energies in Eh) and `coefficients`, the S-normalised
+    ground-state vector; a basis that is not a non-empty `Basis` or an unknown `coordinates` is an
+    InputError."""
+    if not isinstance(basis, Basis) or len(basis) == 0:
+        raise InputError(f"evaluate: basis = {basis!r}: must be a prebo.Basis with at least one function")
     system = basis.system
     if coordinates == "lab":
         m = laboratory(system).matrices(basis)
@@ -33,7 +40,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
         m = translationally_invariant(system).matrices(basis)
         energy_lab = None  # filled below: CM factor exp(-c_A X^2) common to all functions
     else:
-        raise ValueError(f"coordinates must be 'lab' or 'ti', not {coordinates!r}")
+        raise InputError(f"evaluate: coordinates = {coordinates!r}: must be 'lab' or 'ti'")
     ti = eigen.solve(m["T_ti"] + m["V"], m["S"], threshold)
     c = ti.vectors[:, 0]
     kinetic, potential = float(c @ m["T_ti"] @ c), float(c @ m["V"] @ c)
