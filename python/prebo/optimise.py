@@ -229,7 +229,10 @@ class Sampler:
 
 
 class State:
-    """Current basis with its matrices (S, T, T_ti, V) and eigen-solution."""
+    """Current basis with its matrices (S, T, T_ti, V), eigen-solution, energy and `sigma`, the
+    energy's numerical uncertainty (eigen.energy_uncertainty). A change is kept only if it lowers
+    the energy by more than the uncertainty of the energies before and after it (`put`,
+    `replace_basis`): a gain rounding can fake is refused, never accepted."""
 
     def __init__(self, basis: Basis, rep, threshold: float, min_norm: float = 1e-8, max_overlap: float = 0.99):
         self.basis, self.rep, self.threshold = basis, rep, threshold
@@ -242,17 +245,36 @@ class State:
 
     def solve(self):
         if len(self.basis) == 0:
-            self.eig = None
-            self.energy = np.inf
+            self.eig, self.energy, self.sigma = None, np.inf, 0.0
             return
         self.eig = eigen.solve(self.m["T_ti"] + self.m["V"], self.m["S"], self.threshold)
         self.energy = float(self.eig.energies[0])
+        self.sigma = eigen.energy_uncertainty(self.eig.vectors[:, 0], self.energy, self.m["S"], self.m["T_ti"],
+                                              self.m["V"])
 
-    def replace_basis(self, basis: Basis) -> None:
-        """Take a whole new basis (matrices rebuilt)."""
+    def gains(self, energy: float) -> bool:
+        """Whether `energy` lies below the current energy by more than its uncertainty."""
+        return energy < self.energy - self.sigma
+
+    def _snapshot(self) -> tuple:
+        return (self.basis.subset(slice(None)), {k: v.copy() for k, v in self.m.items()}, self.eig, self.energy,
+                self.sigma)
+
+    def _keep_if_lower(self, before: tuple) -> bool:
+        """After a change: keep it if the energy fell by more than the uncertainty before and after
+        it; otherwise restore the state `before` (`_snapshot`). True if kept."""
+        if before[3] == np.inf or self.energy < before[3] - max(self.sigma, before[4]):
+            return True
+        self.basis, self.m, self.eig, self.energy, self.sigma = before
+        return False
+
+    def replace_basis(self, basis: Basis) -> bool:
+        """Take a whole new basis (matrices rebuilt) if it lowers the energy beyond the uncertainty."""
+        before = self._snapshot()
         self.basis = basis
         self.m = self.rep.matrices(basis)
         self.solve()
+        return self._keep_if_lower(before)
 
     def without(self, i: int):
         """The eigen-solution of the basis without function i (None if that leaves nothing)."""
@@ -290,10 +312,12 @@ class State:
         energies[~self.rep.plausible({"S": S[:, keep]}, diag, np.diag(self.m["S"])[keep])] = np.inf
         return energies, rows, diag
 
-    def put(self, i: int, f: Basis, row: dict | None = None, d=None):
-        """Append (i == len) or replace function i by `f`. The matrices are patched from the
+    def put(self, i: int, f: Basis, row: dict | None = None, d=None) -> bool:
+        """Append (i == len) or replace function i by `f` if that lowers the energy beyond the
+        uncertainty (class docstring); True if it did. The matrices are patched from the
         function's oriented row (`Representation.rows` with position i) or else rebuilt, so that
         the state is a function of the basis alone and a resumed run continues bit for bit."""
+        before = self._snapshot()
         nb = len(self.basis)
         if i == nb:
             self.basis.append(f)
@@ -316,6 +340,7 @@ class State:
                     self.m[k][i, :] = r
                     self.m[k][:, i] = r
         self.solve()
+        return self._keep_if_lower(before)
 
 
 PHASES = ("grow", "sweep", "refine", "polish", "done")
@@ -414,8 +439,9 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 energies, rows, diag = st.candidates(trials)
                 best = int(np.argmin(energies))
                 report.trials(len(trials))
-                if np.isfinite(energies[best]) and energies[best] < st.energy:
-                    st.put(len(st.basis), trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
+                if (np.isfinite(energies[best]) and st.gains(energies[best])
+                        and st.put(len(st.basis), trials.subset([best]), {k: v[best] for k, v in rows.items()},
+                                   diag[best])):
                     stalled = 0
                     if opts.refine:  # competitive selection, then Powell refinement of the winner
                         refine_function(st, len(st.basis) - 1, opts.refine_evaluations, opts.refine_method)
@@ -437,7 +463,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 if opts.refine and np.isfinite(energies[best]):
                     regenerate_function(st, i, trials.subset([best]), opts.refine_evaluations, opts.refine_method,
                                         rest)
-                elif np.isfinite(energies[best]) and energies[best] < st.energy - 1e-15 * abs(st.energy):
+                elif np.isfinite(energies[best]) and st.gains(energies[best]):
                     st.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
             elif cursor.phase == "refine":
                 report.trials(1)

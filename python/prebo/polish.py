@@ -80,7 +80,6 @@ def polish(state, iterations: int) -> bool:
     joint = Joint(state)
     minimize(joint, joint.theta0, jac=True, method="L-BFGS-B",
              options={"maxiter": iterations, "maxfun": 2 * iterations, "ftol": 1e-16, "gtol": 1e-12, "maxcor": 20})
-    if joint.best is None or not joint.best_E < state.energy - 1e-15 * abs(state.energy):
+    if joint.best is None or not state.gains(joint.best_E):
         return False
-    state.replace_basis(joint.best)
-    return True
+    return state.replace_basis(joint.best)

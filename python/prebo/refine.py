@@ -201,12 +201,12 @@ def minimise(obj: Objective, max_evaluations: int, method: str) -> None:
 
 
 def accept(state, i: int, obj: Objective) -> bool:
-    """Put the objective's best function in slot i if it lowers the energy; True if it did."""
-    if obj.best_f is None or not obj.best_E < state.energy - 1e-15 * abs(state.energy):
+    """Put the objective's best function in slot i if it lowers the energy beyond its numerical
+    uncertainty (optimise.State.put); True if it did."""
+    if obj.best_f is None or not state.gains(obj.best_E):
         return False
     rows, diag = state.rep.rows(obj.best_f, state.basis, i)  # oriented: patched matrices equal a rebuild
-    state.put(i, obj.best_f, {k: v[0] for k, v in rows.items()}, diag[0])
-    return True
+    return state.put(i, obj.best_f, {k: v[0] for k, v in rows.items()}, diag[0])
 
 
 def refine_function(state, i: int, max_evaluations: int = 200, method: str = "gradient", rest=None) -> bool:
