@@ -112,12 +112,14 @@ def test_refinement_matches_mpmath_where_lapack_is_off(h2plus_pecg):
 
 
 def test_refinement_is_a_fixed_point(h2plus_pecg):
-    """Refining an already refined pair changes nothing."""
+    """Refining an already refined pair moves its energy by no more than the stopping rule allows
+    (a predicted change of one ulp; the refined vector differs with the BLAS kernel, so a second
+    refinement may take one more step of that size on some kernels and none on others)."""
     m = h2plus_pecg
     H, S = m["T_ti"] + m["V"], m["S"]
     sol = eigen.solve(H, S)
     again = eigen.refine(H, S, sol)
-    assert again.energies[0] == sol.energies[0]
+    assert abs(again.energies[0] - sol.energies[0]) <= 2 * np.spacing(abs(sol.energies[0]))
 
 
 def test_refinement_that_does_not_converge_is_refused(problem):
