@@ -12,12 +12,19 @@ from pathlib import Path
 from .errors import NonFiniteError, OutputError, PreboError
 
 
-def _finite(r: dict) -> dict:
-    """The result `r`, or NonFiniteError naming the keys that are not finite numbers."""
-    bad = [f"{k} = {v}" for k, v in r.items() if isinstance(v, float) and not math.isfinite(v)]
-    if bad:
-        raise NonFiniteError(f"the result is not finite ({', '.join(bad)}): the basis's integrals "
-                             "overflow or lost their digits")
+def _result(basis, where, coordinates: str = "lab") -> dict:
+    """The JSON-ready result of `basis`; NonFiniteError naming the keys that are not finite
+    numbers, and every error prefixed with `where` (the basis file)."""
+    from .results import evaluate, public
+
+    try:
+        r = public(evaluate(basis, coordinates=coordinates))
+        bad = [f"{k} = {v}" for k, v in r.items() if isinstance(v, float) and not math.isfinite(v)]
+        if bad:
+            raise NonFiniteError(f"the result is not finite ({', '.join(bad)}): the basis's integrals "
+                                 "overflow or lost their digits")
+    except PreboError as exc:
+        raise type(exc)(f"{where}: {exc}") from exc
     return r
 
 
@@ -42,7 +49,6 @@ def cmd_run(args) -> int:
     from .basis import write_json_atomic
     from .errors import InputError, StalledError
     from .optimise import optimise, resume_from
-    from .results import evaluate, public
 
     t0 = time.perf_counter()
     if args.resume:
@@ -66,10 +72,7 @@ def cmd_run(args) -> int:
     except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
         raise StalledError(f"{source}: {exc}") from exc
     title = title or basis.system.label()
-    try:
-        r = _finite(public(evaluate(basis)))
-    except PreboError as exc:
-        raise type(exc)(f"{out / 'basis.json'}: {exc}") from exc
+    r = _result(basis, out / "basis.json")
     r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source}
     write_json_atomic(out / "result.json", r)
     if not args.quiet:
@@ -125,13 +128,8 @@ def load_basis(path):
 
 
 def cmd_energy(args) -> int:
-    from .results import evaluate, public
-
     basis = load_basis(args.basis)
-    try:
-        r = _finite(public(evaluate(basis, coordinates=args.coordinates)))
-    except PreboError as exc:
-        raise type(exc)(f"{args.basis}: {exc}") from exc
+    r = _result(basis, args.basis, args.coordinates)
     if args.json:
         print(json.dumps(r, allow_nan=False))
     else:
