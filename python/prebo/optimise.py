@@ -38,9 +38,10 @@ import numpy as np
 
 from . import coordinates as coords
 from . import eigen
-from .basis import Basis, remove_stale_temporaries
+from .basis import Basis, family
 from .errors import BasisFileError, IllConditionedError, InputError, PreboError, StalledError
 from .integrals import laboratory
+from .io.basis_json import remove_stale_temporaries
 from .polish import polish
 from .refine import Parametrisation, refine_function, regenerate_function
 from .system import System
@@ -155,7 +156,7 @@ class Sampler:
                     seen[key] = known[key] if key in known else Parametrisation.of(basis.subset([i])).theta()
                 thetas.append(seen[key])
             thetas = np.array(thetas)
-            Ks = basis.K[idx] if basis.kind == "ecg-gvr" else None
+            Ks = basis.family.powers(basis, idx)
             self.learned[ch] = (Parametrisation.of(basis.subset(idx[:1])), thetas.mean(axis=0), thetas.std(axis=0),
                                 Ks, len(idx))
         self._thetas = seen
@@ -169,9 +170,7 @@ class Sampler:
             weights = np.array([learned[c][4] for c in names], float)
             p, mean, std, Ks, _ = learned[names[self.rng.choice(len(names), p=weights / weights.sum())]]
             theta = mean + self.rng.normal(size=mean.shape) * np.maximum(std, 0.05)
-            K = None
-            if Ks is not None:
-                K = int(np.clip(self.rng.choice(Ks) + self.rng.integers(-2, 3), 0, self.opts.K_max))
+            K = None if Ks is None else family(self.opts.kind).draw_learned_power(self.rng, Ks, self.opts.K_max)
             try:
                 return p.function(theta, K)
             except IllConditionedError:
@@ -183,11 +182,10 @@ class Sampler:
         s, c_A = self.system, self.opts.c_A
         n = s.n
         cm = s.cm_vector
-        kind = self.opts.kind
-        K = int(self.rng.integers(self.opts.K_max + 1)) if kind == "ecg-gvr" else 0
+        fam = family(self.opts.kind)
         # |v|^{2K+N} exp(-α v²) peaks at |v| = sqrt((K + N/2)/α): for the coordinate that carries
         # the global vector, the drawn length b is that peak, α = (K + N/2)/b² (K + N/2 > 0)
-        power = K + 0.5 * s.state.N if kind == "ecg-gvr" else 0.0
+        K, power = fam.draw_power(self.rng, self.opts.K_max, s.state.N)
         if not self.sets:
             i0, j0 = self.pairs[self.rng.integers(len(self.pairs))]
             A = c_A * np.outer(cm, cm)
@@ -220,12 +218,7 @@ class Sampler:
             sx[k0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(lengths[k0])
             centres = x.U_inv @ sx
             channel = x.name
-        if kind == "pecg":
-            return Basis(s, A[None], [c_A], [channel])
-        if kind == "fecg":
-            centres = centres - cm @ centres  # no CM component: μ^T s = 0
-            return Basis(s, A[None], [c_A], [channel], kind="fecg", s=centres[None])
-        return Basis(s, A[None], [c_A], [channel], kind="ecg-gvr", u=u[None], K=[K])
+        return Basis.single(s, A, c_A, channel, fam.name, fam.drawn(s, u, centres, K))
 
 
 class State:
@@ -323,7 +316,7 @@ class State:
             self.basis.append(f)
         else:
             self.basis.replace(i, f)
-        if row is None or not self.rep.oriented(self.basis.kind):
+        if row is None or not self.rep.oriented(self.basis):
             self.m = self.rep.matrices(self.basis)
         else:
             values = {"S": d[0], "T": d[1], "T_ti": d[2], "V": d[3]}

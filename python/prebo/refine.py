@@ -30,7 +30,8 @@ from .validation import REFINE_METHODS
 
 @dataclass
 class Parametrisation:
-    """θ <-> one function, in the coordinate set `x`."""
+    """θ <-> one function, in the coordinate set `x`: θ = (ln diag L, strict lower L, tail), the
+    tail being the family's (Family.theta_tail: u' of ECG-GVR, s' of floating ECGs)."""
 
     f: Basis
     x: coords.CoordinateSet
@@ -40,61 +41,42 @@ class Parametrisation:
         m = f.system.masses
         name = f.channels[0]
         x = coords.by_name(m, name) if name.split(":")[0] in ("jacobi", "hpc", "cmc") else coords.jacobi(m)
-        if f.kind == "ecg-gvr":  # the same normalised function with |(u', c_U)| = 1
-            scale = np.linalg.norm(x.transform_vectors_to_x(f.u[0]))
-            f = Basis(f.system, f.A, f.c_A, f.channels, kind="ecg-gvr", u=f.u / scale, K=f.K)
-        return cls(f, x)
+        return cls(f.family.prepared(f, x), x)
+
+    @property
+    def _split(self) -> int:
+        """Where the tail of θ starts: after the d + d(d-1)/2 parameters of L, d = n - 1."""
+        d = self.f.system.n - 1
+        return d + d * (d - 1) // 2
 
     def theta(self) -> np.ndarray:
         A_int, _ = self.x.from_lab(self.f.A[0])
         L = np.linalg.cholesky(A_int)
         d = len(L)
-        parts = [np.log(np.diag(L)), L[np.tril_indices(d, -1)]]
-        if self.f.kind == "ecg-gvr":
-            parts.append(self.x.transform_vectors_to_x(self.f.u[0])[:-1])
-        if self.f.kind == "fecg":
-            parts.append((self.x.U @ self.f.s[0])[:-1].ravel())
-        return np.concatenate(parts)
+        return np.concatenate([np.log(np.diag(L)), L[np.tril_indices(d, -1)], self.f.family.theta_tail(self.f, self.x)])
 
     def _L(self, theta: np.ndarray) -> np.ndarray:
         d = self.f.system.n - 1
         L = np.diag(np.exp(np.clip(theta[:d], *LOG_DIAG)))
-        L[np.tril_indices(d, -1)] = theta[d:d + d * (d - 1) // 2]
+        L[np.tril_indices(d, -1)] = theta[d:self._split]
         sv = np.linalg.svd(L, compute_uv=False)
         if not sv[-1] > 0 or (sv[0] / sv[-1]) ** 2 > MAX_CONDITION:
             raise IllConditionedError(f"exponent matrix with condition number above {MAX_CONDITION:.0e}")
         return L
 
-    def _v(self, theta: np.ndarray) -> tuple[np.ndarray, float]:
-        """(v/|v|, |v|) for ECG-GVR, v = (u', c_U)."""
-        d = self.f.system.n - 1
-        v = np.append(theta[d + d * (d - 1) // 2:], float(self.f.u[0].sum()))
-        norm = np.linalg.norm(v)
-        return v / norm, norm
-
     def function(self, theta: np.ndarray, K: int | None = None) -> Basis:
-        d = self.f.system.n - 1
-        L = self._L(theta)
-        nl = d * (d - 1) // 2
-        c_A = self.f.c_A[0]
-        A = self.x.to_lab(L @ L.T, c_A)
-        if self.f.kind == "pecg":
-            return Basis(self.f.system, A[None], [c_A], [self.x.name])
-        if self.f.kind == "fecg":
-            sx = self.x.U @ self.f.s[0]
-            sx[:-1] = theta[d + nl:].reshape(d, 3)
-            return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="fecg", s=(self.x.U_inv @ sx)[None])
-        u = self.x.U.T @ self._v(theta)[0]
-        return Basis(self.f.system, A[None], [c_A], [self.x.name], kind="ecg-gvr", u=u[None],
-                     K=self.f.K[:1] if K is None else [K])
+        """The one-function basis of θ (`K`: a power to set instead of the function's own)."""
+        f, L = self.f, self._L(theta)
+        c_A = f.c_A[0]
+        extras = f.family.from_tail(f, self.x, theta[self._split:], K)
+        return Basis.single(f.system, self.x.to_lab(L @ L.T, c_A), c_A, self.x.name, f.kind, extras)
 
     def directions(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """∂A^(r)/∂θ_p (P x n x n) and ∂u^(r)/∂θ_p (P x n) or ∂s^(r)/∂θ_p (P x n x 3); None for plain ECGs.
+        """∂A^(r)/∂θ_p (P x n x n) and the family's ∂(u or s)^(r)/∂θ_p (None for plain ECGs).
         With 𝒜 = L L^T: ∂𝒜 = ∂L L^T + L ∂L^T, ∂L = L_kk E_kk for θ = ln L_kk (0 where clipped),
-        E_ab for a strict-lower entry; A^(r) and u^(r), s^(r) are linear in 𝒜 and u', s'."""
+        E_ab for a strict-lower entry; A^(r) is linear in 𝒜."""
         n = self.f.system.n
         d, P = n - 1, len(theta)
-        nl = d * (d - 1) // 2
         L = self._L(theta)
         inside = (theta[:d] > LOG_DIAG[0]) & (theta[:d] < LOG_DIAG[1])
         entries = [(k, k, L[k, k] * inside[k]) for k in range(d)]
@@ -104,19 +86,7 @@ class Parametrisation:
             dL = np.zeros((d, d))
             dL[a, b] = v
             dA[p] = self.x.to_lab(dL @ L.T + L @ dL.T, 0.0)
-        if self.f.kind == "pecg":
-            return dA, None
-        if self.f.kind == "ecg-gvr":
-            v, norm = self._v(theta)  # u^(r) = U^T v/|v|: ∂(v/|v|)/∂u'_k = (e_k - v v_k)/|v|
-            dv = np.zeros((P, n))
-            for k in range(d):
-                dv[d + nl + k] = self.x.U.T @ ((np.eye(n)[k] - v * v[k]) / norm)
-            return dA, dv
-        dv = np.zeros((P, n, 3))
-        for a in range(d):
-            for k in range(3):
-                dv[d + nl + 3 * a + k, :, k] = self.x.U_inv[:, a]  # s^(r) = U^-1 (s', μ^T s)
-        return dA, dv
+        return dA, self.f.family.tail_directions(self.f, self.x, theta[self._split:], P, self._split)
 
 
 LOG_DIAG = (-8.0, 10.0)  # ln L_kk: exponents within ~1e-7..5e8

@@ -237,12 +237,6 @@ def half_integer(value, label: str) -> Fraction:
 
 
 def check_kind(kind: str, state) -> None:
-    """Refuse a basis type that cannot describe the state: plain ECGs are N = 0, parity +1
-    functions, ECG-GVR functions have natural parity (-1)^N (floating ECGs are no
-    angular-momentum eigenfunctions and take any label)."""
-    if kind == "pecg" and (state.N, state.parity) != (0, 1):
-        raise InputError(f"plain ECGs (pecg) describe N = 0, parity +1 states only, not N = {state.N}, "
-                         f"parity {state.parity:+d} (use ecg-gvr)")
-    if kind == "ecg-gvr" and state.parity != (-1) ** state.N:
-        raise InputError(f"ECG-GVR functions have natural parity (-1)^N = {(-1) ** state.N:+d}, "
-                         f"not parity {state.parity:+d} with N = {state.N}")
+    """Refuse a basis type that cannot describe the state (prebo.basis.family(kind).check_state)."""
+    from .basis import family  # the basis package builds on this module
+    family(kind).check_state(state)

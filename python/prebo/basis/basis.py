@@ -1,0 +1,170 @@
+"""The basis container: the functions of one family for a system, in laboratory-frame Cartesian
+coordinates (LFCC, docs/conventions.md).
+
+Every function has an exponent matrix A^(r) (n x n, symmetric positive definite, in bohr⁻²) with
+A^(r) 1 = c_A m/m_tot, so that it factors into a centre-of-mass Gaussian exp(-c_A R_cm²) times an
+internal part (Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018), Sec. IV, the
+elimination of the CM); A^(r) = U_x^T blockdiag(𝒜, c_A) U_x for the coordinate set ("channel") x
+it was generated in. Its family (`Basis.family`) adds its own arrays (u and K, or s).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import BasisFileError, InputError, NotPositiveDefiniteError, SeparabilityError
+from ..system import System
+from .families import family as family_of
+from .family import Family
+
+
+@dataclass
+class Basis:
+    """An ECG basis of `system`.
+
+    Parameters (nb functions, n particles; hartree atomic units, lengths in bohr):
+    A: (nb, n, n) exponent matrices A^(r); c_A: (nb,) CM exponents; channels: the coordinate set
+    each function was drawn in ("pairs", "jacobi:0-1-2", ...; default "unknown"); coefficients:
+    (nb,) linear coefficients of the state, if known; kind: the family's name ("pecg", "ecg-gvr",
+    "fecg", the basis.json basis_type); u: (nb, n) global vectors and K: (nb,) powers (ECG-GVR);
+    s: (nb, n, 3) centres in bohr (floating ECGs). InputError for shapes or values that do not fit.
+    """
+
+    system: System
+    A: np.ndarray
+    c_A: np.ndarray
+    channels: list[str] = field(default_factory=list)
+    coefficients: np.ndarray | None = None
+    kind: str = "pecg"
+    u: np.ndarray | None = None
+    K: np.ndarray | None = None
+    s: np.ndarray | None = None
+
+    def __post_init__(self):
+        n = self.system.n
+        self.A = np.ascontiguousarray(np.asarray(self.A, dtype=float).reshape(-1, n, n))
+        self.c_A = np.ascontiguousarray(np.asarray(self.c_A, dtype=float).reshape(-1))
+        nb = len(self.A)
+        if len(self.c_A) != nb:
+            raise InputError(f"basis: {nb} exponent matrices but {len(self.c_A)} values of c_A")
+        fam = family_of(self.kind)
+        fam.check_state(self.system.state)
+        for name, shape in fam.shapes.items():
+            value = getattr(self, name)
+            if value is None:
+                raise InputError(f"a {self.kind} basis needs the parameters {name!r}")
+            value = fam.coerce(name, value)
+            dims = tuple(n if d == "n" else d for d in shape)
+            if value.size != nb * int(np.prod(dims, dtype=int)):
+                raise InputError(f"basis: {nb} functions but {value.size} values of {name!r}")
+            setattr(self, name, np.ascontiguousarray(value.reshape((nb, *dims))))
+        if not self.channels:
+            self.channels = ["unknown"] * nb
+
+    @property
+    def family(self) -> Family:
+        """The basis family (prebo.basis.family(kind))."""
+        return family_of(self.kind)
+
+    @property
+    def parameters(self) -> dict:
+        """The family's per-function arrays beyond A and c_A, by name."""
+        return {name: getattr(self, name) for name in self.family.shapes}
+
+    @classmethod
+    def empty(cls, system: System, kind: str = "pecg") -> "Basis":
+        """A basis of no functions of family `kind`."""
+        n = system.n
+        extra = {name: np.zeros((0, *(n if d == "n" else d for d in shape)))
+                 for name, shape in family_of(kind).shapes.items()}
+        return cls(system, np.zeros((0, n, n)), np.zeros(0), [], kind=kind, **extra)
+
+    @classmethod
+    def single(cls, system: System, A: np.ndarray, c_A: float, channel: str, kind: str, extras: dict) -> "Basis":
+        """One function: A (n x n), c_A, its channel and its family's extras (each with a leading 1)."""
+        return cls(system, A[None], [c_A], [channel], kind=kind, **extras)
+
+    def __len__(self) -> int:
+        return len(self.A)
+
+    @property
+    def N(self) -> int:
+        """The total orbital angular momentum quantum number of the system's state."""
+        return self.system.state.N
+
+    def subset(self, idx) -> "Basis":
+        """The functions `idx` (indices or mask) as a new basis."""
+        idx = np.arange(len(self))[idx]
+        extra = {name: v[idx] for name, v in self.parameters.items()}
+        return Basis(self.system, self.A[idx], self.c_A[idx], [self.channels[i] for i in idx], kind=self.kind, **extra)
+
+    @classmethod
+    def concat(cls, fs: list["Basis"]) -> "Basis":
+        """The functions of several bases (same system and kind), in order."""
+        first = fs[0]
+        extra = {name: np.concatenate([getattr(f, name) for f in fs]) for name in first.parameters}
+        return cls(first.system, np.concatenate([f.A for f in fs]), np.concatenate([f.c_A for f in fs]),
+                   [c for f in fs for c in f.channels], kind=first.kind, **extra)
+
+    def append(self, f: "Basis") -> None:
+        """Append the functions of `f` (same system and kind); forgets the coefficients."""
+        self.A = np.ascontiguousarray(np.concatenate([self.A, f.A]))
+        self.c_A = np.concatenate([self.c_A, f.c_A])
+        for name, v in self.parameters.items():
+            setattr(self, name, np.ascontiguousarray(np.concatenate([v, getattr(f, name)])))
+        self.channels += list(f.channels)
+        self.coefficients = None
+
+    def replace(self, i: int, f: "Basis") -> None:
+        """Replace function i by the single function of `f`; forgets the coefficients."""
+        self.A[i] = f.A[0]
+        self.c_A[i] = f.c_A[0]
+        for name, v in self.parameters.items():
+            v[i] = getattr(f, name)[0]
+        self.channels[i] = f.channels[0]
+        self.coefficients = None
+
+    def validate(self) -> None:
+        """Every A symmetric, positive definite and CM-separable (A 1 = c_A m/m_tot, c_A > 0), and
+        the family's parameters valid; BasisFileError, InputError, NotPositiveDefiniteError or
+        SeparabilityError naming the function otherwise."""
+        m = self.system.cm_vector
+        fam = self.family
+        for i, (A, c) in enumerate(zip(self.A, self.c_A)):
+            if not np.all(np.isfinite(A)) or not np.isfinite(c):
+                raise BasisFileError(f"function {i}: non-finite parameters")
+            if np.max(np.abs(A - A.T)) > 1e-12 * max(1.0, np.max(np.abs(A))):
+                raise InputError(f"function {i}: exponent matrix A is not symmetric")
+            if not c > 0:
+                raise NotPositiveDefiniteError(f"function {i}: c_A = {c} must be positive")
+            if np.max(np.abs(A.sum(axis=1) - c * m)) > 1e-9 * max(1.0, np.max(np.abs(A))):
+                raise SeparabilityError(f"function {i}: A^(r) 1 != c_A m/m_tot, the CM does not separate")
+            try:
+                np.linalg.cholesky(A)
+            except np.linalg.LinAlgError:
+                raise NotPositiveDefiniteError(f"function {i}: exponent matrix A is not positive definite") from None
+            fam.check_function(self, i)
+
+    # --- basis.json (prebo.io.basis_json; io builds on basis, so it is imported on use) ---
+    def to_dict(self, extra: dict | None = None) -> dict:
+        """The basis.json mapping of this basis (docs/basis-format.md), with `extra` keys added."""
+        from ..io import basis_json
+        return basis_json.to_dict(self, extra)
+
+    def save(self, path, extra: dict | None = None) -> None:
+        """Write basis.json atomically: a killed run leaves either the old or the new file."""
+        from ..io import basis_json
+        basis_json.save(self, path, extra)
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "basis", empty: bool = False) -> "Basis":
+        """The basis of a basis.json mapping (prebo.io.basis_json.from_dict)."""
+        from ..io import basis_json
+        return basis_json.from_dict(d, where, empty)
+
+    @classmethod
+    def load(cls, path) -> "Basis":
+        """The basis of a basis.json file; BasisFileError naming the file for anything wrong."""
+        from ..io import basis_json
+        return basis_json.load(path)

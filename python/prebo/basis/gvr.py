@@ -1,0 +1,117 @@
+"""ECG-GVR functions ("ecg-gvr"): φ(r) = |v|^{2K} (v_x + i v_y)^N exp(-r^T (A ⊗ I_3) r), v = u^T r.
+
+A global vector u (n) and a power K per function, the state's N (Muolo, Mátyus & Reiher,
+J. Chem. Phys. 149, 184105 (2018), Sec. II, the ECG-GVR ansatz; docs/gvr.md). The functions have
+natural parity (-1)^N. The normalised function does not depend on the length of u; refinement
+keeps |(u', c_U)| = 1 in its coordinate set.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _core
+from ..errors import InputError, SeparabilityError
+from ..validation import SETTINGS
+from .family import Family
+
+#: the largest power K a function may hold (the settings' bound on K_max)
+K_LIMIT = SETTINGS["K_max"].rule.hi
+
+
+class GlobalVectorECG(Family):
+    name = "ecg-gvr"
+    shapes = {"u": ("n",), "K": ()}
+    conserves_L = True
+
+    def check_state(self, state) -> None:
+        if state.parity != (-1) ** state.N:
+            raise InputError(f"ECG-GVR functions have natural parity (-1)^N = {(-1) ** state.N:+d}, "
+                             f"not parity {state.parity:+d} with N = {state.N}")
+
+    def coerce(self, name: str, value) -> np.ndarray:
+        value = np.asarray(value)
+        if name != "K":
+            return value.astype(float)
+        if not np.all((value >= 0) & (value <= K_LIMIT) & (value == np.round(value))):
+            raise InputError(f"basis: every K must be an integer in 0..{K_LIMIT}")
+        return value.astype(np.uint32)
+
+    def check_function(self, basis, i: int) -> None:
+        if not (np.all(np.isfinite(basis.u[i])) and np.any(basis.u[i] != 0)):
+            raise InputError(f"function {i}: the global vector u must be finite and non-zero")
+
+    def ticc_extras(self, extras: tuple, coords) -> tuple:
+        u, K = extras
+        ux = coords.transform_vectors_to_x(u)  # u^(x) = U^-T u^(r) = (u', c_U)
+        if np.any(np.abs(ux[:, -1]) > 1e-12 * np.max(np.abs(ux), axis=1)):
+            raise SeparabilityError("a global vector has a CM component (c_U != 0): "
+                                    "no translationally invariant evaluation (use --coordinates lab)")
+        return ux[:, :-1], K
+
+    def engine(self, ops: tuple, N: int) -> "Engine":
+        return Engine(ops, N)
+
+    # sampling: the drawn length of the coordinate carrying u is the peak of |v|^{2K+N} exp(-α v²)
+    def draw_power(self, rng, K_max: int, N: int) -> tuple[int, float]:
+        K = int(rng.integers(K_max + 1))
+        return K, K + 0.5 * N
+
+    def drawn(self, system, u: np.ndarray, centres: np.ndarray, K: int) -> dict:
+        return {"u": u[None], "K": [K]}
+
+    def powers(self, basis, idx) -> np.ndarray:
+        return basis.K[idx]
+
+    def draw_learned_power(self, rng, powers, K_max: int) -> int:
+        return int(np.clip(rng.choice(powers) + rng.integers(-2, 3), 0, K_max))
+
+    # refinement: θ tail u' with u^(r) = U_x^T v/|v|, v = (u', c_U), c_U fixed
+    def prepared(self, f, x):
+        scale = np.linalg.norm(x.transform_vectors_to_x(f.u[0]))
+        return type(f)(f.system, f.A, f.c_A, f.channels, kind=self.name, u=f.u / scale, K=f.K)
+
+    def theta_tail(self, f, x) -> np.ndarray:
+        return x.transform_vectors_to_x(f.u[0])[:-1]
+
+    @staticmethod
+    def _v(f, tail: np.ndarray) -> tuple[np.ndarray, float]:
+        """(v/|v|, |v|), v = (u', c_U)."""
+        v = np.append(tail, float(f.u[0].sum()))
+        norm = np.linalg.norm(v)
+        return v / norm, norm
+
+    def from_tail(self, f, x, tail: np.ndarray, K: int | None = None) -> dict:
+        u = x.U.T @ self._v(f, tail)[0]
+        return {"u": u[None], "K": f.K[:1] if K is None else [K]}
+
+    def tail_directions(self, f, x, tail: np.ndarray, P: int, offset: int) -> np.ndarray:
+        """∂u^(r)/∂θ_p (P x n): ∂(v/|v|)/∂u'_k = (e_k - v v_k)/|v|."""
+        n = f.system.n
+        v, norm = self._v(f, tail)
+        dv = np.zeros((P, n))
+        for k in range(n - 1):
+            dv[offset + k] = x.U.T @ ((np.eye(n)[k] - v * v[k]) / norm)
+        return dv
+
+
+class Engine:
+    """The core's ECG-GVR functions for one representation and the state's N. Rows at a position
+    are evaluated in full-build orientation (`oriented`), so patched matrices have a rebuild's bits."""
+
+    oriented = True
+
+    def __init__(self, ops: tuple, N: int):
+        self.ops, self.N = ops, N
+
+    def matrices(self, params: tuple) -> dict:
+        return _core.gvr_matrices(*params, self.N, *self.ops)
+
+    def rows(self, trials: tuple, basis: tuple, position: int | None = None) -> tuple[dict, np.ndarray]:
+        return _core.gvr_rows(*trials, *basis, self.N, *self.ops, position)
+
+    def row_gradient(self, f: tuple, dA: np.ndarray, du: np.ndarray, basis: tuple) -> tuple[dict, np.ndarray]:
+        c = np.ascontiguousarray
+        return _core.gvr_row_gradient(*f, c(dA), c(du), *basis, self.N, *self.ops)
+
+
+FAMILY = GlobalVectorECG()

@@ -1,0 +1,41 @@
+"""The basis-family registry (issue 14): one Family object per basis type, looked up by name."""
+import numpy as np
+import pytest
+
+import prebo
+from prebo.basis import FAMILIES, Basis, family
+from prebo.errors import InputError
+
+
+def test_families_by_name():
+    assert list(FAMILIES) == ["pecg", "ecg-gvr", "fecg"]
+    assert family("pecg").parameters == ("A", "c_A")
+    assert family("ecg-gvr").parameters == ("A", "u", "K", "c_A")
+    assert family("fecg").parameters == ("A", "s", "c_A")
+    assert [family(k).conserves_L for k in FAMILIES] == [True, True, False]
+    assert all(family(k).name == k for k in FAMILIES)
+
+
+@pytest.mark.parametrize("name", ["gvr", "ECG", None, 3])
+def test_unknown_family_names_the_known_ones(name):
+    with pytest.raises(InputError, match="pecg, ecg-gvr, fecg"):
+        family(name)
+    with pytest.raises(InputError, match="pecg, ecg-gvr, fecg"):
+        Basis.empty(prebo.System(["p", "e"]), name)
+
+
+def test_check_state_is_the_families_rule():
+    p_state = prebo.System(["p", "e"], N=1, parity=-1).state
+    with pytest.raises(InputError, match="N = 0, parity \\+1"):
+        family("pecg").check_state(p_state)
+    family("ecg-gvr").check_state(p_state)
+    with pytest.raises(InputError, match="natural parity"):
+        family("ecg-gvr").check_state(prebo.System(["p", "e"], N=1, parity=1).state)
+    family("fecg").check_state(prebo.System(["p", "e"], N=1, parity=1).state)
+
+
+def test_basis_knows_its_family_and_keeps_its_kind():
+    s = prebo.System(["p", "e"], N=1, parity=-1)
+    b = Basis(s, np.eye(2)[None], [1.0], kind="ecg-gvr", u=[[1.0, -1.0]], K=[2])
+    assert b.family is family("ecg-gvr") and b.kind == "ecg-gvr"
+    assert b.K.dtype == np.uint32 and set(b.parameters) == {"u", "K"}
