@@ -39,7 +39,7 @@ ECGPACK = {("He-490", 1): (10.1, 10.8), ("He-490", 2): (17.8, 19.4),
 def measure(name: str, repeat: int, representation: str) -> dict:
     """Runs inside the subprocess."""
     from prebo import _core
-    from prebo.ecgpack import read_inout
+    from prebo.io.ecgpack import read_inout
     from prebo.integrals import laboratory, translationally_invariant
 
     basis = read_inout(BASES[name])

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import prebo
-from prebo.inputs import tomllib  # tomli before Python 3.11
+from prebo.io.toml import tomllib  # tomli before Python 3.11
 
 ROOT = Path(__file__).resolve().parents[1]
 

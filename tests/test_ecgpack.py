@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 import prebo
-from prebo import ecgpack, eigen
+from prebo import eigen
 from prebo.basis import Basis
 from prebo.errors import BasisFileError
 from prebo.integrals import laboratory
+from prebo.io import ecgpack
 
 DATA = Path(__file__).parent / "data" / "ecgpack"
 HE = DATA / "ecgpack-He4-490.inout.txt"

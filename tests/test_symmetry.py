@@ -6,7 +6,7 @@ import pytest
 
 import prebo
 from prebo.errors import SpinError
-from prebo.symmetry import Group, clebsch_gordan, permutation_sign
+from prebo.system.symmetry import Group, clebsch_gordan, permutation_sign
 
 
 def coefficients(particles, spin):

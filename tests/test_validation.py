@@ -121,7 +121,7 @@ def test_toml_with_plain_ecgs_or_unnatural_parity_is_refused(tmp_path, capsys):
 
 def test_ecgpack_import_goes_through_the_same_check(monkeypatch):
     """An ecgpack file is read as an N = 0 state; the Basis it becomes is checked against the state."""
-    from prebo import ecgpack
+    from prebo.io import ecgpack
     li = ROOT / "tests" / "data" / "ecgpack" / "ecgpack-Li7-100.inout.txt"
     state = prebo.State(N=1, parity=-1, spin={"e": 0.5})
     monkeypatch.setattr(ecgpack, "State", lambda **kw: state)
@@ -205,7 +205,7 @@ def test_import_with_non_positive_c_A(tmp_path, capsys):
     for value in ("0", "-1", "nan"):
         err = cli_error(capsys, "import", li, "--c-A", value, "--out", tmp_path / "li.json")
         assert "--c-A = " in err and "> 0" in err
-    from prebo.ecgpack import read_inout
+    from prebo.io.ecgpack import read_inout
     with pytest.raises(InputError, match="c_A = 0"):
         read_inout(li, c_A=0)
 
@@ -275,7 +275,7 @@ def test_every_setting_has_a_range(tmp_path, capsys, name, bad, good):
 def test_settings_table_covers_every_optimiser_field():
     from dataclasses import fields
 
-    from prebo import inputs
+    from prebo.io import toml as inputs
     from prebo.validation import SETTINGS
     assert set(SETTINGS) == {f.name for f in fields(prebo.Optimiser)}
     for name, s in SETTINGS.items():  # the defaults are within their ranges
@@ -328,7 +328,7 @@ def test_api_misuse_raises_prebo_errors(call):
 def test_python_3_10_is_supported():
     """requires-python says 3.10; the TOML reader falls back to tomli there (declared for < 3.11),
     and no module uses syntax newer than 3.10."""
-    from prebo.inputs import tomllib
+    from prebo.io.toml import tomllib
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
     assert project["requires-python"] == ">=3.10"
     assert any(d.replace(" ", "").startswith("tomli>=") and "python_version<'3.11'" in d.replace(" ", "").replace('"', "'")
@@ -338,7 +338,7 @@ def test_python_3_10_is_supported():
 
 
 def test_toml_reader_uses_tomli_before_3_11(monkeypatch):
-    from prebo import inputs
+    from prebo.io import toml as inputs
     fake = types.ModuleType("tomli")
     fake.loads, fake.TOMLDecodeError = (lambda text: {}), ValueError
     monkeypatch.setitem(sys.modules, "tomli", fake)

@@ -6,7 +6,7 @@ from .basis import Basis
 from .coordinates import CoordinateSet, all_sets, cm_centred, heavy_particle_centred, jacobi
 from .errors import PreboError
 from .optimise import Optimiser, optimise
-from .particles import Particle, particle
+from .system import Particle, particle
 from .results import evaluate
 from .system import State, System
 

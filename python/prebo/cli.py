@@ -45,7 +45,7 @@ def _print_result(r: dict) -> None:
 
 
 def cmd_run(args) -> int:
-    from . import inputs
+    from .io import toml as inputs
     from .basis import write_json_atomic
     from .errors import InputError, StalledError
     from .optimise import optimise, resume_from
@@ -82,7 +82,7 @@ def cmd_run(args) -> int:
 
 
 def cmd_import(args) -> int:
-    from .ecgpack import read_inout
+    from .io.ecgpack import read_inout
     from .validation import check
 
     basis = read_inout(args.file, c_A=check("c_A", args.c_A, "--c-A"))
@@ -93,7 +93,7 @@ def cmd_import(args) -> int:
 
 
 def cmd_export(args) -> int:
-    from .ecgpack import write_inout
+    from .io.ecgpack import write_inout
     from .errors import UnsupportedError
 
     basis = load_basis(args.basis)
@@ -122,7 +122,7 @@ def load_basis(path):
     from .basis import Basis
 
     if str(path).endswith(".inout.txt"):
-        from .ecgpack import read_inout
+        from .io.ecgpack import read_inout
         return read_inout(path)
     return Basis.load(path)
 

@@ -19,11 +19,11 @@ if sys.version_info >= (3, 11):
 else:  # Python 3.10: the same parser as a package
     import tomli as tomllib
 
-from .basis import read_text
-from .errors import InputError
-from .optimise import Optimiser, coordinate_sets
-from .system import State, System
-from .validation import SETTINGS, check, check_kind
+from ..basis import read_text
+from ..errors import InputError
+from ..optimise import Optimiser, coordinate_sets
+from ..system import State, System
+from ..validation import SETTINGS, check, check_kind
 
 #: [basis] key -> Optimiser setting; [optimiser] takes every other setting
 BASIS_KEYS = {"type": "kind", "size": "size", "c_A": "c_A", "K_max": "K_max"}

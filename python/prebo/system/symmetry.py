@@ -23,7 +23,7 @@ from math import factorial, sqrt
 
 import numpy as np
 
-from .errors import SpinError
+from ..errors import SpinError
 
 
 def clebsch_gordan(j1: Fraction, m1: Fraction, j2: Fraction, m2: Fraction, j: Fraction, m: Fraction) -> float:

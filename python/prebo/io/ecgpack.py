@@ -93,13 +93,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .basis import Basis, read_text, write_atomic
-from .coordinates import heavy_particle_centred
-from .errors import BasisFileError, PreboError, UnsupportedError
-from .particles import KNOWN
-from .symmetry import Group, Symmetriser
-from .system import State, System
-from .validation import check
+from ..basis import Basis, read_text, write_atomic
+from ..coordinates import heavy_particle_centred
+from ..errors import BasisFileError, PreboError, UnsupportedError
+from ..system.particles import KNOWN
+from ..system.symmetry import Group, Symmetriser
+from ..system.system import State, System
+from ..validation import check
 
 __all__ = [
     "read_inout", "write_inout", "parse_inout", "InoutFile", "YoungSystem", "system_with_symmetry",
@@ -382,7 +382,7 @@ def _central(op: dict, moved) -> dict:
 def _implied_spins(op: dict, raw_groups: list[tuple[int, ...]], spins: list[Fraction], n: int) -> dict | None:
     """Total spin per group whose spin-projected operator lies in the same irreducible
     representation as `op`, or None when there is no such state."""
-    from .symmetry import coupling_path
+    from ..system.symmetry import coupling_path
 
     choices = []
     for idx, s in zip(raw_groups, spins):
@@ -600,7 +600,7 @@ def _system(f: InoutFile) -> System:
         idx = tuple(i for i, x in enumerate(names) if x == nm)
         if len(idx) > 1:
             raw_groups.append(idx)
-    from .particles import particle
+    from ..system.particles import particle
 
     spins = [particle(specs[idx[0]]).spin for idx in raw_groups]
     implied = _implied_spins(op, raw_groups, spins, n) if raw_groups else {}
@@ -732,7 +732,7 @@ def write_inout(basis: Basis, path, energy: float | None = None) -> None:
     if not (young and _same(_as_operator(young_operator(young, n)), _as_operator(sym))):
         young = young_string(sym, system.groups, n)
     if energy is None:
-        from .results import evaluate
+        from ..results import evaluate
 
         energy = evaluate(basis)["energy"] if len(basis) else 0.0
     K = len(basis)

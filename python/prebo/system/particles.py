@@ -8,8 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-from .errors import InputError
-from .validation import half_integer, number
+from ..errors import InputError
+from ..validation import half_integer, number
 
 
 @dataclass(frozen=True)

@@ -5,10 +5,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InputError
+from ..errors import InputError
 from .particles import Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
-from .validation import MAX_PARTICLES, half_integer, strict_keywords
+from ..validation import MAX_PARTICLES, half_integer, strict_keywords
 
 
 @strict_keywords
