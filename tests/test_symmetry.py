@@ -6,7 +6,8 @@ import pytest
 
 import prebo
 from prebo.errors import SpinError
-from prebo.system.symmetry import Group, clebsch_gordan, permutation_sign
+from prebo.system.permutations import sign as permutation_sign
+from prebo.system.symmetry import Group, clebsch_gordan
 
 
 def coefficients(particles, spin):

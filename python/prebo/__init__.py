@@ -1,14 +1,25 @@
 """prebo: pre-Born–Oppenheimer variational solver with explicitly correlated Gaussians.
 
-Pipeline: system → coordinates → basis → integrals → eigen → optimise → results.
+The pipeline, one subpackage or module per stage (docs/architecture.md):
+
+- `prebo.system`: particles (CODATA masses), `System`, `State`, permutational symmetry;
+- `prebo.coordinates`: coordinate sets x = U_x r (`CoordinateSet`, `jacobi`, `all_sets`, ...);
+- `prebo.basis`: `Basis` and its families (plain ECGs, ECG-GVR, floating ECGs);
+- `prebo.integrals`, `prebo.eigen`: matrices and the generalised eigenproblem;
+- `prebo.optimise`: `Optimiser` settings and `optimise`, the stochastic variational driver;
+- `prebo.results`: `evaluate`, the energies of a basis;
+- `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
+- `prebo.cli`, `prebo.plot`: the command line and convergence plots.
+
+Hartree atomic units: energies in Eh, lengths in bohr, masses in m_e. The method is that of
+Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018).
 """
 from .basis import Basis
 from .coordinates import CoordinateSet, all_sets, cm_centred, heavy_particle_centred, jacobi
 from .errors import PreboError
 from .optimise import Optimiser, optimise
-from .system import Particle, particle
 from .results import evaluate
-from .system import State, System
+from .system import Particle, State, System, particle
 
 __all__ = [
     # system building

@@ -45,9 +45,11 @@ def _print_result(r: dict) -> None:
 
 
 def cmd_run(args) -> int:
-    from .io import toml as inputs
-    from .basis import write_json_atomic
+    """`prebo run INPUT [--out DIR]` or `prebo run --resume DIR`: optimise, then write DIR/result.json
+    (`_result`, energies in Eh) beside the checkpoint DIR/basis.json. Returns the exit status 0."""
+    from .io.basis_json import write_json_atomic
     from .errors import InputError, StalledError
+    from .io import toml
     from .optimise import optimise, resume_from
 
     t0 = time.perf_counter()
@@ -57,7 +59,7 @@ def cmd_run(args) -> int:
     else:
         if args.input is None:
             raise InputError("give an input file, or --resume DIR")
-        job = inputs.load(args.input)
+        job = toml.load(args.input)
         out = Path(args.out or Path("runs") / Path(args.input).stem)
         title, source = job.title, str(args.input)
         try:
@@ -82,23 +84,22 @@ def cmd_run(args) -> int:
 
 
 def cmd_import(args) -> int:
+    """`prebo import FILE.inout.txt [--out X.json] [--c-A C]`: an ecgpack basis as basis.json."""
     from .io.ecgpack import read_inout
     from .validation import check
 
     basis = read_inout(args.file, c_A=check("c_A", args.c_A, "--c-A"))
     out = Path(args.out or str(args.file).removesuffix(".txt").removesuffix(".inout") + ".json")
     basis.save(out)
-    print(f"wrote {out} ({len(basis)} {basis.kind} functions, {basis.system.label()})")
+    print(f"wrote {out} ({len(basis)} {basis.family.name} functions, {basis.system.label()})")
     return 0
 
 
 def cmd_export(args) -> int:
+    """`prebo export BASIS.json --format ecgpack [--out FILE]`: a plain-ECG basis as an ecgpack file."""
     from .io.ecgpack import write_inout
-    from .errors import UnsupportedError
 
     basis = load_basis(args.basis)
-    if basis.kind != "pecg":
-        raise UnsupportedError(f"ecgpack's RG_0S format holds plain ECGs only, not {basis.kind}")
     out = Path(args.out or str(args.basis).removesuffix(".json") + ".inout.txt")
     write_inout(basis, out)
     print(f"wrote {out}")
@@ -106,6 +107,7 @@ def cmd_export(args) -> int:
 
 
 def cmd_plot(args) -> int:
+    """`prebo plot RUN... [--reference E] [--out PNG]`: convergence plot of run checkpoints."""
     from .plot import convergence
 
     png = args.out or Path(args.runs[0]) / "convergence.png"
@@ -128,6 +130,7 @@ def load_basis(path):
 
 
 def cmd_energy(args) -> int:
+    """`prebo energy BASIS [--coordinates lab|ti] [--json]`: re-evaluate a stored basis (Eh)."""
     basis = load_basis(args.basis)
     r = _result(basis, args.basis, args.coordinates)
     if args.json:
@@ -141,10 +144,12 @@ class Parser(argparse.ArgumentParser):
     """argparse with the one-line errors of every other failure (exit 2)."""
 
     def error(self, message):
+        """Exit 2 with one line naming the subcommand and its --help."""
         self.exit(2, f"prebo: error: {self.prog}: {message} (see {self.prog} --help)\n")
 
 
 def parser() -> argparse.ArgumentParser:
+    """The `prebo` argument parser with its five subcommands."""
     p = Parser(prog="prebo", description="pre-Born–Oppenheimer ECG solver")
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="optimise a basis for the system of a TOML input")
@@ -178,6 +183,8 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """The `prebo` command (`argv`: its arguments, default sys.argv[1:]). Returns the exit status:
+    0, 2 for every error (one line on stderr, never a traceback), 130 when interrupted."""
     args = parser().parse_args(argv)
     try:
         status = args.func(args)

@@ -1,10 +1,11 @@
-"""Coordinate sets x = U_x r (paper section "The Schrödinger Hamiltonian and coordinate sets").
+"""Coordinate sets x = U_x r (Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018),
+sec. II; equation numbers below are that paper's).
 
-Every U_x is N_p x N_p: rows 1..N_p-1 are translationally invariant (each sums to
-zero, paper eq. Uconstraint1), the last row is m_j / m_tot (eq. Uconstraint2).
-Exponents transform as A^(x) = U^-T A^(r) U^-1 = blockdiag(𝒜, c_A) and global
-vectors as u^(x) = U^-T u^(r) = (u', c_U) (eqs. backandforthtransfonA/u). The
-kinetic matrix in x is U M U^T = blockdiag(μ, 1/(2 m_tot)).
+Every U_x is N_p x N_p and dimensionless: rows 1..N_p-1 are translationally invariant
+(each sums to zero, eq. (3)), the last row is m_j / m_tot (eq. (4)). Exponents transform
+as A^(x) = U^-T A^(r) U^-1 = blockdiag(𝒜, c_A) and global vectors as u^(x) = U^-T u^(r)
+= (u', c_U) (eqs. (24), (25)). The kinetic matrix in x is U M U^T = blockdiag(μ, 1/(2 m_tot))
+(eq. (9)). Exponents are in bohr⁻², masses in m_e, μ in 1/m_e.
 """
 from __future__ import annotations
 
@@ -18,13 +19,17 @@ from .errors import InputError, SeparabilityError
 
 @dataclass(frozen=True)
 class CoordinateSet:
-    """A named coordinate set ("channel") and its matrix U_x."""
+    """A named coordinate set ("channel") and its matrix U_x.
+
+    Parameters: `name`, as `by_name` reads it (``"jacobi:0-1-2"``, ``"hpc:0"``, ``"cmc:2"``);
+    `U`, the (N_p, N_p) matrix U_x of eq. (2) (dimensionless).
+    """
 
     name: str
     U: np.ndarray
 
     def check(self, masses: np.ndarray, tol: float = 1e-12) -> None:
-        """Raise InputError unless U satisfies paper eqs. Uconstraint1 and Uconstraint2 and is invertible."""
+        """Raise InputError unless U satisfies eqs. (3) and (4) for `masses` (m_e) and is invertible."""
         n = len(masses)
         if self.U.shape != (n, n):
             raise InputError(f"{self.name}: U has shape {self.U.shape}, expected {(n, n)}")
@@ -37,14 +42,15 @@ class CoordinateSet:
 
     @property
     def U_inv(self) -> np.ndarray:
+        """U_x⁻¹."""
         return np.linalg.inv(self.U)
 
     def mu(self, M: np.ndarray) -> np.ndarray:
-        """Internal kinetic matrix μ: the TI block of U M U^T (paper eq. nonrel-H-transf)."""
+        """Internal kinetic matrix μ (1/m_e): the TI block of U M U^T for the mass matrix M (eq. (9))."""
         return (self.U @ M @ self.U.T)[:-1, :-1]
 
     def to_lab(self, A_int: np.ndarray, c_A: float) -> np.ndarray:
-        """A^(r) = U^T blockdiag(𝒜, c_A) U."""
+        """A^(r) = U^T blockdiag(𝒜, c_A) U (eq. (24)); 𝒜 (N_p-1 square) and c_A in bohr⁻²."""
         n = self.U.shape[0]
         Ax = np.zeros((n, n))
         Ax[:-1, :-1] = A_int
@@ -52,7 +58,8 @@ class CoordinateSet:
         return self.U.T @ Ax @ self.U
 
     def from_lab(self, A_r: np.ndarray, tol: float = 1e-9) -> tuple[np.ndarray, float]:
-        """(𝒜, c_A) from A^(r); SeparabilityError if A^(x) has a CM-internal coupling."""
+        """(𝒜, c_A) from A^(r) (eq. (24)); SeparabilityError if A^(x) couples the CM to internal
+        coordinates by more than `tol` of its largest element."""
         Ui = self.U_inv
         Ax = Ui.T @ A_r @ Ui
         scale = max(np.max(np.abs(Ax)), 1e-300)
@@ -70,7 +77,8 @@ class CoordinateSet:
 
 
 def jacobi(masses: np.ndarray, order=None) -> CoordinateSet:
-    """Jacobi set (paper eq. Jac-TICC) for a particle order: x_i = Σ_{j<=i} m_j r_j / m_{1..i} - r_{i+1}."""
+    """Jacobi set (eq. (5)) for a particle `order` (default 0..N_p-1; `masses` in m_e):
+    x_i = Σ_{j<=i} m_j r_j / m_{1..i} - r_{i+1}; named ``jacobi:ORDER``."""
     n = len(masses)
     order = list(range(n)) if order is None else list(order)
     if sorted(order) != list(range(n)):
@@ -87,7 +95,7 @@ def jacobi(masses: np.ndarray, order=None) -> CoordinateSet:
 
 
 def heavy_particle_centred(masses: np.ndarray, centre: int) -> CoordinateSet:
-    """Heavy-particle-centred set (paper eq. HPC-TICC): x_i = r_i - r_centre for i != centre."""
+    """Heavy-particle-centred set (eq. (6)): x_i = r_i - r_centre for i != centre; named ``hpc:CENTRE``."""
     n = len(masses)
     _particle_index(centre, n, "hpc")
     U = np.zeros((n, n))
@@ -100,8 +108,8 @@ def heavy_particle_centred(masses: np.ndarray, centre: int) -> CoordinateSet:
 def cm_centred(masses: np.ndarray, dropped: int | None = None) -> CoordinateSet:
     """CM-centred set: x_i = r_i - X_CM for every particle but `dropped` (default: the last).
 
-    (Paper eq. CMC-TICC divides by m_{i..N}, which violates eq. Uconstraint1; this is
-    the set its figure describes.)
+    Named ``cmc:DROPPED``. (Eq. (7) divides by m_{i..N}, which violates eq. (3); this is
+    the set the paper's figure 1 describes.)
     """
     n = len(masses)
     dropped = n - 1 if dropped is None else dropped
@@ -124,7 +132,8 @@ def all_sets(masses: np.ndarray, labels=None) -> list[CoordinateSet]:
 
     Sets that differ only by a relabelling of identical particles (equal `labels`, e.g. the
     particle names) are counted once, as are Jacobi orders that differ only by swapping the
-    first two particles (x_1 changes sign). Without labels every particle is distinct."""
+    first two particles (x_1 changes sign). Without labels every particle is distinct.
+    `masses` in m_e; returns the list of `CoordinateSet`s."""
     n = len(masses)
     labels = list(range(n)) if labels is None else list(labels)
     sets, seen = [], set()

@@ -15,6 +15,8 @@ from .errors import BasisFileError
 
 
 def history(folder: Path) -> list:
+    """The optimisation history of the run checkpoint folder/basis.json: rows [basis size,
+    energy (Eh), ..., wall time (s) when recorded]; BasisFileError if there is none."""
     path = Path(folder) / "basis.json"
     try:
         d = json.loads(path.read_text())
@@ -26,6 +28,8 @@ def history(folder: Path) -> list:
 
 
 def convergence(folders: list[Path], png: Path, reference: float | None = None) -> Path:
+    """Plot the energies (Eh) of the runs in `folders` against basis size (and wall time, minutes)
+    into the PNG file `png`; with `reference` (Eh) E - E_ref on a log axis. Returns `png`."""
     import matplotlib
 
     matplotlib.use("Agg")

@@ -1,5 +1,9 @@
 """Energies of a basis: translation-free and laboratory-frame, with the virial coefficient.
 
+The pipeline's last stage (system → basis → integrals → eigen → results): `evaluate` is what
+`prebo energy`, `prebo run` (result.json) and the Python API report. It stays a top-level
+module because it uses every earlier stage and none of them uses it.
+
 result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_uncertainty
 (Eh, below), energy_lab (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential,
 n_basis, basis_type, particles, state, symmetry, coordinates, overlap_condition, kept; for
@@ -23,11 +27,19 @@ from .integrals import laboratory, require_shared_c_A, translationally_invariant
 
 
 def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -> dict:
-    """Evaluate a basis; `coordinates="ti"` uses TICC (only for one shared c_A).
+    """The energies of `basis`'s lowest state.
 
-    Returns the keys of the module docstring (energies in Eh) and `coefficients`, the S-normalised
-    ground-state vector; a basis that is not a non-empty `Basis` or an unknown `coordinates` is an
-    InputError."""
+    Parameters: `basis`, a non-empty `Basis`; `coordinates`, "lab" (LFCC with the CM kinetic
+    energy eliminated, Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018)) or "ti"
+    (translationally invariant coordinates, only for one c_A shared by every function);
+    `threshold`, the relative overlap eigenvalue below which directions are dropped
+    (`eigen.solve`).
+
+    Returns a dict with the keys of the module docstring — energy, energy_uncertainty,
+    energy_lab, kinetic and potential in Eh; virial, overlap_condition dimensionless; n2
+    in ħ² — and `coefficients`, the S-normalised ground-state vector. InputError for a
+    basis that is not a non-empty `Basis` or an unknown `coordinates`; NonFiniteError and
+    the eigen errors as `eigen.solve` raises them."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"evaluate: basis = {basis!r}: must be a prebo.Basis with at least one function")
     system = basis.system
@@ -49,7 +61,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
     if energy_lab is None:
         energy_lab = energy + 1.5 * c_A / system.m_total
     extra = {}
-    if basis.kind == "fecg":  # not an angular-momentum eigenfunction: report <N²>_TI
+    if not basis.family.conserves_L:  # not an angular-momentum eigenfunction: report <N²>_TI
         n2 = laboratory(system).angular(basis, system.cm_vector)
         extra["n2"] = float(c @ n2 @ c)
     return extra | {
@@ -60,7 +72,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
         "kinetic": kinetic,
         "potential": potential,
         "n_basis": len(basis),
-        "basis_type": basis.kind,
+        "basis_type": basis.family.name,
         "particles": [p.to_dict() for p in system.particles],
         "state": system.to_dict()["state"],
         "symmetry": system.symmetriser.as_dict(),

@@ -31,60 +31,45 @@ Cartesian coordinates, A = U_xᵀ blockdiag(𝒜, c_A) U_x with a c_A of our cho
 Only the header keywords, the basis section and its size are read; the status line,
 commands and energy history are skipped. Fortran ``D`` exponents are accepted.
 
-Symmetry: what the Young string means
--------------------------------------
-SYMMETRY is a product of factors such as ``(1+P23)(1-P24)``; ``Pij`` swaps particles i
-and j (1-based, file order), acting on the ket as A → PᵀAP. As operators on functions,
-(P_a P_b f)(r) = f(Π_b Π_a r), i.e. the product of P_a and P_b is the permutation a∘b.
-The string's product is a Young operator Y, which is not Hermitian in general.
-ecgpack's energy is the Rayleigh–Ritz energy of the functions Y φ_I, i.e. matrix elements
-⟨Yφ_I|H|Yφ_J⟩ = ⟨φ_I|H Y†Y|φ_J⟩: the symmetry coefficients over permutations are those
-of the Hermitian element O = Y†Y (we normalise them so that the identity has 1). This
-was established on the Li-7 file: O reproduces the file's CURRENT_ENERGY to 1e-15
-relative (a 32-digit evaluation to 1e-16), while Y itself gives no symmetric matrix and
-the spin-projected operator gives another energy.
+Symmetry
+--------
+SYMMETRY is a Young string such as ``(1+P23)(1-P24)`` (`prebo.system.young`: ``Pij`` swaps
+particles i and j, 1-based, file order; the operator of a string Y is Y†Y). That Y†Y is
+ecgpack's operator was established on the Li-7 file: it reproduces the file's
+CURRENT_ENERGY to 1e-15 relative (a 32-digit evaluation to 1e-16), while Y itself gives no
+symmetric matrix and the spin-projected operator gives another energy.
 
-prebo's own symmetry (python/prebo/symmetry.py) is the spin-projected operator of one
-spin function per group, with the smallest intermediate spins. For He, (1+P23)†(1+P23)
-∝ 1 + P23 is exactly prebo's singlet, and the imported system is a plain
-`prebo.System`. For Li, (1+P23)(1−P24) gives O ∝ 2 + P23 + P34 − 2 P24 − P234 − P243: the
-projector onto the row of the [2,1] representation antisymmetric in particles 2 and 4.
-prebo's doublet (spin function [[e2 e3]_0 e4]_1/2) projects onto the row symmetric in
-2 and 3 — the same irreducible representation and spin, but a different row, so the same
-functions give another energy (−7.4764 instead of −7.4774 Eh for Li-100). No spin state
-and no particle order of prebo's Symmetriser gives O (rows symmetric in a pair and rows
-antisymmetric in a pair are never conjugate in S3), so such a file's system is a
-`YoungSystem`: a `prebo.System` whose `symmetriser` is the file's operator O. Everything
-that asks `system.symmetriser` (prebo.evaluate in "lab" and "ti" coordinates,
-prebo.integrals, the optimiser) then uses the file's operator. The state's spins are
-the ones the operator implies (the irreducible representation O lies in), for labels.
-
-basis.json keeps the operator: `Basis.to_dict` writes the "symmetry" block and
-`System.from_dict` honours it whenever it is not the spin state's own operator.
+prebo's own symmetry (`prebo.system.symmetry`) is the spin-projected operator of one spin
+function per group, with the smallest intermediate spins. For He, (1+P23)†(1+P23) ∝ 1 + P23
+is exactly prebo's singlet, and the imported system carries no explicit operator. For Li,
+(1+P23)(1−P24) gives O ∝ 2 + P23 + P34 − 2 P24 − P234 − P243: the projector onto the row of
+the [2,1] representation antisymmetric in particles 2 and 4. prebo's doublet (spin function
+[[e2 e3]_0 e4]_1/2) projects onto the row symmetric in 2 and 3 — the same irreducible
+representation and spin, but a different row, so the same functions give another energy
+(−7.4764 instead of −7.4774 Eh for Li-100). No spin state and no particle order gives O
+(rows symmetric in a pair and rows antisymmetric in a pair are never conjugate in S3), so
+such a file's system is a `System(..., symmetriser=O)` with O labelled by the file's string:
+everything that asks `system.symmetriser` (evaluate, the integrals, the optimiser) uses it.
+The state's spins are the ones O implies (the irreducible representation it lies in), for
+labels. basis.json keeps the operator in its "symmetry" block.
 
 Export
 ------
 `write_inout` writes the header, a status line, an empty command list, a one-line
 energy history and the basis, numbers as ``1PE23.16`` (the field width of ecgpack's
 ``-0.dddE+xx`` numbers, but 17 significant digits, so that doubles survive). A function
-read from a file and not changed since is written with the file's own L (bit-exact
-round trip); others with the Cholesky factor of their 𝒜 in ``hpc:0``. The Young
-string is the imported one when it still describes the basis's symmetry; otherwise
-it is searched among products of (1±Pij) factors within each group of identical
-particles (Y†Y ∝ prebo's operator; e.g. prebo's doublet of three electrons is
-(1−P24)(1+P23)); if there is none, the Hermitian operator itself is written as one
-factor with explicit coefficients and transposition products, which `read_inout`
-reads back exactly (ecgpack may not).
+still bitwise as read from the file it came from (`source=`) is written with the file's
+own L (bit-exact round trip); others with the Cholesky factor of their 𝒜 in ``hpc:0``.
+The Young string is `prebo.system.young.young_string`: the imported one when it still
+describes the symmetry, else a product of (1±Pij) factors, else one explicit factor.
 
-API: `read_inout(path, c_A=1.0) -> Basis`, `write_inout(basis, path, energy=None)`;
+API: `read_inout(path, c_A=1.0) -> Basis`, `write_inout(basis, path, energy=None, source=None)`;
 `parse_inout(path) -> InoutFile` for the raw content (e.g. `.energy`, ecgpack's
-CURRENT_ENERGY, to print beside prebo's); `young_operator` / `young_string` convert
-between SYMMETRY strings and prebo Symmetrisers; `YoungSystem` and `system_with_symmetry`
-carry an explicit operator. Errors: `prebo.errors.BasisFileError` with ``file:line:``.
+CURRENT_ENERGY, to print beside prebo's) and `InoutFile.to_basis`. Errors:
+`prebo.errors.BasisFileError` with ``file:line:``.
 """
 from __future__ import annotations
 
-import itertools
 import math
 import re
 from dataclasses import dataclass, field
@@ -93,18 +78,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..basis import Basis, read_text, write_atomic
+from ..basis import Basis
 from ..coordinates import heavy_particle_centred
 from ..errors import BasisFileError, PreboError, UnsupportedError
-from ..system.particles import KNOWN
-from ..system.symmetry import Group, Symmetriser
-from ..system.system import State, System
+from ..system import KNOWN, State, System, particle
+from ..system.symmetry import implied_spins
+from ..system.young import young_operator, young_product, young_string
 from ..validation import check
+from .basis_json import read_text, write_atomic
 
-__all__ = [
-    "read_inout", "write_inout", "parse_inout", "InoutFile", "YoungSystem", "system_with_symmetry",
-    "young_operator", "young_string",
-]
+__all__ = ["read_inout", "write_inout", "parse_inout", "InoutFile"]
 
 SUPPORTED_TYPE = "RG_0S"
 _SEP = re.compile(r"^\s*={5,}\s*$")
@@ -116,240 +99,6 @@ EXTRA_NUCLEI = {
     "be9": (16424.205, 4.0, Fraction(3, 2)),
 }
 _NAME_RTOL = 1e-5
-_COEF_TOL = 1e-12
-
-
-# --- the group algebra of permutations -------------------------------------------------
-# A permutation is a tuple p of 0-based positions; P_p f(r) = f(Π_p r), (Π_p r)_i = r_{p(i)}
-# (as in prebo.symmetry.Symmetriser). Operators multiply as P_a P_b = P_{a∘b}, (a∘b)(i) = a(b(i)).
-
-def _compose(a, b):
-    return tuple(a[i] for i in b)
-
-
-def _inverse(p):
-    inv = [0] * len(p)
-    for i, k in enumerate(p):
-        inv[k] = i
-    return tuple(inv)
-
-
-def _transposition(n, i, j):
-    p = list(range(n))
-    p[i], p[j] = j, i
-    return tuple(p)
-
-
-def _mul(x: dict, y: dict) -> dict:
-    out: dict = {}
-    for a, ca in x.items():
-        for b, cb in y.items():
-            k = _compose(a, b)
-            out[k] = out.get(k, 0.0) + ca * cb
-    return {k: v for k, v in out.items() if v != 0.0}
-
-
-def _adjoint(x: dict) -> dict:
-    return {_inverse(p): c for p, c in x.items()}
-
-
-def _normalised(x: dict) -> dict:
-    """Coefficients divided by the identity's, those below 1e-12 of it dropped."""
-    ident = tuple(range(len(next(iter(x)))))
-    c0 = x.get(ident, 0.0)
-    if not c0 > 0:
-        raise ValueError("operator has no positive identity coefficient")
-    return {p: c / c0 for p, c in x.items() if abs(c) > _COEF_TOL * abs(c0)}
-
-
-def _same(x: dict, y: dict, tol: float = 1e-10) -> bool:
-    keys = set(x) | set(y)
-    return all(abs(x.get(k, 0.0) - y.get(k, 0.0)) <= tol for k in keys)
-
-
-def _symmetriser(op: dict) -> Symmetriser:
-    """A Symmetriser from a normalised operator, identity first, then in lexicographic order."""
-    perms = sorted(op)
-    return Symmetriser(tuple(perms), tuple(float(op[p]) for p in perms))
-
-
-def _as_operator(sym: Symmetriser) -> dict:
-    return _normalised({tuple(p): float(c) for p, c in zip(sym.permutations, sym.coefficients)})
-
-
-# --- Young strings -------------------------------------------------------------------------
-_TERM = re.compile(r"\s*([+-])?\s*(\d+(?:\.\d*)?(?:[eEdD][+-]?\d+)?)?\s*\*?\s*((?:P(?:\d\d|\(\s*\d+\s*,\s*\d+\s*\))\s*\*?\s*)*)")
-_PTOK = re.compile(r"P(?:(\d)(\d)|\(\s*(\d+)\s*,\s*(\d+)\s*\))")
-
-
-def _parse_factor(text: str, n: int) -> dict:
-    out: dict = {}
-    pos, first = 0, True
-    text = text.strip()
-    if not text:
-        raise ValueError("empty factor ()")
-    while pos < len(text):
-        m = _TERM.match(text, pos)
-        if not m or m.end() == pos:
-            raise ValueError(f"cannot read {text[pos:]!r}")
-        sign, num, ps = m.group(1), m.group(2), m.group(3)
-        if sign is None and not first:
-            raise ValueError(f"missing + or - before {text[pos:]!r}")
-        if not num and not ps.strip():
-            raise ValueError(f"cannot read {text[pos:]!r}")
-        coef = float(num.replace("d", "e").replace("D", "e")) if num else 1.0
-        if sign == "-":
-            coef = -coef
-        perm = tuple(range(n))
-        if ps.strip():
-            for t in _PTOK.finditer(ps):
-                i, j = (t.group(1), t.group(2)) if t.group(1) else (t.group(3), t.group(4))
-                i, j = int(i), int(j)
-                if not (1 <= i <= n and 1 <= j <= n) or i == j:
-                    raise ValueError(f"P{i}{j}: particles are numbered 1..{n}, two different ones")
-                perm = _compose(perm, _transposition(n, i - 1, j - 1))
-        out[perm] = out.get(perm, 0.0) + coef
-        pos, first = m.end(), False
-    return {k: v for k, v in out.items() if v != 0.0}
-
-
-def young_product(string: str, n: int) -> dict:
-    """The group-algebra element Y of a SYMMETRY string: the product of its factors, in order.
-
-    A factor is ``(t ± t ± ...)`` with terms ``1``, ``Pij`` / ``P(i,j)`` and products of them,
-    optionally with a numeric coefficient (``0.5P23P24``). ``1``, ``(1)`` or ``none`` is the
-    identity. ValueError on anything else."""
-    s = string.strip()
-    ident = {tuple(range(n)): 1.0}
-    if s.lower() in ("", "1", "none", "(1)"):
-        return ident
-    y = ident
-    pos, found = 0, False
-    while pos < len(s):
-        if s[pos] in " \t*":
-            pos += 1
-            continue
-        if s[pos] != "(":
-            raise ValueError(f"unexpected {s[pos:]!r}: expected factors in parentheses, e.g. (1+P23)(1-P24)")
-        depth, end = 0, None
-        for k in range(pos, len(s)):
-            depth += {"(": 1, ")": -1}.get(s[k], 0)
-            if depth == 0:
-                end = k
-                break
-        if end is None:
-            raise ValueError(f"unbalanced parentheses in {s[pos:]!r}")
-        y = _mul(y, _parse_factor(s[pos + 1:end], n))
-        pos, found = end + 1, True
-    if not found:
-        raise ValueError("expected factors in parentheses, e.g. (1+P23)(1-P24)")
-    if not y:
-        raise ValueError("the product of the factors is zero")
-    return y
-
-
-def young_operator(string: str, n: int) -> Symmetriser:
-    """The symmetry of ``SYMMETRY string`` as prebo coefficients: Y†Y, identity coefficient 1."""
-    y = young_product(string, n)
-    return _symmetriser(_normalised(_mul(_adjoint(y), y)))
-
-
-def _format_perm_term(p) -> str:
-    """A permutation as a product of transpositions Pij (1-based) whose operator product is P_p."""
-    cur, swaps = list(p), []
-    for i in range(len(cur)):
-        if cur[i] != i:
-            j = cur.index(i)
-            cur[i], cur[j] = cur[j], cur[i]
-            swaps.append((i, j))
-    # p ∘ t_1 ∘ ... ∘ t_m = id  =>  p = t_m ∘ ... ∘ t_1
-    return "".join(f"P{a + 1}{b + 1}" if max(a, b) < 9 else f"P({a + 1},{b + 1})" for a, b in reversed(swaps))
-
-
-def _explicit_string(op: dict) -> str:
-    n = len(next(iter(op)))
-    ident = tuple(range(n))
-    terms = ["1"]
-    for p in sorted(op):
-        if p == ident:
-            continue
-        c = op[p]
-        num = "" if abs(abs(c) - 1.0) < 1e-15 else repr(abs(c))
-        terms.append(("-" if c < 0 else "+") + num + _format_perm_term(p))
-    return "(" + "".join(terms) + ")"
-
-
-def _group_products(indices, n, max_factors=4):
-    """Young strings over one group: ordered products of distinct (1±Pij) factors."""
-    pairs = list(itertools.combinations(indices, 2))
-    for k in range(1, min(len(pairs), max_factors) + 1):
-        for seq in itertools.permutations(pairs, k):
-            for signs in itertools.product((1.0, -1.0), repeat=k):
-                yield seq, signs
-
-
-def young_string(sym: Symmetriser, groups: list[Group], n: int) -> str:
-    """A SYMMETRY string whose Y†Y is `sym` up to a factor (see the module docstring)."""
-    target = _as_operator(sym)
-    if len(target) == 1:
-        return "(1)"
-    # try a product over groups of per-group factor products
-    parts = []
-    ident = tuple(range(n))
-    for g in groups:
-        gop = _normalised({_lift(gp, g.indices, n): c for gp, c in g.coefficients().items()})
-        if len(gop) == 1:
-            continue
-        found = None
-        for seq, signs in _group_products(g.indices, n):
-            y = {ident: 1.0}
-            for (i, j), sg in zip(seq, signs):
-                y = _mul(y, {ident: 1.0, _transposition(n, i, j): sg})
-            if not y:
-                continue
-            op = _mul(_adjoint(y), y)
-            if ident in op and op[ident] > 0 and _same(_normalised(op), gop):
-                found = "".join(f"(1{'+' if sg > 0 else '-'}P{i + 1}{j + 1})" for (i, j), sg in zip(seq, signs))
-                break
-        if found is None:
-            parts = None
-            break
-        parts.append(found)
-    if parts is not None and parts:
-        s = "".join(parts)
-        if _same(_as_operator(young_operator(s, n)), target):
-            return s
-    return _explicit_string(target)
-
-
-def _lift(gp, indices, n):
-    q = list(range(n))
-    for pos, src in enumerate(gp):
-        q[indices[pos]] = indices[src]
-    return tuple(q)
-
-
-# --- systems with an explicit symmetry -----------------------------------------------------
-class YoungSystem(System):
-    """A `System` whose symmetry operator is given explicitly (`System(symmetriser=...)`)
-    instead of by the spin state; `young` is the SYMMETRY string it came from."""
-
-    def __init__(self, particles, state: State | None = None, symmetriser: Symmetriser | None = None,
-                 young: str | None = None, **state_kw):
-        super().__init__(particles, state, symmetriser=symmetriser, **state_kw)
-        self.young = young
-
-    def __repr__(self) -> str:
-        return f"YoungSystem({self.label()!r}, {self.state}, {self.young!r})"
-
-
-def system_with_symmetry(particles, state: State, symmetriser: Symmetriser, young: str | None = None) -> System:
-    """A plain `System` if `symmetriser` is the spin state's own operator (up to a factor), else a
-    `YoungSystem` carrying it (e.g. for a basis.json whose "symmetry" block must be honoured)."""
-    plain = System(particles, state)
-    if _same(_as_operator(plain.symmetriser), _as_operator(symmetriser)):
-        return plain
-    return YoungSystem(particles, state, symmetriser, young)
 
 
 # --- particles and spin states -----------------------------------------------------------
@@ -362,59 +111,11 @@ def _particle_spec(mass: float, charge: float) -> dict | str | None:
     return None
 
 
-def _central(op: dict, moved) -> dict:
-    """Σ_g g op g⁻¹ over the permutations g of the positions `moved` (for op a primitive
-    idempotent of that symmetric group: ∝ the central idempotent of its irrep)."""
-    n = len(next(iter(op)))
-    out: dict = {}
-    for sigma in itertools.permutations(moved):
-        g = list(range(n))
-        for a, b in zip(moved, sigma):
-            g[a] = b
-        g = tuple(g)
-        gi = _inverse(g)
-        for p, c in op.items():
-            k = _compose(_compose(g, p), gi)
-            out[k] = out.get(k, 0.0) + c
-    return out
-
-
-def _implied_spins(op: dict, raw_groups: list[tuple[int, ...]], spins: list[Fraction], n: int) -> dict | None:
-    """Total spin per group whose spin-projected operator lies in the same irreducible
-    representation as `op`, or None when there is no such state."""
-    from ..system.symmetry import coupling_path
-
-    choices = []
-    for idx, s in zip(raw_groups, spins):
-        opts = []
-        S = Fraction(len(idx) * s).limit_denominator(2)
-        lo = S - int(S)  # 0 or 1/2
-        cand = lo
-        while cand <= S:
-            try:
-                coupling_path(s, len(idx), cand)
-                opts.append(cand)
-            except PreboError:
-                pass
-            cand += 1
-        choices.append(opts)
-    scale = max(abs(c) for c in op.values())
-    for combo in itertools.product(*choices):
-        z = {tuple(range(n)): 1.0}
-        for idx, s, S in zip(raw_groups, spins, combo):
-            g = Group("g", idx, s, S)
-            gop = {_lift(gp, idx, n): c for gp, c in g.coefficients().items()}
-            z = _mul(z, _central(gop, idx))
-        prod = _mul(op, z)
-        if prod and max(abs(c) for c in prod.values()) > 1e-9 * scale * max(abs(c) for c in z.values()):
-            return dict(zip(range(len(raw_groups)), combo))
-    return None
-
-
 # --- the file --------------------------------------------------------------------------
 @dataclass
 class InoutFile:
-    """A parsed ``*.inout.txt``: header values, the L vectors and where each came from."""
+    """A parsed ``*.inout.txt``: BASIS_TYPE, MASSES (m_e), CHARGES (e), the SYMMETRY string,
+    CURRENT_ENERGY (Eh; None if absent), each function's vech(L) and every header line."""
 
     path: Path
     basis_type: str
@@ -427,14 +128,8 @@ class InoutFile:
 
     @property
     def n_particles(self) -> int:
+        """PARTICLES."""
         return len(self.masses)
-
-    def lower(self, k: int) -> np.ndarray:
-        """L of function k (0-based) as an (n, n) lower-triangular matrix."""
-        n = self.n_particles - 1
-        L = np.zeros((n, n))
-        L[_vech_indices(n)] = self.L[k]  # the lower triangle, column by column
-        return L
 
     def exponents(self) -> np.ndarray:
         """𝒜 = L Lᵀ of every function, (K, n, n), in ecgpack's coordinates r_i = R_{i+1} − R_1."""
@@ -444,10 +139,8 @@ class InoutFile:
         Ls[:, rows, cols] = self.L
         return Ls @ Ls.transpose(0, 2, 1)
 
-    def system(self) -> System:
-        return _system(self)
-
     def to_basis(self, c_A: float = 1.0) -> Basis:
+        """The file's basis with CM exponent `c_A` (bohr⁻²), as `read_inout` describes."""
         return _basis(self, c_A)
 
 
@@ -573,6 +266,7 @@ def parse_inout(path) -> InoutFile:
 
 
 def _system(f: InoutFile) -> System:
+    """The file's particles (named as `read_inout` says) with its symmetry and the spins it implies."""
     n = f.n_particles
     ln = f.header["SYMMETRY"][0]
     # particle names: prebo's known name (or a nucleus of EXTRA_NUCLEI) with the file's mass
@@ -589,7 +283,8 @@ def _system(f: InoutFile) -> System:
     names = [s if isinstance(s, str) else s["name"] for s in specs]
     if len(set(names)) != len(set(zip(f.masses.tolist(), f.charges.tolist()))):
         _fail(f.path, f.header["MASSES"][0], "particles with one name but different masses or charges")
-    op = _as_operator(young_operator(f.symmetry, n))
+    sym = young_operator(f.symmetry, n)
+    op = sym.operator()
     for p in op:
         for i in range(n):
             if names[p[i]] != names[i]:
@@ -600,15 +295,13 @@ def _system(f: InoutFile) -> System:
         idx = tuple(i for i, x in enumerate(names) if x == nm)
         if len(idx) > 1:
             raw_groups.append(idx)
-    from ..system.particles import particle
-
     spins = [particle(specs[idx[0]]).spin for idx in raw_groups]
-    implied = _implied_spins(op, raw_groups, spins, n) if raw_groups else {}
+    implied = implied_spins(op, raw_groups, spins, n) if raw_groups else []
     if implied is None:
         # unknown identical particles: try spin 1/2 instead of 0
         alt = [Fraction(1, 2) if not isinstance(specs[idx[0]], str) and specs[idx[0]]["name"].startswith("x")
                else s for idx, s in zip(raw_groups, spins)]
-        implied = _implied_spins(op, raw_groups, alt, n)
+        implied = implied_spins(op, raw_groups, alt, n)
         if implied is not None:
             for idx in raw_groups:
                 for i in idx:
@@ -621,7 +314,7 @@ def _system(f: InoutFile) -> System:
     spin = {names[idx[0]]: float(implied[k]) for k, idx in enumerate(raw_groups)}
     state = State(N=0, parity=1, spin=spin)
     try:
-        return system_with_symmetry(specs, state, _symmetriser(op), f.symmetry)
+        return System(specs, state, symmetriser=sym)
     except PreboError as exc:
         _fail(f.path, None, f"cannot build the system: {exc}")
 
@@ -636,17 +329,19 @@ def _basis(f: InoutFile, c_A: float) -> Basis:
         k = bad[0]
         _fail(f.path, _basis_line(f, k), f"basis function {k + 1}: L Lᵀ is not positive definite "
                                          "(a zero on the diagonal of L)")
-    A = np.array([hpc.to_lab(a, c_A) for a in A_int]).reshape(len(A_int), system.n, system.n)
-    A = 0.5 * (A + A.transpose(0, 2, 1))
+    A = np.array([_to_lab(hpc, a, c_A) for a in A_int]).reshape(len(A_int), system.n, system.n)
     basis = Basis(system, A, np.full(len(A), float(c_A)), [hpc.name] * len(A))
     try:
         basis.validate()
     except PreboError as exc:
         _fail(f.path, None, f"converted basis is invalid: {exc}")
-    # the file's own L, for write_inout: a function still equal to its import is written back
-    # with these exact parameters (an exact round trip), others from their Cholesky factor
-    basis.ecgpack_source = (basis.A.copy(), f.L.copy())
     return basis
+
+
+def _to_lab(hpc, A_int: np.ndarray, c_A: float) -> np.ndarray:
+    """A = U_xᵀ blockdiag(𝒜, c_A) U_x, symmetrised; the same bits in `to_basis` and `write_inout`."""
+    A = hpc.to_lab(A_int, c_A)
+    return 0.5 * (A + A.T)
 
 
 def _pd(a) -> bool:
@@ -680,8 +375,12 @@ def read_inout(path, c_A: float = 1.0) -> Basis:
     with the file's mass, which may differ from prebo's CODATA value. Each function is
     A = U_xᵀ blockdiag(L Lᵀ, c_A) U_x with x = ``hpc:0`` (relative to particle 1) and the
     given `c_A` (the translation-free energy does not depend on it). The symmetry is the
-    file's SYMMETRY string's Y†Y (module docstring): a plain `System` with the implied spin
-    state when that is prebo's own operator, else a `YoungSystem` carrying the operator.
+    file's SYMMETRY string's Y†Y (module docstring): the implied spin state's own operator
+    when it is that, else carried explicitly (`System(..., symmetriser=...)`).
+
+    Parameters: `path`, the file; `c_A`, the CM exponent in bohr⁻² (> 0). Returns the
+    `Basis`; `parse_inout(path).to_basis(c_A)` is the same with the parsed file kept, for
+    `write_inout(..., source=...)`.
 
     Raises BasisFileError naming the file and line for anything prebo cannot take: complex
     ECGs, L > 0 basis types, a malformed header or basis line, a size mismatch, a symmetry
@@ -695,30 +394,35 @@ def _fmt(x: float) -> str:
     return " " + f"{float(x): .16E}"
 
 
-def write_inout(basis: Basis, path, energy: float | None = None) -> None:
+def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFile | None = None) -> None:
     """Write a plain-ECG `basis` as an ecgpack ``*.inout.txt`` (RG_0S).
 
-    Each function's internal exponent 𝒜 is taken in prebo's ``hpc:0`` set (relative to the
-    first particle, SeparabilityError if a function couples the CM to internal motion; c_A
-    is dropped) and written as vech of its Cholesky factor L — except a function of a
-    basis from `read_inout` that is still bitwise the imported one: it is written with the
-    file's own L, so that read → write → read gives the same A bit for bit. (Through
-    basis.json that link is lost and A comes back to rounding, ~1e-16 relative, which moves
-    the energy of a nearly linearly dependent basis such as He-490 by ~1e-12 relative.) The header gives the masses
-    and charges in the basis's particle order, the SYMMETRY string (`young_string`) and
-    CURRENT_ENERGY: `energy` if given, else the translation-free energy prebo.evaluate
-    computes. The file is written atomically (basis.write_atomic)."""
+    Parameters: `basis`, plain ECGs (UnsupportedError for another family); `path`, the
+    file, written atomically (`write_atomic`); `energy` (Eh) for CURRENT_ENERGY, default the
+    translation-free energy `prebo.evaluate` computes; `source`, the `InoutFile` the basis
+    was read from (`parse_inout(path).to_basis()`), if any.
+
+    Each function's internal exponent 𝒜 (bohr⁻²) is taken in prebo's ``hpc:0`` set
+    (relative to the first particle; SeparabilityError if a function couples the CM to
+    internal motion; c_A is dropped) and written as vech of its Cholesky factor L — except
+    a function still bitwise as imported from `source`: it is written with the file's own
+    L, so that read → write → read gives the same A bit for bit. (Through basis.json that
+    link is lost and A comes back to rounding, ~1e-16 relative, which moves the energy of
+    a nearly linearly dependent basis such as He-490 by ~1e-12 relative.) The header gives
+    the masses (m_e) and charges (e) in the basis's particle order and the SYMMETRY string
+    (`prebo.system.young.young_string`)."""
+    if basis.family.parameters != ("A", "c_A"):
+        raise UnsupportedError(f"ecgpack's RG_0S format holds plain ECGs only, not {basis.family.name}")
     system = basis.system
     n = system.n
-    if n < 2:
-        raise UnsupportedError("ecgpack needs at least two particles")
     hpc = heavy_particle_centred(system.masses, 0)
     rows, cols = _vech_indices(n - 1)
-    src_A, src_L = getattr(basis, "ecgpack_source", (np.zeros((0, n, n)), None))
+    imported = source.exponents() if source is not None else np.zeros((0, n - 1, n - 1))
     vech = []
     for k, (A, c) in enumerate(zip(basis.A, basis.c_A)):
-        if k < len(src_A) and src_A[k].shape == A.shape and np.array_equal(src_A[k], A):
-            vech.append(src_L[k])
+        if k < len(imported) and imported[k].shape == (n - 1, n - 1) \
+                and np.array_equal(_to_lab(hpc, imported[k], c), A):
+            vech.append(source.L[k])
             continue
         A_int, _ = hpc.from_lab(A)
         A_int = 0.5 * (A_int + A_int.T)
@@ -727,10 +431,7 @@ def write_inout(basis: Basis, path, energy: float | None = None) -> None:
         except np.linalg.LinAlgError:
             raise UnsupportedError(f"function {k}: internal exponent is not positive definite") from None
         vech.append(L[rows, cols])
-    sym = system.symmetriser
-    young = getattr(system, "young", None)
-    if not (young and _same(_as_operator(young_operator(young, n)), _as_operator(sym))):
-        young = young_string(sym, system.groups, n)
+    young = young_string(system.symmetriser, system.groups, n)
     if energy is None:
         from ..results import evaluate
 

@@ -2,10 +2,10 @@
 
     [system]     particles = ["p", "e", {name = "x", mass = 3.0, charge = 1, spin = 0.5}]   -> System
     [state]      N = 0, parity = 1, spin = {e = 0}                                          -> State
-    [basis]      type = "pecg" | "ecg-gvr" | "fecg", size = 100, c_A = 1.0, K_max = 20               -> Optimiser.kind, .size, .c_A, .K_max
+    [basis]      type = "pecg", size = 100, c_A = 1.0, K_max = 20     -> Optimiser.kind (a prebo.basis.family), .size, .c_A, .K_max
     [optimiser]  trials = 20, sweeps = 1, seed = 1, channels = "pairs", length_range = [0.01, 15]
 
-Every value is checked against validation.SETTINGS, the basis type against the state and the
+Every value is checked against validation.SETTINGS, the basis family against the state and the
 coordinate sets against the particles before anything runs; errors name the file and the key.
 """
 from __future__ import annotations
@@ -19,11 +19,12 @@ if sys.version_info >= (3, 11):
 else:  # Python 3.10: the same parser as a package
     import tomli as tomllib
 
-from ..basis import read_text
+from ..basis import family
 from ..errors import InputError
 from ..optimise import Optimiser, coordinate_sets
 from ..system import State, System
-from ..validation import SETTINGS, check, check_kind
+from ..validation import SETTINGS, check
+from .basis_json import read_text
 
 #: [basis] key -> Optimiser setting; [optimiser] takes every other setting
 BASIS_KEYS = {"type": "kind", "size": "size", "c_A": "c_A", "K_max": "K_max"}
@@ -32,10 +33,11 @@ OPTIMISER_KEYS = set(SETTINGS) - set(BASIS_KEYS.values())
 
 @dataclass
 class Job:
+    """An input file's run: its `title` (default: the particle names), `system` and `optimiser` settings."""
+
     title: str
     system: System
     optimiser: Optimiser
-    basis_type: str = "pecg"
 
 
 def _table(d: dict, name: str, allowed: set) -> dict:
@@ -49,7 +51,7 @@ def _table(d: dict, name: str, allowed: set) -> dict:
 
 
 def from_dict(d: dict) -> Job:
-    """A Job from the parsed TOML mapping (see module docstring)."""
+    """A Job from the parsed TOML mapping (module docstring); InputError naming the key."""
     unknown = set(d) - {"title", "system", "state", "basis", "optimiser"}
     if unknown:
         raise InputError(f"unknown tables {sorted(unknown)}")
@@ -65,12 +67,13 @@ def from_dict(d: dict) -> Job:
     system = System(system_t["particles"], State(**state_t))
     settings = {BASIS_KEYS[k]: v for k, v in basis_t.items()} | opt_t
     opts = Optimiser(**{name: check(name, v, SETTINGS[name].key) for name, v in settings.items()})
-    check_kind(opts.kind, system.state)
+    family(opts.kind).check_state(system.state)
     coordinate_sets(system, opts.channels)
-    return Job(title or system.label(), system, opts, opts.kind)
+    return Job(title or system.label(), system, opts)
 
 
 def load(path) -> Job:
+    """The Job of a TOML input file; InputError naming the file (and the key) for anything wrong."""
     path = Path(path)
     text = read_text(path, InputError)
     try:

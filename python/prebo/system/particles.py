@@ -14,7 +14,8 @@ from ..validation import half_integer, number
 
 @dataclass(frozen=True)
 class Particle:
-    """A point particle: `mass` in m_e, `charge` in e, `spin` in hbar (0, 1/2, 1, ...)."""
+    """A point particle: `name`, `mass` in m_e (> 0), `charge` in e, `spin` in ħ (0, 1/2, 1, ...);
+    InputError for anything else."""
 
     name: str
     mass: float
@@ -31,9 +32,11 @@ class Particle:
 
     @property
     def fermion(self) -> bool:
+        """Half-integer spin."""
         return self.spin.denominator == 2
 
     def to_dict(self) -> dict:
+        """{name, mass, charge, spin} as basis.json stores it."""
         return {"name": self.name, "mass": self.mass, "charge": self.charge, "spin": float(self.spin)}
 
 
@@ -58,8 +61,9 @@ ALIASES = {"e-": "e", "electron": "e", "positron": "e+", "proton": "p", "deutero
 def particle(spec) -> Particle:
     """A particle from a name (`"p"`) or a mapping (`{name, mass?, charge?, spin?}`).
 
-    A known name supplies defaults that explicit keys override; an unknown name
-    must give mass, charge and spin explicitly.
+    A known name (`KNOWN`, `ALIASES`: "e", "p", "d", "mu", "alpha", ...) supplies CODATA 2018
+    defaults that explicit keys override (mass in m_e, charge in e, spin in ħ); an unknown
+    name must give mass, charge and spin explicitly. Returns the `Particle`; InputError otherwise.
     """
     if isinstance(spec, Particle):
         return spec

@@ -17,13 +17,14 @@ of the groups' permutations.
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
 from math import factorial, sqrt
 
 import numpy as np
 
 from ..errors import SpinError
+from .permutations import class_sum, compose, lift, normalised, product, sign
 
 
 def clebsch_gordan(j1: Fraction, m1: Fraction, j2: Fraction, m2: Fraction, j: Fraction, m: Fraction) -> float:
@@ -114,6 +115,7 @@ class Group:
 
     @property
     def fermion(self) -> bool:
+        """Half-integer spin: permutations carry their sign."""
         return self.spin.denominator == 2
 
     def coefficients(self) -> dict[tuple[int, ...], float]:
@@ -123,51 +125,55 @@ class Group:
         out = {}
         for p in itertools.permutations(range(n)):
             overlap = float(np.sum(chi * np.transpose(chi, p)))
-            sign = permutation_sign(p) if self.fermion else 1
-            c = sign * overlap
+            c = (sign(p) if self.fermion else 1) * overlap
             if abs(c) > 1e-14:
                 out[p] = c
         return out
 
 
-def permutation_sign(p) -> int:
-    """(-1)^(number of inversions)."""
-    p = list(p)
-    sign = 1
-    for i in range(len(p)):
-        for j in range(i + 1, len(p)):
-            if p[i] > p[j]:
-                sign = -sign
-    return sign
-
-
 @dataclass(frozen=True)
 class Symmetriser:
-    """The Young operator of a system as LFCC permutation matrices and coefficients.
+    """A symmetry operator Σ_P c_P P over permutations of the particles (LFCC order).
 
-    `matrices[k]` is Pi with (Pi r)_i = r_{p(i)}, so P phi(r) = phi(Pi r) and A -> Pi^T A Pi.
+    Parameters: `permutations`, tuples p with (Π_p r)_i = r_{p(i)}, so that P φ(r) = φ(Π_p r)
+    and a Gaussian's A → Π_pᵀ A Π_p; `coefficients`, the real c_P (dimensionless, only their
+    ratios matter); `young`, the Young string (ecgpack SYMMETRY syntax, e.g. "(1+P23)(1-P24)")
+    the operator was made from, a label that is not compared and not stored in basis.json.
+    A `System` builds its spin state's operator (`from_groups`) or carries an explicit one.
     """
 
     permutations: tuple[tuple[int, ...], ...]
     coefficients: tuple[float, ...]
+    young: str | None = field(default=None, compare=False)
 
     @classmethod
     def from_groups(cls, n: int, groups: list[Group]) -> "Symmetriser":
+        """The spin-projected operator of the module docstring: the product over `groups`."""
         perms, coefs = [tuple(range(n))], [1.0]
         for g in groups:
             new_p, new_c = [], []
             for gp, gc in g.coefficients().items():
+                lifted = lift(gp, g.indices, n)
                 for p, c in zip(perms, coefs):
-                    q = list(p)
-                    for pos, src in enumerate(gp):
-                        q[g.indices[pos]] = p[g.indices[src]]
-                    new_p.append(tuple(q))
+                    new_p.append(compose(p, lifted))
                     new_c.append(c * gc)
             perms, coefs = new_p, new_c
         return cls(tuple(perms), tuple(coefs))
 
+    @classmethod
+    def from_operator(cls, op: dict, young: str | None = None) -> "Symmetriser":
+        """From a group-algebra element {permutation: coefficient}, permutations in
+        lexicographic order (the identity first)."""
+        perms = sorted(op)
+        return cls(tuple(perms), tuple(float(op[p]) for p in perms), young)
+
+    def operator(self) -> dict:
+        """The group-algebra element {permutation: coefficient}, identity coefficient 1."""
+        return normalised({tuple(p): float(c) for p, c in zip(self.permutations, self.coefficients)})
+
     @property
     def matrices(self) -> np.ndarray:
+        """The LFCC permutation matrices Π_p, shape (operations, N, N)."""
         n = len(self.permutations[0])
         out = np.zeros((len(self.permutations), n, n))
         for k, p in enumerate(self.permutations):
@@ -175,10 +181,12 @@ class Symmetriser:
         return out
 
     def as_dict(self) -> dict:
+        """basis.json's "symmetry" block."""
         return {"permutations": [list(p) for p in self.permutations], "coefficients": list(self.coefficients)}
 
     @classmethod
     def from_dict(cls, d: dict) -> "Symmetriser":
+        """The operator of an `as_dict` block; SpinError if it is malformed."""
         try:
             perms = tuple(tuple(int(i) for i in p) for p in d["permutations"])
             coefs = tuple(float(c) for c in d["coefficients"])
@@ -201,3 +209,32 @@ class Symmetriser:
         if identity not in a or identity not in b:
             return False
         return all(abs(a.get(p, 0.0) / a[identity] - b.get(p, 0.0) / b[identity]) <= tol for p in set(a) | set(b))
+
+
+def implied_spins(op: dict, groups: list[tuple[int, ...]], spins: list[Fraction], n: int) -> list[Fraction] | None:
+    """The total spin of each group of identical particles (`groups`: their indices, `spins`:
+    their spin s) whose spin-projected operator lies in the same irreducible representation
+    as the operator `op`, or None when there is no such spin state."""
+    choices = []
+    for idx, s in zip(groups, spins):
+        opts = []
+        S = Fraction(len(idx) * s).limit_denominator(2)
+        cand = S - int(S)  # 0 or 1/2
+        while cand <= S:
+            try:
+                coupling_path(s, len(idx), cand)
+                opts.append(cand)
+            except SpinError:
+                pass
+            cand += 1
+        choices.append(opts)
+    scale = max(abs(c) for c in op.values())
+    for combo in itertools.product(*choices):
+        z = {tuple(range(n)): 1.0}
+        for idx, s, S in zip(groups, spins, combo):
+            gop = {lift(gp, idx, n): c for gp, c in Group("g", idx, s, S).coefficients().items()}
+            z = product(z, class_sum(gop, idx))
+        prod = product(op, z)
+        if prod and max(abs(c) for c in prod.values()) > 1e-9 * scale * max(abs(c) for c in z.values()):
+            return list(combo)
+    return None

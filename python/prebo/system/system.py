@@ -1,4 +1,8 @@
-"""A Coulomb system: particles, the state sought, and the groups of identical particles."""
+"""A Coulomb system: particles, the state sought, and the groups of identical particles.
+
+Hartree atomic units throughout: masses in m_e, charges in e, spins and N in ħ, energies in Eh.
+Equation numbers refer to Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018).
+"""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -6,15 +10,21 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..validation import MAX_PARTICLES, half_integer, strict_keywords
 from .particles import Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
-from ..validation import MAX_PARTICLES, half_integer, strict_keywords
 
 
 @strict_keywords
 @dataclass(frozen=True)
 class State:
-    """Total orbital angular momentum `N`, `parity` (+1/-1) and the total spin of each identical group."""
+    """The quantum numbers of the state sought.
+
+    Parameters: `N`, the total orbital angular momentum quantum number (≥ 0, units of ħ);
+    `parity`, +1 or -1; `spin`, {particle name: total spin S} of each group of identical
+    particles (0, 1/2, 1, ...); a group not named gets its lowest total spin (singlet,
+    doublet, para). InputError for anything else (unknown keywords included).
+    """
 
     N: int = 0
     parity: int = 1
@@ -32,10 +42,18 @@ class State:
 
 
 class System:
-    """Particles (LFCC order = input order) and the state; defines M, the Coulomb pairs and the symmetry.
+    """Particles in LFCC order (the input order), the state, and the symmetry operator.
 
-    The Hamiltonian is paper eq. nonrel-H: H = -∇^T M ∇ + Σ_{i<j} q_i q_j / |r_i - r_j|,
-    M = diag(1/(2 m_i)).
+    The Hamiltonian is eq. (1), H = -∇ᵀ M ∇ + Σ_{i<j} q_i q_j / |r_i - r_j| with
+    M = diag(1/(2 m_i)) (Eh; r in bohr, m in m_e, q in e).
+
+    Parameters: `particles`, 2 to MAX_PARTICLES names (``"p"``, ``"e"``, see
+    `prebo.system.particles.KNOWN`) or tables {name, mass, charge, spin}; `state`, a
+    `State`, or its keywords (`N`, `parity`, `spin`) given directly; `symmetriser`, an
+    explicit symmetry operator (e.g. an ecgpack file's Young operator) that replaces the
+    spin state's own — kept only when it differs from it beyond an overall factor, so a
+    system carries an explicit operator exactly when its spin state does not describe its
+    symmetry. InputError (SpinError for impossible spins) for anything invalid.
     """
 
     def __init__(self, particles, state: State | None = None, symmetriser: Symmetriser | None = None,
@@ -48,10 +66,11 @@ class System:
             raise InputError(f"system: state = {state!r}: must be a prebo.State")
         self.state = state if state is not None else State(**state_kw)
         self.groups = self._groups()
+        self._symmetriser = None
         if symmetriser is not None:
             self._check_operator(symmetriser)
-        # an explicit Young operator (e.g. an ecgpack file's), else the spin state's
-        self._symmetriser = symmetriser
+            if not symmetriser.equivalent(self.symmetriser):
+                self._symmetriser = symmetriser
 
     # --- identical particles -------------------------------------------------
     def _groups(self) -> list[Group]:
@@ -80,6 +99,7 @@ class System:
 
     @property
     def symmetriser(self) -> Symmetriser:
+        """The symmetry operator: the explicit one if given, else the spin state's (`prebo.system.symmetry`)."""
         if self._symmetriser is not None:
             return self._symmetriser
         return Symmetriser.from_groups(self.n, self.groups)
@@ -97,37 +117,42 @@ class System:
     # --- masses and charges --------------------------------------------------
     @property
     def n(self) -> int:
+        """The number of particles N_p."""
         return len(self.particles)
 
     @property
     def masses(self) -> np.ndarray:
+        """Particle masses m_i in m_e, LFCC order."""
         return np.array([p.mass for p in self.particles])
 
     @property
     def charges(self) -> np.ndarray:
+        """Particle charges q_i in e, LFCC order."""
         return np.array([p.charge for p in self.particles])
 
     @property
     def m_total(self) -> float:
+        """The total mass m_tot in m_e."""
         return float(self.masses.sum())
 
     @property
     def M(self) -> np.ndarray:
-        """Kinetic mass matrix M = diag(1/(2 m_i)) of paper eq. nonrel-H."""
+        """Kinetic mass matrix M = diag(1/(2 m_i)) of eq. (1), in 1/m_e."""
         return np.diag(1.0 / (2.0 * self.masses))
 
     @property
     def M_internal(self) -> np.ndarray:
-        """M - 1 1^T / (2 m_tot): the kinetic operator with the CM kinetic energy removed exactly."""
+        """M - 1 1ᵀ / (2 m_tot) (1/m_e): the kinetic operator with the CM kinetic energy removed exactly."""
         return self.M - np.ones((self.n, self.n)) / (2.0 * self.m_total)
 
     @property
     def cm_vector(self) -> np.ndarray:
-        """m / m_tot: the last row of every U_x (paper eq. Uconstraint2)."""
+        """m / m_tot: the last row of every U_x (eq. (4))."""
         return self.masses / self.m_total
 
     def coulomb_pairs(self) -> tuple[np.ndarray, np.ndarray]:
-        """LFCC vectors w = e_i - e_j and charge products q_i q_j of every interacting pair."""
+        """The Coulomb terms of eq. (1): LFCC vectors w = e_i - e_j, shape (pairs, N), and charge
+        products q_i q_j (e²) of every pair i < j with q_i q_j ≠ 0."""
         w, q = [], []
         for i in range(self.n):
             for j in range(i + 1, self.n):
@@ -141,6 +166,7 @@ class System:
 
     # --- I/O -----------------------------------------------------------------
     def to_dict(self) -> dict:
+        """basis.json's "system" block: the particles and the state with every group's total spin."""
         return {
             "particles": [p.to_dict() for p in self.particles],
             "state": {"N": self.state.N, "parity": self.state.parity,
@@ -149,8 +175,8 @@ class System:
 
     @classmethod
     def from_dict(cls, d: dict, symmetry: dict | None = None) -> "System":
-        """The system of `to_dict`; `symmetry` (`Symmetriser.as_dict`) is honoured when it is not
-        the spin state's own operator (an explicit Young operator, e.g. imported from ecgpack)."""
+        """The system of `to_dict`, with the operator of a `Symmetriser.as_dict` block `symmetry`
+        (explicit when it is not the spin state's own); InputError/SpinError if malformed."""
         if not isinstance(d, dict) or "particles" not in d:
             raise InputError("system: missing 'particles'")
         if not isinstance(d.get("state", {}), dict):
@@ -159,15 +185,15 @@ class System:
         unknown = set(st) - {"N", "parity", "spin"}
         if unknown:
             raise InputError(f"state: unknown keys {sorted(unknown)}")
-        system = cls(d["particles"], State(**st))
-        if symmetry is not None:
-            stored = Symmetriser.from_dict(symmetry)
-            if not stored.equivalent(system.symmetriser):
-                system = cls(system.particles, system.state, symmetriser=stored)
-        return system
+        return cls(d["particles"], State(**st),
+                   symmetriser=Symmetriser.from_dict(symmetry) if symmetry is not None else None)
 
     def label(self) -> str:
+        """The particle names, space-separated (``"p p e e"``)."""
         return " ".join(p.name for p in self.particles)
 
     def __repr__(self) -> str:
-        return f"System({self.label()!r}, {self.state})"
+        explicit = ""
+        if self._symmetriser is not None:
+            explicit = f", symmetry {self._symmetriser.young or 'explicit'}"
+        return f"System({self.label()!r}, {self.state}{explicit})"
