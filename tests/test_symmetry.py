@@ -80,3 +80,26 @@ def test_clebsch_gordan_known_values():
     assert clebsch_gordan(h, -h, h, h, F(0), F(0)) == pytest.approx(-np.sqrt(0.5))
     assert clebsch_gordan(F(1), F(1), F(1), F(-1), F(0), F(0)) == pytest.approx(np.sqrt(1 / 3))
     assert clebsch_gordan(F(1), F(0), F(1), F(0), F(2), F(0)) == pytest.approx(np.sqrt(2 / 3))
+
+
+def test_an_explicit_operator_is_kept_only_when_the_spin_state_does_not_give_it():
+    """One concept: System(symmetriser=S) carries S exactly when S is not the spin state's own
+    operator up to a factor; basis.json's "symmetry" block brings it back; S may only permute
+    identical particles."""
+    from prebo.errors import InputError
+    from prebo.system import Symmetriser
+    from prebo.system.young import young_operator
+
+    he = prebo.System(["alpha", "e", "e"], spin={"e": 0})
+    own = he.symmetriser
+    twice = Symmetriser(own.permutations, tuple(2 * c for c in own.coefficients), young="(1+P23)")
+    assert prebo.System(he.particles, he.state, symmetriser=twice).symmetriser is not twice
+    li = ["alpha", "e", "e", "e"]
+    row = young_operator("(1+P23)(1-P24)", 4)  # another row of the doublet's representation
+    s = prebo.System(li, spin={"e": 0.5}, symmetriser=row)
+    assert s.symmetriser is row and "(1+P23)(1-P24)" in repr(s)
+    assert not row.equivalent(prebo.System(li, spin={"e": 0.5}).symmetriser)
+    back = prebo.System.from_dict(s.to_dict(), s.symmetriser.as_dict())
+    assert back.symmetriser == row and back.symmetriser.young is None  # the label is not stored
+    with pytest.raises(InputError, match="not identical"):
+        prebo.System(["e", "alpha", "e", "e"], spin={"e": 0.5}, symmetriser=row)
