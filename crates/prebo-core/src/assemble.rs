@@ -1,34 +1,25 @@
 //! Parallel assembly of symmetric matrices and of rows from an element function (rayon).
 use rayon::prelude::*;
 
-use crate::build::Matrices;
 use crate::ecg::Element;
-
-fn store(m: &mut Matrices, i: usize, j: usize, e: &Element) {
-    let k = i * m.cols + j;
-    m.s[k] = e.s;
-    m.t[k] = e.t;
-    m.t_ti[k] = e.t_ti;
-    m.v[k] = e.v;
-}
-
-fn zeros(rows: usize, cols: usize) -> Matrices {
-    let z = vec![0.0; rows * cols];
-    Matrices { rows, cols, s: z.clone(), t: z.clone(), t_ti: z.clone(), v: z }
-}
+use crate::matrices::Matrices;
 
 /// The `nb x nb` symmetric matrices: `element(i, j)` for `j >= i`, mirrored.
 pub fn symmetric(nb: usize, element: impl Fn(usize, usize) -> Element + Sync) -> Matrices {
-    let upper: Vec<Vec<Element>> =
-        (0..nb).into_par_iter().map(|i| (i..nb).map(|j| element(i, j)).collect()).collect();
-    let mut m = zeros(nb, nb);
+    let upper = upper(nb, element);
+    let mut m = Matrices::zeros(nb, nb);
     for (i, row) in upper.iter().enumerate() {
         for (k, e) in row.iter().enumerate() {
-            store(&mut m, i, i + k, e);
-            store(&mut m, i + k, i, e);
+            m.set(i, i + k, e);
+            m.set(i + k, i, e);
         }
     }
     m
+}
+
+/// The upper triangle `element(i, j)`, `j >= i`, row by row (rows in parallel).
+pub fn upper<E: Send>(nb: usize, element: impl Fn(usize, usize) -> E + Sync) -> Vec<Vec<E>> {
+    (0..nb).into_par_iter().map(|i| (i..nb).map(|j| element(i, j)).collect()).collect()
 }
 
 /// `k x nb` rows `row(t, j)` and the diagonals `diag(t)`.
@@ -42,11 +33,11 @@ pub fn rows(
         .into_par_iter()
         .map(|t| ((0..nb).into_par_iter().map(|j| row(t, j)).collect(), diag(t)))
         .collect();
-    let mut m = zeros(k, nb);
+    let mut m = Matrices::zeros(k, nb);
     let mut d = Vec::with_capacity(k);
     for (t, (r, e)) in computed.iter().enumerate() {
         for (j, x) in r.iter().enumerate() {
-            store(&mut m, t, j, x);
+            m.set(t, j, x);
         }
         d.push(*e);
     }

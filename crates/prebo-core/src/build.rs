@@ -11,84 +11,13 @@
 //! once per build. All of them give the same bits (see `pecg`).
 use rayon::prelude::*;
 
-use crate::ecg::{Element, Gaussian, Mat, Operators};
-use crate::error::Result;
+use crate::ecg::{Element, Gaussian, Operators};
+use crate::images::Images;
+use crate::matrices::Matrices;
 use crate::pecg::{self, Accumulator, Bra, KetLanes, Prepared};
 
-/// Basis functions with their images under every symmetry operation.
-pub struct Symmetrised<const D: usize> {
-    pub functions: Vec<Gaussian<D>>,
-    /// `images[j][p]` = function `j` transformed by operation `p`.
-    pub images: Vec<Vec<Gaussian<D>>>,
-    pub coef: Vec<f64>,
-}
-
-impl<const D: usize> Symmetrised<D> {
-    pub fn new(functions: Vec<Gaussian<D>>, ops: &[(Mat<D>, f64)]) -> Result<Self> {
-        let images = functions
-            .iter()
-            .enumerate()
-            .map(|(j, f)| ops.iter().map(|(t, _)| f.transformed(t, j)).collect())
-            .collect::<Result<Vec<Vec<_>>>>()?;
-        Ok(Self {
-            functions,
-            images,
-            coef: ops.iter().map(|(_, c)| *c).collect(),
-        })
-    }
-
-    pub fn len(&self) -> usize {
-        self.functions.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.functions.is_empty()
-    }
-
-    /// `Σ_P c_P <bra| O |P phi_j>`.
-    #[inline]
-    pub fn element(&self, bra: &Gaussian<D>, j: usize, ops: &Operators<D>) -> Element {
-        let mut e = Element::default();
-        for (ket, c) in self.images[j].iter().zip(&self.coef) {
-            e += (*c, pecg::element(bra, ket, ops));
-        }
-        e
-    }
-}
-
-/// Row-major `nb x nb` matrices (or `k x nb` rows) of every operator.
-#[derive(Clone, Debug, Default)]
-pub struct Matrices {
-    pub rows: usize,
-    pub cols: usize,
-    pub s: Vec<f64>,
-    pub t: Vec<f64>,
-    pub t_ti: Vec<f64>,
-    pub v: Vec<f64>,
-}
-
-impl Matrices {
-    fn zeros(rows: usize, cols: usize) -> Self {
-        // four separate zeroed allocations (calloc: fresh pages, no copying)
-        let z = || vec![0.0; rows * cols];
-        Self {
-            rows,
-            cols,
-            s: z(),
-            t: z(),
-            t_ti: z(),
-            v: z(),
-        }
-    }
-
-    fn set(&mut self, i: usize, j: usize, e: &Element) {
-        let k = i * self.cols + j;
-        self.s[k] = e.s;
-        self.t[k] = e.t;
-        self.t_ti[k] = e.t_ti;
-        self.v[k] = e.v;
-    }
-}
+/// Plain ECGs with their images under every symmetry operation.
+pub type Symmetrised<const D: usize> = Images<Gaussian<D>>;
 
 /// The kets of a build: every image of every function in blocks of `W`, and the coefficients.
 struct Kets<const D: usize, const W: usize> {
@@ -411,7 +340,7 @@ fn rows_w<const D: usize, const W: usize>(
 mod tests {
     //! Every instruction set gives the same bits; matrices, rows and `Symmetrised::element` agree.
     use super::*;
-    use crate::ecg::Vector;
+    use crate::ecg::{Mat, Vector};
 
     fn lcg(state: &mut u64) -> f64 {
         *state = state
@@ -453,7 +382,7 @@ mod tests {
             pairs,
             cm_mass: Some(masses.iter().sum()),
         };
-        (Symmetrised::new(funcs, &sym).unwrap(), ops)
+        (Symmetrised::new(funcs, &sym, &()).unwrap(), ops)
     }
 
     fn bits(m: &Matrices) -> Vec<u64> {
@@ -489,7 +418,7 @@ mod tests {
         for i in 0..nb {
             for j in 0..nb {
                 let k = i * nb + j;
-                let e = basis.element(&basis.functions[i.min(j)], i.max(j), &ops);
+                let e = basis.element(&basis.functions[i.min(j)], i.max(j), |x, y| pecg::element(x, y, &ops));
                 assert_eq!(
                     [m.s[k], m.t[k], m.t_ti[k], m.v[k]],
                     [e.s, e.t, e.t_ti, e.v],

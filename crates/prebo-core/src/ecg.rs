@@ -90,8 +90,11 @@ impl<const D: usize> Gaussian<D> {
         Ok(Self { a, log_det, c_a })
     }
 
+}
+
+impl<const D: usize, Ctx> crate::images::Transform<D, Ctx> for Gaussian<D> {
     /// The permuted (or otherwise linearly transformed) function `phi(T r)`: `A -> T^T A T`.
-    pub fn transformed(&self, t: &Mat<D>, index: usize) -> Result<Self> {
+    fn transformed(&self, t: &Mat<D>, _: &Ctx, index: usize) -> Result<Self> {
         Self::new(t.transpose() * self.a * t, self.c_a, index)
     }
 }

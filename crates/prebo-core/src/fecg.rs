@@ -22,6 +22,8 @@ use nalgebra::SMatrix;
 
 use crate::ecg::{dot_f, inverse_log_det, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
+use crate::family::{matrices_of, Family, Params};
+use crate::gradient::{seed_matrix, Dual};
 use crate::images::Transform;
 
 pub type Centres<const D: usize, T = f64> = SMatrix<T, D, 3>;
@@ -64,12 +66,56 @@ impl<const D: usize, T: Real> Fecg<D, T> {
     }
 }
 
-impl<const D: usize, T: Real> Transform<D, ()> for Fecg<D, T> {
+impl<const D: usize, T: Real, Ctx> Transform<D, Ctx> for Fecg<D, T> {
     /// `phi(T r)`: `A -> T^T A T`, `s -> T^{-1} s`.
-    fn transformed(&self, t: &Mat<D>, _: &(), index: usize) -> Result<Self> {
+    fn transformed(&self, t: &Mat<D>, _: &Ctx, index: usize) -> Result<Self> {
         let t_inv = t.try_inverse().ok_or_else(|| CoreError::Unsupported("singular symmetry operation".into()))?;
         let (t, t_inv): (SMatrix<T, D, D>, SMatrix<T, D, D>) = (t.map(re), t_inv.map(re));
         Self::new(t.transpose() * self.a * t, t_inv * self.s, self.c_a, index)
+    }
+}
+
+/// The floating-ECG family: parameters `A` (`k x n x n`), centres `s` (`k x n x 3`), `c_A`.
+pub struct FloatingEcg;
+
+impl<const D: usize> Family<D> for FloatingEcg {
+    const NAME: &'static str = "fecg";
+    type Function<T: Real> = Fecg<D, T>;
+    type Context = Operators<D>;
+
+    fn context(ops: Operators<D>, _: u32, _: &[&Params]) -> Result<Operators<D>> {
+        Ok(ops)
+    }
+
+    fn functions(p: &Params, _: &Operators<D>) -> Result<Vec<Fecg<D>>> {
+        let a = p.exponents::<D>()?;
+        let s = matrices_of::<D, 3>(p.v, p.len(), "centres")?;
+        (0..p.len()).map(|i| Fecg::new(a[i], s[i], p.c_a[i], i)).collect()
+    }
+
+    fn element<T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops: &Operators<D>) -> Element<T> {
+        element(bra, ket, ops)
+    }
+
+    fn overlap<T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, _: &Operators<D>) -> T {
+        pair(bra, ket).map_or(re(f64::NAN), |(s, _, _)| s)
+    }
+
+    fn cast<T: Real>(f: &Fecg<D>) -> Fecg<D, T> {
+        f.cast()
+    }
+
+    fn seeded<const W: usize>(f: &Fecg<D>, da: &[Mat<D>], ds: &[f64], _: &Operators<D>) -> Result<Fecg<D, Dual<W>>> {
+        let ds: Vec<Centres<D>> = matrices_of::<D, 3>(ds, da.len(), "centre directions")?;
+        Fecg::new(seed_matrix(&f.a, da), seed_matrix(&f.s, &ds), f.c_a, 0)
+    }
+
+    /// `(r-s)^T A (r-s) + r^T M r = r^T (A+M) r - 2 r^T A s + s^T A s`: `A` grows, `A s`, `s^T A s`
+    /// and `ln|A|` (the normalisation) stay.
+    fn damped<T: Real>(f: &Fecg<D>, m: &SMatrix<T, D, D>) -> Fecg<D, T> {
+        let mut g: Fecg<D, T> = f.cast();
+        g.a += m;
+        g
     }
 }
 

@@ -11,9 +11,9 @@ use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, DualSVec64};
 use rayon::prelude::*;
 
-use crate::build::Matrices;
 use crate::ecg::{Element, Mat};
 use crate::error::Result;
+use crate::matrices::Matrices;
 use crate::images::{Images, Transform};
 
 /// Most directions carried by one pass (a longer direction list is chunked).
@@ -87,8 +87,7 @@ pub fn gather(
     mut pass: impl FnMut(usize, usize) -> Result<(Vec<Vec<Element>>, Vec<Element>)>,
 ) -> Result<(Matrices, Vec<Element>)> {
     let rows = 1 + n_dir;
-    let z = vec![0.0; rows * nb];
-    let mut m = Matrices { rows, cols: nb, s: z.clone(), t: z.clone(), t_ti: z.clone(), v: z };
+    let mut m = Matrices::zeros(rows, nb);
     let mut diag = vec![Element::default(); rows];
     let mut first = 0;
     loop {
@@ -98,11 +97,7 @@ pub fn gather(
             for (k, e) in r.iter().enumerate() {
                 // k = 0 is the value (the same in every chunk), k >= 1 direction first + k - 1
                 let target = if k == 0 { 0 } else { first + k };
-                let idx = target * nb + j;
-                m.s[idx] = e.s;
-                m.t[idx] = e.t;
-                m.t_ti[idx] = e.t_ti;
-                m.v[idx] = e.v;
+                m.set(target, j, e);
             }
         }
         diag[0] = d[0];

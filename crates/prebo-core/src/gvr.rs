@@ -51,8 +51,10 @@ use std::f64::consts::PI;
 
 use nalgebra::{Cholesky, SMatrix, SVector};
 
-use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real};
+use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
+use crate::family::{check, matrices_of, Family, Params};
+use crate::gradient::{seed_matrix, Dual};
 use crate::images::Transform;
 
 /// One ECG-GVR function: exponent `A`, global vector `u`, power `K`, and its CM parameters.
@@ -331,6 +333,46 @@ impl<const D: usize, T: Real> Transform<D, GvrOps<D>> for Gvr<D, T> {
     fn transformed(&self, t: &Mat<D>, go: &GvrOps<D>, index: usize) -> Result<Self> {
         let t: SMatrix<T, D, D> = t.map(re);
         Self::new(t.transpose() * self.a * t, t.transpose() * self.u, self.k, self.c_a, go, index)
+    }
+}
+
+/// The ECG-GVR family: parameters `A` (`k x n x n`), `u` (`k x n`), `K`, `c_A`; N is the context's.
+pub struct EcgGvr;
+
+impl<const D: usize> Family<D> for EcgGvr {
+    const NAME: &'static str = "ecg-gvr";
+    type Function<T: Real> = Gvr<D, T>;
+    type Context = GvrOps<D>;
+
+    fn context(ops: Operators<D>, n_ang: u32, sets: &[&Params]) -> Result<GvrOps<D>> {
+        let k_max = sets.iter().flat_map(|p| p.k_pow.iter()).copied().max().unwrap_or(0);
+        GvrOps::new(ops, n_ang, k_max)
+    }
+
+    fn functions(p: &Params, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
+        let a = p.exponents::<D>()?;
+        let u = matrices_of::<D, 1>(p.v, p.len(), "global vectors")?;
+        check(p.k_pow.len(), p.len(), "powers K")?;
+        (0..p.len()).map(|i| Gvr::new(a[i], u[i], p.k_pow[i], p.c_a[i], go, i)).collect()
+    }
+
+    fn element<T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
+        element(bra, ket, go)
+    }
+
+    fn cast<T: Real>(f: &Gvr<D>) -> Gvr<D, T> {
+        f.cast()
+    }
+
+    fn seeded<const W: usize>(f: &Gvr<D>, da: &[Mat<D>], du: &[f64], go: &GvrOps<D>) -> Result<Gvr<D, Dual<W>>> {
+        let du: Vec<Vector<D>> = matrices_of::<D, 1>(du, da.len(), "global-vector directions")?;
+        Gvr::new(seed_matrix(&f.a, da), seed_matrix(&f.u, &du), f.k, f.c_a, go, 0)
+    }
+
+    fn damped<T: Real>(f: &Gvr<D>, m: &SMatrix<T, D, D>) -> Gvr<D, T> {
+        let mut g: Gvr<D, T> = f.cast();
+        g.a += m;
+        g
     }
 }
 

@@ -1,19 +1,27 @@
 //! prebo-core: explicitly correlated Gaussian integrals, symmetrised matrix and
 //! row builds for pre-Born–Oppenheimer calculations. Pure Rust, no Python.
 //!
-//! Pipeline position: integrals (`pecg`) → symmetrised builds (`build`) → flat
-//! array entry points (`api`) used by the `prebo._core` binding.
-pub mod api;
+//! Two axes: basis families (`family`: `plain`, `gvr`, `fecg`) and operators (the Hamiltonian
+//! in each family's element, further ones in `operators`). One path (`path`) builds symmetrised
+//! matrices, oriented rows, row gradients and operator matrices for any pair; plain ECGs
+//! specialise the builds with the SIMD kernel (`pecg`, `build`). `engine` is the flat-array
+//! entry point of the `prebo._core` binding.
 pub mod assemble;
 pub mod build;
 pub mod ecg;
 pub mod eigenpair;
+pub mod engine;
 pub mod error;
+pub mod family;
 pub mod fecg;
 pub mod gradient;
 pub mod gvr;
 pub mod images;
+pub mod matrices;
+pub mod operators;
+pub mod path;
 pub mod pecg;
+pub mod plain;
 pub mod secular;
 
 pub use error::{CoreError, Result};

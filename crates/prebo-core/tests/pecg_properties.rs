@@ -1,6 +1,8 @@
 //! Properties of the plain-ECG kernel that need no Python: normalisation, hermiticity,
 //! and the CM elimination equal to the internal mass matrix M - 1 1^T / (2 m_tot).
-use prebo_core::api::{matrices, Functions, Setup};
+use prebo_core::engine::{Engine, Kind, Representation};
+use prebo_core::family::Params;
+use prebo_core::matrices::Matrices;
 
 const N: usize = 3;
 const MASSES: [f64; N] = [1836.15267343, 1.0, 1.0];
@@ -36,7 +38,7 @@ fn basis() -> (Vec<f64>, Vec<f64>) {
     (a, params.iter().map(|p| p.1).collect())
 }
 
-fn run(lambda: &[f64], cm_mass: Option<f64>) -> prebo_core::build::Matrices {
+fn run(lambda: &[f64], cm_mass: Option<f64>) -> Matrices {
     let identity: Vec<f64> = (0..N * N)
         .map(|k| if k % (N + 1) == 0 { 1.0 } else { 0.0 })
         .collect();
@@ -44,17 +46,18 @@ fn run(lambda: &[f64], cm_mass: Option<f64>) -> prebo_core::build::Matrices {
     let p23 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0];
     let sym_t: Vec<f64> = identity.iter().chain(p23.iter()).copied().collect();
     let pair_w = [1.0, -1.0, 0.0, 1.0, 0.0, -1.0, 0.0, 1.0, -1.0];
-    let setup = Setup {
+    let rep = Representation {
         n: N,
-        lambda,
-        pair_w: &pair_w,
-        pair_q: &[-1.0, -1.0, 1.0],
-        sym_t: &sym_t,
-        sym_c: &[1.0, 1.0],
+        lambda: lambda.to_vec(),
+        pair_w: pair_w.to_vec(),
+        pair_q: vec![-1.0, -1.0, 1.0],
+        sym_t,
+        sym_c: vec![1.0, 1.0],
         cm_mass,
     };
     let (a, c_a) = basis();
-    matrices(&setup, &Functions { a: &a, c_a: &c_a }).unwrap()
+    let engine = Engine::new(Kind::Pecg, rep, 0).unwrap();
+    engine.matrices(&Params { a: &a, c_a: &c_a, ..Default::default() }).unwrap()
 }
 
 fn mass_matrix(internal: bool) -> Vec<f64> {
@@ -104,16 +107,17 @@ fn not_positive_definite_is_an_error() {
     let mut a = exponent([1.0, 0.3, 0.1], 0.5);
     a[0] = -1.0;
     let l = mass_matrix(false);
-    let setup = Setup {
+    let rep = Representation {
         n: N,
-        lambda: &l,
-        pair_w: &[],
-        pair_q: &[],
-        sym_t: &[1., 0., 0., 0., 1., 0., 0., 0., 1.],
-        sym_c: &[1.0],
+        lambda: l,
+        pair_w: vec![],
+        pair_q: vec![],
+        sym_t: vec![1., 0., 0., 0., 1., 0., 0., 0., 1.],
+        sym_c: vec![1.0],
         cm_mass: None,
     };
-    let err = matrices(&setup, &Functions { a: &a, c_a: &[0.5] }).unwrap_err();
+    let engine = Engine::new(Kind::Pecg, rep, 0).unwrap();
+    let err = engine.matrices(&Params { a: &a, c_a: &[0.5], ..Default::default() }).unwrap_err();
     assert_eq!(
         err,
         prebo_core::CoreError::NotPositiveDefinite { function: 0 }

@@ -1,0 +1,232 @@
+//! The engine: one basis family in one coordinate representation, with every build the
+//! binding offers. Flat row-major arrays in and out; the coordinate dimension `n` and the
+//! family are dispatched once per call to the const-generic, family-generic path (`path`).
+use crate::ecg::{Element, Mat, Operators, Vector};
+use crate::error::{CoreError, Result};
+use crate::family::{check, Directions, Family, Params};
+use crate::fecg::{self, FloatingEcg};
+use crate::gvr::EcgGvr;
+use crate::matrices::Matrices;
+use crate::operators;
+use crate::path;
+use crate::plain::PlainEcg;
+
+/// Largest number of coordinates compiled (laboratory frame: particles).
+pub const MAX_DIM: usize = 8;
+
+/// The basis families.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Pecg,
+    EcgGvr,
+    Fecg,
+}
+
+impl Kind {
+    pub fn from_name(name: &str) -> Result<Self> {
+        [Kind::Pecg, Kind::EcgGvr, Kind::Fecg]
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| CoreError::Unsupported(format!("basis family {name:?} (pecg, ecg-gvr or fecg)")))
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Pecg => <PlainEcg as Family<1>>::NAME,
+            Kind::EcgGvr => <EcgGvr as Family<1>>::NAME,
+            Kind::Fecg => <FloatingEcg as Family<1>>::NAME,
+        }
+    }
+
+    /// Whether rows reproduce full-build bits (`Family::ORIENTED`).
+    pub fn oriented(self) -> bool {
+        match self {
+            Kind::Pecg => <PlainEcg as Family<1>>::ORIENTED,
+            Kind::EcgGvr => <EcgGvr as Family<1>>::ORIENTED,
+            Kind::Fecg => <FloatingEcg as Family<1>>::ORIENTED,
+        }
+    }
+}
+
+/// The operators and the symmetry of a system in one coordinate representation (owned).
+#[derive(Clone, Debug)]
+pub struct Representation {
+    /// number of coordinates `n` (particles in the laboratory frame)
+    pub n: usize,
+    /// `n x n` kinetic matrix `Λ`
+    pub lambda: Vec<f64>,
+    /// `n_pairs x n` Coulomb vectors `w`
+    pub pair_w: Vec<f64>,
+    /// `n_pairs` charge products
+    pub pair_q: Vec<f64>,
+    /// `n_ops x n x n` symmetry transformations `T` (`A -> T^T A T`)
+    pub sym_t: Vec<f64>,
+    /// `n_ops` Young-operator coefficients
+    pub sym_c: Vec<f64>,
+    /// total mass for the CM elimination, or `None`
+    pub cm_mass: Option<f64>,
+}
+
+impl Representation {
+    fn check(&self) -> Result<()> {
+        let n = self.n;
+        if n == 0 || n > MAX_DIM {
+            return Err(CoreError::Unsupported(format!("{n} coordinates (at most {MAX_DIM})")));
+        }
+        check(self.lambda.len(), n * n, "kinetic matrix")?;
+        check(self.pair_w.len(), self.pair_q.len() * n, "Coulomb vectors")?;
+        check(self.sym_t.len(), self.sym_c.len() * n * n, "symmetry transformations")?;
+        if self.sym_c.is_empty() {
+            return Err(CoreError::ShapeMismatch(
+                "no symmetry operations (need at least the identity)".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    fn operators<const D: usize>(&self) -> (Operators<D>, Vec<(Mat<D>, f64)>) {
+        let pairs = self
+            .pair_w
+            .chunks_exact(D)
+            .map(Vector::<D>::from_row_slice)
+            .zip(self.pair_q.iter().copied());
+        let ops = Operators {
+            lambda: Mat::<D>::from_row_slice(&self.lambda),
+            pairs: pairs.collect(),
+            cm_mass: self.cm_mass,
+        };
+        let sym = self
+            .sym_t
+            .chunks_exact(D * D)
+            .map(Mat::<D>::from_row_slice)
+            .zip(self.sym_c.iter().copied());
+        (ops, sym.collect())
+    }
+}
+
+/// One basis family in one representation, with the total angular momentum N (ECG-GVR; M = N).
+#[derive(Clone, Debug)]
+pub struct Engine {
+    pub kind: Kind,
+    pub rep: Representation,
+    pub n_ang: u32,
+}
+
+/// Calls `$f::<D, F>($args)` for the engine's dimension and family (`$fam` limits the families).
+macro_rules! dispatch {
+    ($e:expr, $f:ident ( $($arg:expr),* )) => {
+        match $e.kind {
+            Kind::Pecg => dispatch!(@dim $e, $f, PlainEcg, ($($arg),*)),
+            Kind::EcgGvr => dispatch!(@dim $e, $f, EcgGvr, ($($arg),*)),
+            Kind::Fecg => dispatch!(@dim $e, $f, FloatingEcg, ($($arg),*)),
+        }
+    };
+    (@dim $e:expr, $f:ident, $fam:ty, ($($arg:expr),*)) => {
+        match $e.rep.n {
+            1 => $f::<1, $fam>($($arg),*),
+            2 => $f::<2, $fam>($($arg),*),
+            3 => $f::<3, $fam>($($arg),*),
+            4 => $f::<4, $fam>($($arg),*),
+            5 => $f::<5, $fam>($($arg),*),
+            6 => $f::<6, $fam>($($arg),*),
+            7 => $f::<7, $fam>($($arg),*),
+            8 => $f::<8, $fam>($($arg),*),
+            n => Err(CoreError::Unsupported(format!("{n} coordinates (at most {MAX_DIM})"))),
+        }
+    };
+}
+
+fn matrices_d<const D: usize, F: Family<D>>(e: &Engine, basis: &Params) -> Result<Matrices> {
+    let (ops, sym) = e.rep.operators::<D>();
+    F::matrices(&F::context(ops, e.n_ang, &[basis])?, &sym, basis)
+}
+
+fn rows_d<const D: usize, F: Family<D>>(
+    e: &Engine,
+    trials: &Params,
+    basis: &Params,
+    position: Option<usize>,
+) -> Result<(Matrices, Vec<Element>)> {
+    let (ops, sym) = e.rep.operators::<D>();
+    F::rows(
+        &F::context(ops, e.n_ang, &[trials, basis])?,
+        &sym,
+        trials,
+        basis,
+        position,
+    )
+}
+
+fn row_gradient_d<const D: usize, F: Family<D>>(
+    e: &Engine,
+    trial: &Params,
+    dir: &Directions,
+    basis: &Params,
+) -> Result<(Matrices, Vec<Element>)> {
+    let (ops, sym) = e.rep.operators::<D>();
+    path::row_gradient::<D, F>(&F::context(ops, e.n_ang, &[trial, basis])?, &sym, trial, dir, basis)
+}
+
+fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &Params, w: &[f64]) -> Result<Vec<f64>> {
+    let element = operators::lookup::<D, F>(name)?;
+    let (ops, sym) = e.rep.operators::<D>();
+    path::operator::<D, F>(&F::context(ops, e.n_ang, &[basis])?, &sym, basis, element, w)
+}
+
+fn angular_d<const D: usize, F>(e: &Engine, basis: &Params, mu: &[f64]) -> Result<Vec<f64>>
+where
+    F: Family<D, Function<f64> = fecg::Fecg<D>, Context = Operators<D>>,
+{
+    check(mu.len(), D, "mass fractions")?;
+    let mu = Vector::<D>::from_row_slice(mu);
+    let (ops, sym) = e.rep.operators::<D>();
+    let b = path::images::<D, F>(&ops, &sym, basis)?;
+    Ok(path::symmetric_scalar(&b, |x, y| fecg::angular(x, y, &mu)))
+}
+
+impl Engine {
+    /// Checks the representation (shapes, `1 <= n <= MAX_DIM`); `n_ang` must be 0 except for ECG-GVR.
+    pub fn new(kind: Kind, rep: Representation, n_ang: u32) -> Result<Self> {
+        rep.check()?;
+        if n_ang != 0 && kind != Kind::EcgGvr {
+            return Err(CoreError::Unsupported(format!(
+                "N = {n_ang} for {} functions (N = 0 only)",
+                kind.name()
+            )));
+        }
+        Ok(Self { kind, rep, n_ang })
+    }
+
+    /// Overlap, kinetic (full and translation-free) and Coulomb matrices of a basis.
+    pub fn matrices(&self, basis: &Params) -> Result<Matrices> {
+        dispatch!(self, matrices_d(self, basis))
+    }
+
+    /// Rows of trial functions against a basis, with the trials' diagonal elements; oriented
+    /// for a trial that will sit at `position` (`None`: appended) when `kind.oriented()`.
+    pub fn rows(&self, trials: &Params, basis: &Params, position: Option<usize>) -> Result<(Matrices, Vec<Element>)> {
+        dispatch!(self, rows_d(self, trials, basis, position))
+    }
+
+    /// The row of one function against a basis and its diagonal with their derivatives along
+    /// `dir`: `(1 + P) x nb` matrices (row 0 the values, the function as bra), `1 + P` diagonals.
+    pub fn row_gradient(&self, trial: &Params, dir: &Directions, basis: &Params) -> Result<(Matrices, Vec<Element>)> {
+        dispatch!(self, row_gradient_d(self, trial, dir, basis))
+    }
+
+    /// The symmetrised matrices of the registered operator `name`, one per vector `w` (`p x n`).
+    pub fn operator(&self, name: &str, basis: &Params, w: &[f64]) -> Result<Vec<f64>> {
+        dispatch!(self, operator_d(self, name, basis, w))
+    }
+
+    /// The symmetrised `<phi_I|N_TI²|phi_J>` matrix of a floating-ECG basis (LFCC; `mu` = m/m_tot).
+    pub fn angular(&self, basis: &Params, mu: &[f64]) -> Result<Vec<f64>> {
+        if self.kind != Kind::Fecg {
+            return Err(CoreError::Unsupported(format!(
+                "<N²> matrices of {} functions (fecg only)",
+                self.kind.name()
+            )));
+        }
+        dispatch!(@dim self, angular_d, FloatingEcg, (self, basis, mu))
+    }
+}

@@ -1,0 +1,150 @@
+//! The one build path for every (family, operator): symmetrised matrices, rows oriented as in a
+//! full build, row gradients by dual numbers, and the matrices of extra operators.
+//!
+//! A symmetrised element is `Σ_P c_P <phi_I| O |P phi_J>` over the images `P phi_J`
+//! (`images::Images`); the matrices are evaluated with the lower index as bra and mirrored.
+use crate::assemble;
+use crate::ecg::{Element, Mat, Vector};
+use crate::error::Result;
+use crate::family::{check, Directions, Family, Params, Symmetry};
+use crate::gradient::{self, Dual};
+use crate::images::Images;
+use crate::matrices::Matrices;
+use crate::operators::ElementFn;
+
+/// The functions of `p` with their images under `sym`.
+pub fn images<const D: usize, F: Family<D>>(
+    ctx: &F::Context,
+    sym: &Symmetry<D>,
+    p: &Params,
+) -> Result<Images<F::Function<f64>>> {
+    Images::new(F::functions(p, ctx)?, sym, ctx)
+}
+
+/// The symmetrised `nb x nb` matrices of a basis.
+pub fn matrices<const D: usize, F: Family<D>>(ctx: &F::Context, sym: &Symmetry<D>, basis: &Params) -> Result<Matrices> {
+    let b = images::<D, F>(ctx, sym, basis)?;
+    Ok(assemble::symmetric(b.len(), |i, j| {
+        b.element(&b.functions[i], j, |x, y| F::element(x, y, ctx))
+    }))
+}
+
+/// Rows of trials `t` against basis `b` for a trial that will sit at `position` (`None`: appended).
+/// Element `j` is evaluated with the lower index as bra — `(b_j, t)` for `j < position`,
+/// `(t, b_j)` after — exactly as `matrices` evaluates the full matrix, so a basis grown from such
+/// rows has bit-for-bit the matrices of a fresh build.
+pub fn rows<const D: usize, F: Family<D>>(
+    ctx: &F::Context,
+    sym: &Symmetry<D>,
+    trials: &Params,
+    basis: &Params,
+    position: Option<usize>,
+) -> Result<(Matrices, Vec<Element>)> {
+    let t = images::<D, F>(ctx, sym, trials)?;
+    let b = images::<D, F>(ctx, sym, basis)?;
+    let el = |x: &F::Function<f64>, y: &F::Function<f64>| F::element(x, y, ctx);
+    let pos = position.unwrap_or(b.len());
+    Ok(assemble::rows(
+        t.len(),
+        b.len(),
+        |i, j| {
+            if j < pos {
+                t.element(&b.functions[j], i, el)
+            } else {
+                b.element(&t.functions[i], j, el)
+            }
+        },
+        |i| t.element(&t.functions[i], i, el),
+    ))
+}
+
+/// Calls `$f::<D, F, W>` with the narrowest lane count W that holds `$count` directions. The
+/// widths match the parameter counts of one function (GVR H2+ 5, pECG H2 6, GVR H2 and FECG
+/// of 3 particles 9, FECG of 4 particles 15): a dual element costs about W times an f64 one.
+macro_rules! lanes {
+    ($count:expr, $f:ident ( $($arg:expr),* )) => {
+        match $count {
+            0..=4 => $f::<D, F, 4>($($arg),*),
+            5 => $f::<D, F, 5>($($arg),*),
+            6 => $f::<D, F, 6>($($arg),*),
+            7..=8 => $f::<D, F, 8>($($arg),*),
+            9 => $f::<D, F, 9>($($arg),*),
+            10..=12 => $f::<D, F, 12>($($arg),*),
+            _ => $f::<D, F, 16>($($arg),*),
+        }
+    };
+}
+
+/// One chunk of at most W directions (`gradient::chunk`).
+fn gradient_chunk<const D: usize, F: Family<D>, const W: usize>(
+    ctx: &F::Context,
+    sym: &Symmetry<D>,
+    f: &F::Function<f64>,
+    da: &[Mat<D>],
+    dv: &[f64],
+    b: &Images<F::Function<f64>>,
+) -> Result<(Vec<Vec<Element>>, Vec<Element>)> {
+    let trial = F::seeded::<W>(f, da, dv, ctx)?;
+    gradient::chunk(trial, sym, ctx, b, F::cast::<Dual<W>>, da.len(), |x, y| {
+        F::element(x, y, ctx)
+    })
+}
+
+/// The row of one function against a basis and its diagonal, with their derivatives along the
+/// directions `dir`: `(1 + P) x nb` matrices (row 0 the values, the function as bra) and `1 + P`
+/// diagonal elements (module `gradient`).
+pub fn row_gradient<const D: usize, F: Family<D>>(
+    ctx: &F::Context,
+    sym: &Symmetry<D>,
+    trial: &Params,
+    dir: &Directions,
+    basis: &Params,
+) -> Result<(Matrices, Vec<Element>)> {
+    check(trial.len(), 1, "trial functions")?;
+    let f = F::functions(trial, ctx)?.remove(0);
+    let b = images::<D, F>(ctx, sym, basis)?;
+    let (da, per) = dir.exponents::<D>()?;
+    gradient::gather(b.len(), da.len(), |first, count| {
+        let (da, dv) = (&da[first..first + count], &dir.v[first * per..(first + count) * per]);
+        lanes!(count, gradient_chunk(ctx, sym, &f, da, dv, &b))
+    })
+}
+
+/// The symmetrised matrix of one extra operator (`operators`) for each vector `w`
+/// (`p x n`, flat): `p` row-major `nb x nb` blocks, upper triangle evaluated, mirrored.
+pub fn operator<const D: usize, F: Family<D>>(
+    ctx: &F::Context,
+    sym: &Symmetry<D>,
+    basis: &Params,
+    element: ElementFn<D, F>,
+    w: &[f64],
+) -> Result<Vec<f64>> {
+    check(w.len(), w.len() / D * D, "operator vectors")?;
+    let b = images::<D, F>(ctx, sym, basis)?;
+    let mut out = Vec::with_capacity(w.len() / D * b.len() * b.len());
+    for wk in w.chunks_exact(D) {
+        let wk = Vector::<D>::from_row_slice(wk);
+        out.extend(symmetric_scalar(&b, |x, y| element(x, y, ctx, &wk)));
+    }
+    Ok(out)
+}
+
+/// A symmetrised scalar operator matrix (row-major `nb x nb`): `Σ_P c_P el(phi_i, P phi_j)`
+/// for `j >= i`, mirrored (operators that commute with the symmetry operations).
+pub fn symmetric_scalar<G: Sync>(b: &Images<G>, el: impl Fn(&G, &G) -> f64 + Sync) -> Vec<f64> {
+    let nb = b.len();
+    let upper = assemble::upper(nb, |i, j| {
+        b.images[j]
+            .iter()
+            .zip(&b.coef)
+            .fold(0.0, |acc, (ket, c)| acc + c * el(&b.functions[i], ket))
+    });
+    let mut m = vec![0.0; nb * nb];
+    for (i, row) in upper.iter().enumerate() {
+        for (k, x) in row.iter().enumerate() {
+            m[i * nb + i + k] = *x;
+            m[(i + k) * nb + i] = *x;
+        }
+    }
+    m
+}

@@ -1,0 +1,82 @@
+//! The plain-ECG family. Its matrices and rows come from the SIMD kernel (`build`, `pecg`);
+//! its generic elements (row gradients by dual numbers, extra operators) from the ECG-GVR
+//! kernel at K = N = 0 with `u = e_1`, where `u` drops out and the elements are those of plain
+//! ECGs (gvr.rs: "For K = N = 0 this is the plain-ECG ...").
+use nalgebra::SMatrix;
+
+use crate::build;
+use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
+use crate::error::Result;
+use crate::family::{Family, Params, Symmetry};
+use crate::gradient::{seed_matrix, Dual};
+use crate::gvr::{EcgGvr, Gvr, GvrOps};
+use crate::images::Images;
+use crate::matrices::Matrices;
+
+/// The plain-ECG family: parameters `A` (`k x n x n`) and `c_A`.
+pub struct PlainEcg;
+
+/// The plain ECGs of `p` with their images under `sym`, for the SIMD kernel.
+fn gaussians<const D: usize>(p: &Params, sym: &Symmetry<D>) -> Result<Images<Gaussian<D>>> {
+    let a = p.exponents::<D>()?;
+    let f = a
+        .into_iter()
+        .zip(p.c_a)
+        .enumerate()
+        .map(|(i, (a, c))| Gaussian::new(a, *c, i))
+        .collect::<Result<_>>()?;
+    Images::new(f, sym, &())
+}
+
+impl<const D: usize> Family<D> for PlainEcg {
+    const NAME: &'static str = "pecg";
+    /// Rows have the trial as bra (the SIMD kernel runs one bra against blocks of kets).
+    const ORIENTED: bool = false;
+    type Function<T: Real> = Gvr<D, T>;
+    type Context = GvrOps<D>;
+
+    fn context(ops: Operators<D>, _: u32, _: &[&Params]) -> Result<GvrOps<D>> {
+        GvrOps::new(ops, 0, 0)
+    }
+
+    fn functions(p: &Params, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
+        let a = p.exponents::<D>()?;
+        let u = Vector::<D>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 });
+        a.into_iter()
+            .zip(p.c_a)
+            .enumerate()
+            .map(|(i, (a, c))| Gvr::new(a, u, 0, *c, go, i))
+            .collect()
+    }
+
+    fn element<T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
+        <EcgGvr as Family<D>>::element(bra, ket, go)
+    }
+
+    fn cast<T: Real>(f: &Gvr<D>) -> Gvr<D, T> {
+        f.cast()
+    }
+
+    /// Directions of `A` only (`dv` is ignored: u drops out).
+    fn seeded<const W: usize>(f: &Gvr<D>, da: &[Mat<D>], _: &[f64], go: &GvrOps<D>) -> Result<Gvr<D, Dual<W>>> {
+        Gvr::new(seed_matrix(&f.a, da), seed_matrix(&f.u, &[]), 0, f.c_a, go, 0)
+    }
+
+    fn damped<T: Real>(f: &Gvr<D>, m: &SMatrix<T, D, D>) -> Gvr<D, T> {
+        <EcgGvr as Family<D>>::damped(f, m)
+    }
+
+    fn matrices(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &Params) -> Result<Matrices> {
+        Ok(build::matrices(&gaussians(basis, sym)?, &go.ops))
+    }
+
+    fn rows(
+        go: &GvrOps<D>,
+        sym: &Symmetry<D>,
+        trials: &Params,
+        basis: &Params,
+        _: Option<usize>,
+    ) -> Result<(Matrices, Vec<Element>)> {
+        Ok(build::rows(&gaussians(trials, sym)?, &gaussians(basis, sym)?, &go.ops))
+    }
+}

@@ -1,0 +1,181 @@
+//! Conversions between Python and the core: array-likes to owned flat arrays (any dtype numpy
+//! can cast safely, any memory layout), core results to numpy arrays, and `CoreError` to the
+//! exceptions of `prebo.errors` (one `From`).
+use numpy::ndarray::{Array2, Array3};
+use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLikeDyn, PyUntypedArrayMethods};
+use prebo_core::ecg::Element;
+use prebo_core::engine::Kind;
+use prebo_core::family::Params;
+use prebo_core::matrices::Matrices;
+use prebo_core::CoreError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+pyo3::import_exception!(prebo.errors, NotPositiveDefiniteError);
+pyo3::import_exception!(prebo.errors, ShapeError);
+pyo3::import_exception!(prebo.errors, UnsupportedError);
+
+/// An error of a binding call: from the core, or from Python (conversion).
+pub enum Error {
+    Core(CoreError),
+    Py(PyErr),
+}
+
+impl From<CoreError> for Error {
+    fn from(e: CoreError) -> Self {
+        Error::Core(e)
+    }
+}
+
+impl From<PyErr> for Error {
+    fn from(e: PyErr) -> Self {
+        Error::Py(e)
+    }
+}
+
+impl From<Error> for PyErr {
+    fn from(e: Error) -> Self {
+        match e {
+            Error::Py(e) => e,
+            Error::Core(e) => {
+                let msg = e.to_string();
+                match e {
+                    CoreError::NotPositiveDefinite { .. } => NotPositiveDefiniteError::new_err(msg),
+                    CoreError::ShapeMismatch(_) => ShapeError::new_err(msg),
+                    CoreError::Unsupported(_) => UnsupportedError::new_err(msg),
+                }
+            }
+        }
+    }
+}
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+fn shape_error(msg: String) -> Error {
+    Error::Core(CoreError::ShapeMismatch(msg))
+}
+
+/// An array-like as float64 values in row-major order, and its shape.
+pub fn floats_shaped(x: &Bound<'_, PyAny>, what: &str) -> Result<(Vec<f64>, Vec<usize>)> {
+    let a = x
+        .extract::<PyArrayLikeDyn<'_, f64, AllowTypeChange>>()
+        .map_err(|e| shape_error(format!("{what}: not convertible to a float64 array ({e})")))?;
+    // `as_slice` also accepts Fortran order (memory order): only C order is copied as is
+    let v = match a.as_slice() {
+        Ok(s) if a.is_c_contiguous() => s.to_vec(),
+        _ => a.as_array().iter().copied().collect(),
+    };
+    Ok((v, a.as_array().shape().to_vec()))
+}
+
+/// An array-like as float64 values in row-major order.
+pub fn floats(x: &Bound<'_, PyAny>, what: &str) -> Result<Vec<f64>> {
+    Ok(floats_shaped(x, what)?.0)
+}
+
+/// Non-negative integers below 2^32 (the powers K), from any numeric array-like.
+pub fn naturals(x: &Bound<'_, PyAny>, what: &str) -> Result<Vec<u32>> {
+    floats(x, what)?
+        .into_iter()
+        .map(|k| {
+            if k >= 0.0 && k <= u32::MAX as f64 && k.fract() == 0.0 {
+                Ok(k as u32)
+            } else {
+                Err(shape_error(format!("{what}: {k} is not a non-negative integer")))
+            }
+        })
+        .collect()
+}
+
+/// A family's parameter tuple, owned: pecg `(A, c_A)`, ecg-gvr `(A, u, K, c_A)`, fecg `(A, s, c_A)`.
+#[derive(Default)]
+pub struct OwnedParams {
+    a: Vec<f64>,
+    c_a: Vec<f64>,
+    v: Vec<f64>,
+    k_pow: Vec<u32>,
+}
+
+impl OwnedParams {
+    pub fn new(kind: Kind, params: &Bound<'_, PyAny>) -> Result<Self> {
+        let t = params.downcast::<PyTuple>().map_err(PyErr::from)?;
+        let want = match kind {
+            Kind::Pecg => 2,
+            Kind::EcgGvr => 4,
+            Kind::Fecg => 3,
+        };
+        if t.len() != want {
+            return Err(shape_error(format!(
+                "{} parameters: {} arrays, expected {want}",
+                kind.name(),
+                t.len()
+            )));
+        }
+        let (a, c_a) = (floats(&t.get_item(0)?, "A")?, floats(&t.get_item(want - 1)?, "c_A")?);
+        Ok(match kind {
+            Kind::Pecg => Self {
+                a,
+                c_a,
+                ..Default::default()
+            },
+            Kind::EcgGvr => Self {
+                a,
+                c_a,
+                v: floats(&t.get_item(1)?, "u")?,
+                k_pow: naturals(&t.get_item(2)?, "K")?,
+            },
+            Kind::Fecg => Self {
+                a,
+                c_a,
+                v: floats(&t.get_item(1)?, "s")?,
+                k_pow: vec![],
+            },
+        })
+    }
+
+    pub fn view(&self) -> Params<'_> {
+        Params {
+            a: &self.a,
+            c_a: &self.c_a,
+            v: &self.v,
+            k_pow: &self.k_pow,
+        }
+    }
+}
+
+pub fn matrix<'py>(py: Python<'py>, rows: usize, cols: usize, v: Vec<f64>) -> Bound<'py, PyArray2<f64>> {
+    Array2::from_shape_vec((rows, cols), v)
+        .expect("rows x cols values")
+        .into_pyarray(py)
+}
+
+/// `p` row-major `nb x nb` blocks as a `(p, nb, nb)` array.
+pub fn blocks(py: Python<'_>, nb: usize, v: Vec<f64>) -> Bound<'_, PyArray3<f64>> {
+    let p = if nb == 0 { 0 } else { v.len() / (nb * nb) };
+    Array3::from_shape_vec((p, nb, nb), v)
+        .expect("p x nb x nb values")
+        .into_pyarray(py)
+}
+
+/// `{"S", "T", "T_ti", "V"}`.
+pub fn dict(py: Python<'_>, m: Matrices) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("S", matrix(py, m.rows, m.cols, m.s))?;
+    d.set_item("T", matrix(py, m.rows, m.cols, m.t))?;
+    d.set_item("T_ti", matrix(py, m.rows, m.cols, m.t_ti))?;
+    d.set_item("V", matrix(py, m.rows, m.cols, m.v))?;
+    Ok(d)
+}
+
+/// Diagonal elements as a `k x 4` array (S, T, T_ti, V).
+pub fn diag_array<'py>(py: Python<'py>, diag: &[Element]) -> Bound<'py, PyArray2<f64>> {
+    let d: Vec<f64> = diag.iter().flat_map(|e| [e.s, e.t, e.t_ti, e.v]).collect();
+    matrix(py, diag.len(), 4, d)
+}
+
+pub type Rows<'py> = (Bound<'py, PyDict>, Bound<'py, PyArray2<f64>>);
+
+/// Rows (or row gradients) and diagonals as Python objects.
+pub fn rows(py: Python<'_>, (m, diag): (Matrices, Vec<Element>)) -> Result<Rows<'_>> {
+    Ok((dict(py, m)?, diag_array(py, &diag)))
+}

@@ -1,0 +1,164 @@
+"""Typed interface of `prebo._core`, the PyO3 binding of the Rust core (crates/prebo-py).
+
+Conventions (docs/conventions.md): a basis function in n coordinates has the exponent
+exp(-r^T (A ⊗ I_3) r) (no factor 1/2); every function is used normalised; energies in hartree
+(E_h), lengths in bohr (a_0), masses in electron masses. Arrays are float64 (K: uint32); any
+array-like numpy can convert is accepted, in any memory layout. Errors: `prebo.errors`
+`NotPositiveDefiniteError` (an exponent matrix without a Cholesky factor), `ShapeError` (arrays
+that do not fit together) and `UnsupportedError` (more than `MAX_DIM` coordinates, an unknown
+family or operator, K out of range).
+
+Parameter tuples (`params`) per family, for k functions in n coordinates:
+- "pecg" (plain ECGs): (A (k, n, n), c_A (k,))
+- "ecg-gvr" (ECG with a global vector, M = N): (A (k, n, n), u (k, n), K (k,) uint32, c_A (k,))
+- "fecg" (floating ECGs): (A (k, n, n), s (k, n, 3) centres in a_0, c_A (k,))
+"""
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+Params = tuple[ArrayLike, ...]
+Matrices = dict[str, NDArray[np.float64]]
+
+MAX_DIM: int
+"""Largest number of coordinates compiled (laboratory frame: particles)."""
+
+OPERATORS: list[str]
+"""Names of the registered extra operators of `Engine.operator`."""
+
+
+class Engine:
+    """One basis family in one coordinate representation: symmetrised matrices, rows, row
+    gradients and extra operators, all with the GIL released.
+
+    A symmetrised element is Σ_P c_P <φ_I|O|P φ_J> over the symmetry operations
+    P: φ(r) -> φ(T_P r) with Young-operator coefficients c_P.
+    """
+
+    def __init__(self, family: str, lam: ArrayLike, pair_w: ArrayLike, pair_q: ArrayLike,
+                 sym_t: ArrayLike, sym_c: ArrayLike, cm_mass: float | None = None, N: int = 0) -> None:
+        """family: "pecg", "ecg-gvr" or "fecg"; lam (n, n): kinetic matrix Λ of -∇^T Λ ∇
+        (E_h a_0², laboratory frame diag(1/(2 m_i))); pair_w (p, n): Coulomb vectors w of
+        Σ q/|w^T r|; pair_q (p,): charge products q; sym_t (o, n, n): transformations T_P;
+        sym_c (o,): coefficients c_P; cm_mass: total mass (m_e) for the elimination of the CM
+        kinetic energy (T_ti), None without a CM coordinate; N: total angular momentum quantum
+        number (ECG-GVR only, M = N)."""
+
+    @property
+    def family(self) -> str:
+        """The basis family: "pecg", "ecg-gvr" or "fecg"."""
+
+    @property
+    def n(self) -> int:
+        """Number of coordinates."""
+
+    @property
+    def oriented(self) -> bool:
+        """Whether `rows(..., position=i)` evaluates every element in the orientation of a full
+        build, so that patching rows into the matrices reproduces `matrices` bit for bit."""
+
+    def matrices(self, params: Params) -> Matrices:
+        """Symmetrised (nb, nb) matrices of a basis: "S" overlap, "T" kinetic energy (E_h),
+        "T_ti" kinetic energy with the CM part eliminated (E_h), "V" Coulomb energy (E_h)."""
+
+    def rows(self, trials: Params, basis: Params, position: int | None = None) -> tuple[Matrices, NDArray[np.float64]]:
+        """Rows (k, nb) of k trial functions against a basis (keys as `matrices`) and the
+        trials' symmetrised diagonal elements (k, 4) as [S, T, T_ti, V]. `position`: the index
+        a trial would take in the basis (None: appended), which orients the elements when
+        `oriented`."""
+
+    def row_gradient(self, f: Params, dA: ArrayLike, dv: ArrayLike | None, basis: Params) -> tuple[Matrices, NDArray[np.float64]]:
+        """The row of one function `f` (the bra) against a basis and its diagonal, with the
+        derivatives along P directions: dA (P, n, n) of A and dv of the vector part — (P, n) of
+        u (ecg-gvr), (P, n, 3) of s (fecg), None for pecg. Returns (1 + P, nb) matrices (row 0
+        the values, row 1 + p the derivative along direction p) and the (1 + P, 4) diagonal.
+        Laboratory frame."""
+
+    def operator(self, name: str, params: Params, w: ArrayLike) -> NDArray[np.float64]:
+        """Symmetrised (p, nb, nb) matrices of the registered operator `name` (see `OPERATORS`)
+        between normalised functions, one per vector w (p, n) given in this representation like
+        the Coulomb vectors ("r2": r_w² = |Σ_k w_k r_k|² in a_0², with w = e_i − e_j in the
+        laboratory frame the squared distance r_ij²). Symmetrised like S, which is exact for
+        operators that commute with the symmetry operations."""
+
+    def angular(self, params: Params, mu: ArrayLike) -> NDArray[np.float64]:
+        """Symmetrised (nb, nb) matrix of the translation-free <N²> (ħ² = 1) of a floating-ECG
+        basis in the laboratory frame; mu (n,): mass fractions m_i/m_tot. Error for other families."""
+
+
+def lowest_with_added(e: ArrayLike, c: ArrayLike, h: ArrayLike, s: ArrayLike, h_nn: ArrayLike,
+                      s_nn: ArrayLike, min_norm: float) -> NDArray[np.float64]:
+    """Lowest eigenvalue (E_h) after adding each of k trials to a basis (secular equation):
+    e (kept,) eigenvalues, c (nb, kept) S-orthonormal eigenvectors, rows h, s (k, nb) of H and
+    S, diagonals h_nn, s_nn (k,); a trial whose part orthogonal to the basis has norm² below
+    `min_norm` · s_nn gets +inf. Returns (k,)."""
+
+
+def refine_eigenpairs(h: ArrayLike, s: ArrayLike, e: ArrayLike, c: ArrayLike, roots: int
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], list[int], list[bool]]:
+    """The lowest `roots` eigenpairs of H c = E S c refined in double-double from a
+    double-precision solution: h, s (nb, nb); e (kept,) ascending; c (nb, kept) S-orthonormal.
+    Returns the energies (roots,) in E_h, the S-normalised vectors (nb, roots), the iterations
+    and whether each root converged."""
+
+
+def num_threads() -> int:
+    """Number of rayon worker threads in use (RAYON_NUM_THREADS)."""
+
+
+# Module functions of the binding before `Engine`, kept until the Python side uses `Engine`.
+
+def matrices(a: ArrayLike, c_a: ArrayLike, lambda_: ArrayLike, pair_w: ArrayLike, pair_q: ArrayLike,
+             sym_t: ArrayLike, sym_c: ArrayLike, cm_mass: float | None = None) -> Matrices:
+    """`Engine("pecg", ...).matrices((a, c_a))`."""
+
+
+def rows(trial_a: ArrayLike, trial_c_a: ArrayLike, a: ArrayLike, c_a: ArrayLike, lambda_: ArrayLike,
+         pair_w: ArrayLike, pair_q: ArrayLike, sym_t: ArrayLike, sym_c: ArrayLike,
+         cm_mass: float | None = None) -> tuple[Matrices, NDArray[np.float64]]:
+    """`Engine("pecg", ...).rows((trial_a, trial_c_a), (a, c_a))`."""
+
+
+def gvr_matrices(a: ArrayLike, u: ArrayLike, k: ArrayLike, c_a: ArrayLike, n_ang: int, lambda_: ArrayLike,
+                 pair_w: ArrayLike, pair_q: ArrayLike, sym_t: ArrayLike, sym_c: ArrayLike,
+                 cm_mass: float | None = None) -> Matrices:
+    """`Engine("ecg-gvr", ..., N=n_ang).matrices((a, u, k, c_a))`."""
+
+
+def gvr_rows(trial_a: ArrayLike, trial_u: ArrayLike, trial_k: ArrayLike, trial_c_a: ArrayLike, a: ArrayLike,
+             u: ArrayLike, k: ArrayLike, c_a: ArrayLike, n_ang: int, lambda_: ArrayLike, pair_w: ArrayLike,
+             pair_q: ArrayLike, sym_t: ArrayLike, sym_c: ArrayLike, cm_mass: float | None = None,
+             position: int | None = None) -> tuple[Matrices, NDArray[np.float64]]:
+    """`Engine("ecg-gvr", ..., N=n_ang).rows(trials, basis, position)`."""
+
+
+def gvr_row_gradient(trial_a: ArrayLike, trial_u: ArrayLike, trial_k: ArrayLike, trial_c_a: ArrayLike,
+                     d_a: ArrayLike, d_u: ArrayLike, a: ArrayLike, u: ArrayLike, k: ArrayLike, c_a: ArrayLike,
+                     n_ang: int, lambda_: ArrayLike, pair_w: ArrayLike, pair_q: ArrayLike, sym_t: ArrayLike,
+                     sym_c: ArrayLike, cm_mass: float | None) -> tuple[Matrices, NDArray[np.float64]]:
+    """`Engine("ecg-gvr", ..., N=n_ang).row_gradient(trial, d_a, d_u, basis)`."""
+
+
+def fecg_matrices(a: ArrayLike, s: ArrayLike, c_a: ArrayLike, lambda_: ArrayLike, pair_w: ArrayLike,
+                  pair_q: ArrayLike, sym_t: ArrayLike, sym_c: ArrayLike, cm_mass: float | None = None) -> Matrices:
+    """`Engine("fecg", ...).matrices((a, s, c_a))`."""
+
+
+def fecg_rows(trial_a: ArrayLike, trial_s: ArrayLike, trial_c_a: ArrayLike, a: ArrayLike, s: ArrayLike,
+              c_a: ArrayLike, lambda_: ArrayLike, pair_w: ArrayLike, pair_q: ArrayLike, sym_t: ArrayLike,
+              sym_c: ArrayLike, cm_mass: float | None = None,
+              position: int | None = None) -> tuple[Matrices, NDArray[np.float64]]:
+    """`Engine("fecg", ...).rows(trials, basis, position)`."""
+
+
+def fecg_row_gradient(trial_a: ArrayLike, trial_s: ArrayLike, trial_c_a: ArrayLike, d_a: ArrayLike,
+                      d_s: ArrayLike, a: ArrayLike, s: ArrayLike, c_a: ArrayLike, lambda_: ArrayLike,
+                      pair_w: ArrayLike, pair_q: ArrayLike, sym_t: ArrayLike, sym_c: ArrayLike,
+                      cm_mass: float | None) -> tuple[Matrices, NDArray[np.float64]]:
+    """`Engine("fecg", ...).row_gradient(trial, d_a, d_s, basis)`."""
+
+
+def fecg_angular(a: ArrayLike, s: ArrayLike, c_a: ArrayLike, mu: ArrayLike, lambda_: ArrayLike,
+                 pair_w: ArrayLike, pair_q: ArrayLike, sym_t: ArrayLike, sym_c: ArrayLike) -> NDArray[np.float64]:
+    """`Engine("fecg", ...).angular((a, s, c_a), mu)`."""
