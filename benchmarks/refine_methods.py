@@ -14,12 +14,12 @@ import numpy as np
 
 from prebo.basis import Basis
 from prebo.integrals import laboratory
-from prebo.optimise import State
-from prebo.refine import refine_function
+from prebo.optimise import Expansion
+from prebo.optimise.refine import refine_function
 
 
 def sweep(basis: Basis, method: str, functions: int, evaluations: int) -> tuple[float, float, float]:
-    st = State(basis.subset(np.arange(len(basis))), laboratory(basis.system), 1e-13)
+    st = Expansion(basis.subset(np.arange(len(basis))), laboratory(basis.system), 1e-13)
     e0, t0 = st.energy, time.perf_counter()
     for i in range(min(functions, len(basis))):
         refine_function(st, i, evaluations, method)

@@ -19,8 +19,9 @@ import numpy as np
 
 from prebo.basis import Basis
 from prebo.integrals import laboratory
-from prebo.optimise import Optimiser, State
-from prebo.refine import Objective, Parametrisation, refine_function
+from prebo.optimise import Expansion, Optimiser
+from prebo.optimise.parametrisation import Parametrisation
+from prebo.optimise.refine import Objective, refine_function
 
 
 def energy_gradients(state) -> list[np.ndarray]:
@@ -41,7 +42,7 @@ def energy_gradients(state) -> list[np.ndarray]:
 
 
 def run(basis: Basis, opts: Optimiser, order: str, count: int, start: int):
-    st = State(basis.subset(np.arange(len(basis))), laboratory(basis.system), opts.threshold, opts.min_norm,
+    st = Expansion(basis.subset(np.arange(len(basis))), laboratory(basis.system), opts.threshold, opts.min_norm,
                opts.max_overlap)
     e0, t0 = st.energy, time.perf_counter()
     if order == "gradient":

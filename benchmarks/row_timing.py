@@ -14,7 +14,7 @@ import numpy as np
 
 from prebo.basis import Basis
 from prebo.integrals import laboratory
-from prebo.refine import Parametrisation
+from prebo.optimise.parametrisation import Parametrisation
 
 
 def seconds(call, repeat: int) -> float:
@@ -42,7 +42,7 @@ def main():
     f, (dA, dv) = p.function(theta), p.directions(theta)
     rest = basis.subset(np.flatnonzero(np.arange(len(basis)) != i))
     cases = [("basis K", f, rest)]
-    if basis.kind == "ecg-gvr":
+    if "K" in basis.parameters:
         cases.append(("every K = 0", with_K(f, [0]), with_K(rest, [0] * len(rest))))
     print(f"{args.basis}: function {i} (K = {[int(k) for k in f.K] if f.K is not None else '-'}) against {len(rest)}, "
           f"{len(theta)} directions, {args.repeat} repetitions")

@@ -21,13 +21,13 @@ import numpy as np
 
 from prebo.basis import Basis
 from prebo.integrals import laboratory
-from prebo.optimise import Optimiser, Sampler, State
-from prebo.polish import polish
-from prebo.refine import refine_function, regenerate_function
+from prebo.optimise import Expansion, Optimiser, Sampler
+from prebo.optimise.polish import polish
+from prebo.optimise.refine import refine_function, regenerate_function
 
 
 def run(basis: Basis, opts: Optimiser, method: str, seconds: float, start: int = 0) -> tuple[float, float, float, int]:
-    st = State(basis.subset(np.arange(len(basis))), laboratory(basis.system), opts.threshold, opts.min_norm,
+    st = Expansion(basis.subset(np.arange(len(basis))), laboratory(basis.system), opts.threshold, opts.min_norm,
                opts.max_overlap)
     sampler = Sampler(basis.system, opts, np.random.default_rng(opts.seed))
     sampler.learn(st.basis)

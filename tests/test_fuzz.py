@@ -3,6 +3,7 @@ arguments. Whatever the corruption, prebo either takes the input (a finite resul
 or refuses it with one line and exit 2 (CLI) or a PreboError (API) — never a traceback, a NaN
 or a hang. Derandomised, so CI sees the same examples; the CLI runs in-process. The last tests
 run real processes: a closed output pipe, and a kill during a checkpoint write."""
+import contextlib
 import json
 import os
 import signal
@@ -19,10 +20,12 @@ from hypothesis import strategies as st
 import prebo
 from prebo.cli import main
 from prebo.errors import PreboError
-from prebo.validation import SETTINGS
+from prebo.optimise import SETTINGS
 from test_validation import h_input, toml_text
 
-OPTIMISE = sys.modules["prebo.optimise"]  # the module (prebo.optimise is the function)
+#: where the optimisation is looked up: the package (by cli) and its driver (by resume_from);
+#: sys.modules, because prebo.optimise is the function
+OPTIMISING = [sys.modules["prebo.optimise"], sys.modules["prebo.optimise.driver"]]
 
 FUZZ = settings(max_examples=100, deadline=None, derandomize=True, database=None,
                 suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
@@ -144,6 +147,15 @@ class Accepted(Exception):
     """Raised in place of the optimisation once an input has passed every check."""
 
 
+@contextlib.contextmanager
+def accepting():
+    """The optimisation replaced by `accept` wherever it is looked up."""
+    with contextlib.ExitStack() as stack:
+        for module in OPTIMISING:
+            stack.enter_context(mock.patch.object(module, "optimise", accept))
+        yield
+
+
 def accept(system, opts, *args, **kwargs):
     assert isinstance(system, prebo.System) and isinstance(opts, prebo.Optimiser)
     for name, s in SETTINGS.items():  # what was accepted is within the table
@@ -161,7 +173,7 @@ def test_corrupted_checkpoints_on_resume(checkpoints, tmp_path, capsys, data):
     run = tmp_path / "run"
     run.mkdir(exist_ok=True)
     (run / "basis.json").write_text(json.dumps(doc))
-    with mock.patch.object(OPTIMISE, "optimise", accept):
+    with accepting():
         try:
             rc = main(["run", "--resume", str(run), "--quiet"])
         except Accepted:
@@ -191,7 +203,7 @@ def test_corrupted_toml_inputs(tmp_path, capsys, data):
         doc[table] = data.draw(TOML)
     f = tmp_path / "in.toml"
     f.write_text(toml_text(doc))
-    with mock.patch.object(OPTIMISE, "optimise", accept):
+    with accepting():
         try:
             rc = main(["run", str(f), "--out", str(tmp_path / "out"), "--quiet"])
         except Accepted:

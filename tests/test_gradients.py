@@ -6,22 +6,22 @@ import pytest
 from prebo import eigen
 from prebo.errors import IllConditionedError, InputError
 from prebo.integrals import laboratory
-from prebo.optimise import Optimiser, Sampler, State
-from prebo.polish import Joint, polish
-from prebo.refine import Objective, Parametrisation, refine_function, regenerate_function
-from prebo.system import State as QState
-from prebo.system import System
+from prebo.optimise import Expansion, Optimiser, Sampler
+from prebo.optimise.parametrisation import Parametrisation
+from prebo.optimise.polish import Joint, polish
+from prebo.optimise.refine import Objective, refine_function, regenerate_function
+from prebo.system import State, System
 
 P = {"name": "p", "mass": 1836.15267}
 CASES = {
     # name: particles, state, basis type, K_max
-    "pecg-H2+": ([P, P, "e"], QState(N=0, spin={"p": 0}), "pecg", 0),
-    "pecg-H2": ([P, P, "e", "e"], QState(N=0, spin={"p": 0, "e": 0}), "pecg", 0),
-    "gvr-H2+": ([P, P, "e"], QState(N=0, spin={"p": 0}), "ecg-gvr", 4),
-    "gvr-H2+-N1": ([P, P, "e"], QState(N=1, parity=-1, spin={"p": 1}), "ecg-gvr", 3),
-    "gvr-H2": ([P, P, "e", "e"], QState(N=0, spin={"p": 0, "e": 0}), "ecg-gvr", 3),
-    "fecg-H2+": ([P, P, "e"], QState(N=0, spin={"p": 0}), "fecg", 0),
-    "fecg-Ps-": (["e+", "e", "e"], QState(N=0, spin={"e": 0}), "fecg", 0),
+    "pecg-H2+": ([P, P, "e"], State(N=0, spin={"p": 0}), "pecg", 0),
+    "pecg-H2": ([P, P, "e", "e"], State(N=0, spin={"p": 0, "e": 0}), "pecg", 0),
+    "gvr-H2+": ([P, P, "e"], State(N=0, spin={"p": 0}), "ecg-gvr", 4),
+    "gvr-H2+-N1": ([P, P, "e"], State(N=1, parity=-1, spin={"p": 1}), "ecg-gvr", 3),
+    "gvr-H2": ([P, P, "e", "e"], State(N=0, spin={"p": 0, "e": 0}), "ecg-gvr", 3),
+    "fecg-H2+": ([P, P, "e"], State(N=0, spin={"p": 0}), "fecg", 0),
+    "fecg-Ps-": (["e+", "e", "e"], State(N=0, spin={"e": 0}), "fecg", 0),
 }
 
 
@@ -71,7 +71,7 @@ def test_energy_gradient_matches_finite_differences(case):
     system, basis, p, theta = setup(case, nb=4)  # few functions: the energy depends strongly on each
     f = p.function(theta)
     basis.append(f)
-    st = State(basis, laboratory(system), 1e-13)
+    st = Expansion(basis, laboratory(system), 1e-13)
     obj = Objective(st, len(basis) - 1)
     e, g = obj.energy_and_gradient(theta)
     assert e == pytest.approx(obj.energy(theta), abs=1e-12)
@@ -98,7 +98,7 @@ def test_any_number_of_directions_gives_the_same_derivatives(count):
 
 def test_gradient_refinement_lowers_the_energy_and_keeps_the_matrices_exact():
     system, basis, p, theta = setup("gvr-H2+", nb=15)
-    st = State(basis, laboratory(system), 1e-13)
+    st = Expansion(basis, laboratory(system), 1e-13)
     before = st.energy
     improved = [refine_function(st, i, 40, "gradient") for i in range(4)]
     assert any(improved) and st.energy < before
@@ -117,7 +117,7 @@ def test_regeneration_keeps_the_better_of_refined_newcomer_and_incumbent():
     i = 4
     hopeless = basis.subset([i])
     hopeless.A *= 1e-4  # a function ~100 times too diffuse
-    regenerated, refined = State(basis.subset(range(15)), rep, 1e-13), State(basis.subset(range(15)), rep, 1e-13)
+    regenerated, refined = (Expansion(basis.subset(range(15)), rep, 1e-13) for _ in range(2))
     before = regenerated.energy
     regenerate_function(regenerated, i, hopeless, 5)
     refine_function(refined, i, 5)
@@ -127,7 +127,7 @@ def test_regeneration_keeps_the_better_of_refined_newcomer_and_incumbent():
     good = basis.subset([i])  # the other way round: the incumbent is hopeless, the newcomer good
     worse = basis.subset(range(15))
     worse.replace(i, hopeless)
-    regenerated, refined = State(worse.subset(range(15)), rep, 1e-13), State(worse.subset(range(15)), rep, 1e-13)
+    regenerated, refined = (Expansion(worse.subset(range(15)), rep, 1e-13) for _ in range(2))
     regenerate_function(regenerated, i, good, 5)
     refine_function(refined, i, 5)
     assert regenerated.energy < refined.energy
@@ -152,7 +152,7 @@ def test_extreme_parameters_are_refused_not_collapsed():
     with pytest.raises(IllConditionedError):
         p.function(extreme)
     basis.append(p.function(theta))
-    st = State(basis, laboratory(system), 1e-13)
+    st = Expansion(basis, laboratory(system), 1e-13)
     obj = Objective(st, len(basis) - 1)
     assert obj.energy(extreme) == obj.worse and obj.energy_and_gradient(extreme)[0] == obj.worse
     rows, diag = st.rep.rows(p.function(theta), basis.subset(range(6)))
@@ -184,7 +184,7 @@ def test_the_length_of_the_global_vector_is_irrelevant():
 def test_joint_gradient_matches_finite_differences(case):
     system, basis, p, theta = setup(case, nb=5)
     basis.append(p.function(theta))
-    st = State(basis, laboratory(system), 1e-13)
+    st = Expansion(basis, laboratory(system), 1e-13)
     joint = Joint(st)
     x = joint.theta0 + 0.05 * np.random.default_rng(1).standard_normal(len(joint.theta0))
     e, g = joint(x)
@@ -195,7 +195,7 @@ def test_joint_gradient_matches_finite_differences(case):
 
 def test_polish_lowers_the_energy_and_leaves_a_consistent_state():
     system, basis, p, theta = setup("gvr-H2+", nb=12)
-    st = State(basis, laboratory(system), 1e-13)
+    st = Expansion(basis, laboratory(system), 1e-13)
     before = st.energy
     assert polish(st, 15) and st.energy < before
     fresh = st.rep.matrices(st.basis)

@@ -99,6 +99,16 @@ def test_cursor_repeats_the_block_after_growth_in_cycles():
     assert Cursor(**{"phase": "polish", "sweep": 0, "index": 0}).cycle == 0  # checkpoints before cycles
 
 
+def test_each_phase_has_its_method_configured_by_the_settings():
+    from prebo.optimise import Grow, Polish, Refine, Refinement, Sweep
+    from prebo.optimise.methods import methods
+    plain = methods(Optimiser(trials=7, polish_iterations=9))
+    assert plain == {"grow": Grow(7), "sweep": Sweep(7), "refine": Refine(Refinement(200, "gradient")),
+                     "polish": Polish(9)}
+    refined = methods(Optimiser(trials=3, refine=1, refine_evaluations=40, refine_method="powell"))
+    assert refined["grow"] == Grow(3, Refinement(40, "powell")) and refined["sweep"].refine == Refinement(40, "powell")
+
+
 def test_refinement_and_learning_lower_the_energy():
     """Same seed and size: refinement and learned sampling must beat plain selection."""
     system = prebo.System(["p", "e", "e"], spin={"e": 0})
@@ -113,18 +123,16 @@ def test_refinement_and_learning_lower_the_energy():
 def test_patched_matrices_have_the_bits_of_a_full_build(kind, extra):
     """Appending and replacing through oriented rows gives exactly the matrices of a fresh build
     (what makes a resumed run continue bit for bit without rebuilding after every step)."""
-    import importlib
-
     from prebo import eigen
     from prebo.integrals import laboratory
-    O = importlib.import_module("prebo.optimise")
+    from prebo.optimise import Expansion
     s = prebo.System(["p", "e", "e"], spin={"e": 0})
     b = prebo.optimise(s, Optimiser(size=6, trials=4, seed=3, kind=kind, channels="all", **extra), progress=False)
     rep = laboratory(s)
     poor = b.subset([1])  # function 1 made 100 times tighter: putting it back is a real gain
     poor.A *= 100.0
     poor.c_A *= 100.0
-    st = O.State(prebo.Basis.concat([b.subset([0]), poor, b.subset([2, 3])]), rep, 1e-13)
+    st = Expansion(prebo.Basis.concat([b.subset([0]), poor, b.subset([2, 3])]), rep, 1e-13)
     _, rows, diag = st.candidates(b.subset([4]))
     assert st.put(4, b.subset([4]), {k: v[0] for k, v in rows.items()}, diag[0])
     keep = np.arange(5) != 1
@@ -141,13 +149,11 @@ def test_a_change_within_the_numerical_uncertainty_is_refused():
     replaced by itself perturbed at 1e-10 relative moves the energy by far less than the uncertainty:
     the state refuses the change and keeps its bits, whichever way the energy moved; a real gain
     (the function restored after its removal) is kept."""
-    import importlib
-
     from prebo.integrals import laboratory
-    O = importlib.import_module("prebo.optimise")
+    from prebo.optimise import Expansion
     basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2plus-pecg" / "basis.json")
     rep = laboratory(basis.system)
-    st = O.State(basis, rep, 1e-13)
+    st = Expansion(basis, rep, 1e-13)
     assert st.sigma > 1e-10
     A0, m0, e0 = st.basis.A.copy(), {k: v.copy() for k, v in st.m.items()}, st.energy
     for i in (0, 17, 42):
@@ -157,7 +163,7 @@ def test_a_change_within_the_numerical_uncertainty_is_refused():
         assert not st.put(i, f, {k: v[0] for k, v in rows.items()}, diag[0])
         assert np.array_equal(st.basis.A, A0) and st.energy == e0
         assert all(np.array_equal(st.m[k], m0[k]) for k in m0)
-    small = O.State(basis.subset(np.arange(len(basis) - 1)), rep, 1e-13)
+    small = Expansion(basis.subset(np.arange(len(basis) - 1)), rep, 1e-13)
     last = basis.subset([len(basis) - 1])
     _, rows, diag = small.candidates(last)
     assert small.put(len(small.basis), last, {k: v[0] for k, v in rows.items()}, diag[0])

@@ -261,7 +261,7 @@ def test_values_of_the_wrong_type_are_refused(tmp_path, capsys, text, words):
     ("refine_evaluations", 0, 1), ("learned", 1.5, 1.0), ("trials", 0, 1), ("K_max", 61, 60),
 ])
 def test_every_setting_has_a_range(tmp_path, capsys, name, bad, good):
-    from prebo.validation import SETTINGS
+    from prebo.optimise import SETTINGS
     with pytest.raises(InputError, match=f"Optimiser {name} = {bad!r}: must be"):
         prebo.Optimiser(**{name: bad})
     assert getattr(prebo.Optimiser(**{name: good}), name) == good
@@ -276,7 +276,7 @@ def test_settings_table_covers_every_optimiser_field():
     from dataclasses import fields
 
     from prebo.io import toml as inputs
-    from prebo.validation import SETTINGS
+    from prebo.optimise import SETTINGS
     assert set(SETTINGS) == {f.name for f in fields(prebo.Optimiser)}
     for name, s in SETTINGS.items():  # the defaults are within their ranges
         assert s.rule(getattr(prebo.Optimiser(), name)) == getattr(prebo.Optimiser(), name)

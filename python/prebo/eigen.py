@@ -43,6 +43,10 @@ ELEMENT_ERROR = 4 * 2.0**-53
 
 @dataclass
 class Eigen:
+    """The solution of H c = E S c: `energies` (hartree, ascending) and `vectors` (columns,
+    S-orthonormal, in the original basis) of the kept directions, the number `kept` of overlap
+    eigenvectors kept and the overlap's condition number."""
+
     energies: np.ndarray  # ascending
     vectors: np.ndarray  # columns, S-orthonormal, in the original (unscaled) basis
     kept: int  # number of overlap eigenvectors kept
@@ -51,7 +55,13 @@ class Eigen:
 
 def solve(H: np.ndarray, S: np.ndarray, threshold: float = 1e-13, roots: int = 1) -> Eigen:
     """All eigenpairs of H c = E S c by canonical orthogonalisation, the lowest `roots` of them
-    refined in extended precision (module docstring)."""
+    refined in extended precision (module docstring).
+
+    H, S: (nb, nb) symmetric Hamiltonian (hartree) and overlap matrices; threshold: overlap
+    eigenvalues (of S scaled to unit diagonal) below threshold × the largest are dropped.
+    Returns an `Eigen`. NonFiniteError for NaN or infinite elements, NotPositiveDefiniteError for
+    an overlap that is not positive definite, LinearDependenceError when nothing is kept or a
+    refined root does not converge."""
     require_finite(H, "Hamiltonian", "H")
     require_finite(S, "overlap", "S")
     diag = np.diag(S).copy()
@@ -83,7 +93,9 @@ def require_finite(M: np.ndarray, name: str, symbol: str) -> None:
 
 def refine(H: np.ndarray, S: np.ndarray, eig: Eigen, roots: int = 1) -> Eigen:
     """`eig` with its lowest `roots` eigenpairs refined in double-double (`prebo_core::eigenpair`):
-    each energy is the Rayleigh quotient of the stored H, S at its vector, converged to an ulp."""
+    each energy (hartree) is the Rayleigh quotient of the stored H, S at its vector, converged to
+    an ulp, the same on every machine. Returns a new `Eigen`; LinearDependenceError for a root
+    that does not converge."""
     c = np.ascontiguousarray
     energies, vectors, _, converged = _core.refine_eigenpairs(c(H, dtype=float), c(S, dtype=float),
                                                               c(eig.energies, dtype=float), c(eig.vectors, dtype=float),
@@ -98,9 +110,10 @@ def refine(H: np.ndarray, S: np.ndarray, eig: Eigen, roots: int = 1) -> Eigen:
 
 
 def energy_uncertainty(c: np.ndarray, energy: float, S: np.ndarray, *terms: np.ndarray) -> float:
-    """Standard deviation (Eh) of the energy of the S-normalised vector `c` from independent
+    """Standard deviation (hartree) of the energy of the S-normalised vector `c` from independent
     relative errors `ELEMENT_ERROR` of the elements of S and of each term of H = Σ terms
-    (module docstring)."""
+    (module docstring). c: (nb,) eigenvector; energy: its eigenvalue (hartree); S: (nb, nb)
+    overlap; terms: (nb, nb) matrices summing to H (e.g. T_ti and V)."""
     c2 = c * c
     W = energy**2 * S**2
     for t in terms:

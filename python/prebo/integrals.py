@@ -25,7 +25,13 @@ from .system import System
 
 @dataclass(frozen=True)
 class Representation:
-    """Kinetic matrix Λ, Coulomb vectors w and charges q, symmetry operations T and coefficients."""
+    """The operators of one coordinate representation, for the engines of every basis family.
+
+    lam: (n, n) kinetic matrix Λ of T = -∇^T Λ ∇ (hartree bohr²); pair_w: (p, n) Coulomb vectors w
+    and pair_q: (p,) charge products q of V = Σ q/|w^T r|; sym_t: (o, n, n) symmetry operations T_P
+    and sym_c: (o,) their Young-operator coefficients c_P; cm_mass: total mass (electron masses)
+    for the elimination of the CM kinetic energy (T_ti), None without a CM coordinate; coords:
+    the coordinate set of a TICC representation (None: laboratory frame)."""
 
     lam: np.ndarray
     pair_w: np.ndarray
@@ -97,7 +103,9 @@ class Representation:
 
 
 def laboratory(system: System, kinetic: str = "M") -> Representation:
-    """LFCC with kinetic matrix M (and the c_A elimination), or "internal": M - 1 1^T/(2 m_tot)."""
+    """The laboratory-frame representation of `system`: kinetic matrix M = diag(1/(2 m_i)) with the
+    CM kinetic energy eliminated through c_A (kinetic="M"), or M - 1 1^T/(2 m_tot), the CM
+    kinetic operator removed exactly (kinetic="internal", no T_ti elimination)."""
     w, q = system.coulomb_pairs()
     sym = system.symmetriser
     if kinetic == "M":
@@ -111,7 +119,10 @@ def laboratory(system: System, kinetic: str = "M") -> Representation:
 
 
 def translationally_invariant(system: System, coords: CoordinateSet | None = None) -> Representation:
-    """TICC of `coords` (default: Jacobi in input order): kinetic μ, w' = (U^-T w)_{1..n-1}, 𝒯 = (U Π U^-1)_{TI}."""
+    """The translationally invariant representation of `system` in the coordinate set `coords`
+    (default: Jacobi in input order): kinetic matrix μ = U M U^T without the CM row, Coulomb
+    vectors w' = (U^-T w)_{1..n-1}, operations 𝒯 = (U Π U^-1)_{TI} (Muolo, Mátyus & Reiher,
+    J. Chem. Phys. 149, 184105 (2018), Sec. II). Its matrices need one c_A shared by every function."""
     coords = coords or jacobi(system.masses)
     coords.check(system.masses)
     w, q = system.coulomb_pairs()

@@ -1,14 +1,14 @@
-"""Validation of every input in one place.
+"""The checks of input values, shared by every reader (Python API, TOML, basis.json, ecgpack).
 
-- `SETTINGS`: the optimiser's settings as one table (name -> type and range, meaning, TOML key),
-  used by `Optimiser.__post_init__` (Python API and checkpoints) and by the TOML reader;
 - the limits: `MAX_PARTICLES` (what the Rust core is compiled for) and `MAX_SIZE`, the largest
   basis whose matrices fit in this machine's memory: 16 dense nb x nb float64 matrices (S, T,
   T_ti, V, their copies while a function is appended or replaced, and the eigensolver's
   working matrices), i.e. nb <= sqrt(memory / 128 bytes);
+- the rules of one value (`Integer`, `Real`, `Choice`, `Lengths`, `Channels`), with the text of
+  what they allow; the optimiser's table of settings is prebo.optimise.settings.SETTINGS;
 - `number`, `half_integer`: the checks of one real parameter (masses, charges; spins);
-- `check_kind`: a basis type against the state (plain ECGs: N = 0, parity +1; ECG-GVR: natural
-  parity (-1)^N), called wherever a Basis meets a System.
+- `strict_keywords`: unknown keyword arguments of a settings dataclass as InputError.
+The states a basis family can describe are checked by the family (prebo.basis.Family.check_state).
 
 Every refusal is an `InputError` whose message names the argument or TOML key, the value and what
 is allowed; readers of files prefix the file's name.
@@ -27,8 +27,6 @@ import numpy as np
 from . import _core
 from .errors import InputError
 
-BASIS_TYPES = ("pecg", "ecg-gvr", "fecg")
-REFINE_METHODS = ("powell", "gradient")
 MAX_PARTICLES = int(_core.MAX_DIM)
 MATRICES = 16  # dense nb x nb float64 matrices held at once (module docstring)
 
@@ -65,11 +63,14 @@ def _real(v) -> float:
 
 @dataclass(frozen=True)
 class Integer:
+    """An integer (bools refused) with lo ≤ value (≤ hi if given)."""
+
     lo: int
     hi: int | None = None
 
     @property
     def allowed(self) -> str:
+        """What the rule allows, for error messages."""
         return f"an integer ≥ {self.lo}" if self.hi is None else f"an integer in {self.lo}..{self.hi}"
 
     def __call__(self, v) -> int:
@@ -91,6 +92,7 @@ class Real:
 
     @property
     def allowed(self) -> str:
+        """What the rule allows, for error messages."""
         if self.hi == math.inf:
             return f"a finite number {'≥' if self.lo_closed else '>'} {self.lo:g}"
         return (f"a number x with {self.lo:g} {'≤' if self.lo_closed else '<'} x "
@@ -105,10 +107,13 @@ class Real:
 
 @dataclass(frozen=True)
 class Choice:
+    """One of the strings `values`."""
+
     values: tuple
 
     @property
     def allowed(self) -> str:
+        """What the rule allows, for error messages."""
         return "one of " + ", ".join(map(repr, self.values))
 
     def __call__(self, v) -> str:
@@ -118,6 +123,8 @@ class Choice:
 
 
 class Lengths:
+    """Two lengths [lo, hi] with 0 < lo < hi (bohr), as a tuple."""
+
     allowed = "two finite numbers [lo, hi] with 0 < lo < hi"
 
     def __call__(self, v) -> tuple:
@@ -130,6 +137,8 @@ class Lengths:
 
 
 class Channels:
+    """"pairs", "all" or a non-empty list of coordinate-set names."""
+
     allowed = ("'pairs', 'all' or a non-empty list of coordinate-set names "
                "('jacobi:0-1-2', 'hpc:0', 'cmc:2', ...)")
 
@@ -139,61 +148,6 @@ class Channels:
         if isinstance(v, (list, tuple)) and v and all(isinstance(c, str) for c in v):
             return list(v)
         raise Refused
-
-
-@dataclass(frozen=True)
-class Setting:
-    rule: object
-    meaning: str
-    key: str  # in a TOML input
-
-
-SETTINGS = {
-    "size": Setting(Integer(1, MAX_SIZE), f"basis functions; at most {MAX_SIZE}, what {MATRICES} nb x nb "
-                    "matrices in this machine's memory allow", "[basis] size"),
-    "trials": Setting(Integer(1, MAX_SIZE), "competitive trials per step", "[optimiser] trials"),
-    "sweeps": Setting(Integer(0), "random replacement sweeps per cycle", "[optimiser] sweeps"),
-    "seed": Setting(Integer(0), "seed of the random numbers", "[optimiser] seed"),
-    "channels": Setting(Channels(), "coordinate sets the functions are drawn in", "[optimiser] channels"),
-    "length_range": Setting(Lengths(), "range of the drawn lengths in bohr, scaled per pair",
-                            "[optimiser] length_range"),
-    "c_A": Setting(Real(0.0), "exponent of the centre-of-mass coordinate", "[basis] c_A"),
-    "kind": Setting(Choice(BASIS_TYPES), "basis type", "[basis] type"),
-    "K_max": Setting(Integer(0, 60), "largest power K of an ECG-GVR function", "[basis] K_max"),
-    "refine": Setting(Integer(0), "refinement sweeps per cycle", "[optimiser] refine"),
-    "refine_evaluations": Setting(Integer(1), "energies per refinement of one function",
-                                  "[optimiser] refine_evaluations"),
-    "refine_method": Setting(Choice(REFINE_METHODS), "refinement minimiser", "[optimiser] refine_method"),
-    "polish": Setting(Integer(0), "joint refinement steps per cycle", "[optimiser] polish"),
-    "polish_iterations": Setting(Integer(1), "L-BFGS iterations per joint step", "[optimiser] polish_iterations"),
-    "cycles": Setting(Integer(1), "repetitions of the sweep-refine-polish block", "[optimiser] cycles"),
-    "learned": Setting(Real(0.0, 1.0, True, True), "share of trials from the learned distributions",
-                       "[optimiser] learned"),
-    "learn_after": Setting(Integer(1), "functions of a channel before its distribution is learned",
-                           "[optimiser] learn_after"),
-    "min_norm": Setting(Real(0.0, 1.0), "smallest part of a trial orthogonal to the basis, relative to its norm",
-                        "[optimiser] min_norm"),
-    "max_overlap": Setting(Real(0.0, 1.0, hi_closed=True), "largest normalised overlap of a trial with a function",
-                           "[optimiser] max_overlap"),
-    "threshold": Setting(Real(0.0, 1.0), "relative overlap eigenvalue below which directions are dropped",
-                         "[optimiser] threshold"),
-}
-
-
-def check(name: str, value, label: str | None = None):
-    """`value` of setting `name`, normalised (ints, floats, a tuple for length_range); InputError
-    naming `label` (default: the name), the value and what is allowed."""
-    s = SETTINGS[name]
-    try:
-        return s.rule(value)
-    except (Refused, TypeError, ValueError):
-        raise InputError(f"{label or name} = {value!r}: must be {s.rule.allowed} ({s.meaning})") from None
-
-
-def check_settings(obj, owner: str) -> None:
-    """Check and normalise every field of a settings dataclass (`Optimiser`) in place."""
-    for f in fields(obj):
-        setattr(obj, f.name, check(f.name, getattr(obj, f.name), f"{owner} {f.name}"))
 
 
 def strict_keywords(cls):
@@ -236,7 +190,10 @@ def half_integer(value, label: str) -> Fraction:
     return Fraction(round(2 * x), 2)
 
 
-def check_kind(kind: str, state) -> None:
-    """Refuse a basis type that cannot describe the state (prebo.basis.family(kind).check_state)."""
-    from .basis import family  # the basis package builds on this module
-    family(kind).check_state(state)
+def __getattr__(name: str):
+    """SETTINGS and check for the modules that still import them from here (until io/toml.py,
+    io/ecgpack.py and cli.py import them from prebo.optimise.settings, which builds on this module)."""
+    if name in ("SETTINGS", "check"):
+        from .optimise import settings
+        return getattr(settings, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -14,6 +14,8 @@ from .family import Family
 
 
 class FloatingECG(Family):
+    """Floating ECGs: centres s (n x 3, bohr) per function; any state label, <N²> reported."""
+
     name = "fecg"
     shapes = {"s": ("n", 3)}
     conserves_L = False

@@ -1,7 +1,7 @@
 """ECG-GVR functions ("ecg-gvr"): φ(r) = |v|^{2K} (v_x + i v_y)^N exp(-r^T (A ⊗ I_3) r), v = u^T r.
 
 A global vector u (n) and a power K per function, the state's N (Muolo, Mátyus & Reiher,
-J. Chem. Phys. 149, 184105 (2018), Sec. II, the ECG-GVR ansatz; docs/gvr.md). The functions have
+J. Chem. Phys. 149, 184105 (2018), Sec. III.C; docs/gvr.md). The functions have
 natural parity (-1)^N. The normalised function does not depend on the length of u; refinement
 keeps |(u', c_U)| = 1 in its coordinate set.
 """
@@ -11,14 +11,15 @@ import numpy as np
 
 from .. import _core
 from ..errors import InputError, SeparabilityError
-from ..validation import SETTINGS
 from .family import Family
 
-#: the largest power K a function may hold (the settings' bound on K_max)
-K_LIMIT = SETTINGS["K_max"].rule.hi
+#: the largest power K a function may hold (the bound of the setting K_max)
+K_LIMIT = 60
 
 
 class GlobalVectorECG(Family):
+    """ECG-GVR functions: u (n) and K per function; states of natural parity (-1)^N."""
+
     name = "ecg-gvr"
     shapes = {"u": ("n",), "K": ()}
     conserves_L = True

@@ -13,6 +13,8 @@ from .family import Family
 
 
 class PlainECG(Family):
+    """Plain ECGs: A and c_A only; N = 0, parity +1 states."""
+
     name = "pecg"
     shapes = {}
     conserves_L = True

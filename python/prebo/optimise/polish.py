@@ -1,7 +1,7 @@
 """Joint refinement: L-BFGS over the parameters of every function at once, on the exact gradient.
 
 Refinement sweeps move one function at a time; near the optimum, where the functions' parameters
-are coupled, that coordinate descent crawls. Here θ = (θ_1, ..., θ_N) (refine.Parametrisation of
+are coupled, that coordinate descent crawls. Here θ = (θ_1, ..., θ_N) (Parametrisation of
 each function in its own channel; K fixed) and, with c the S-normalised ground-state vector,
 
     ∂E/∂θ_i = 2 c_i Σ_{j≠i} c_j (∂H_ij − E ∂S_ij) + c_i² (∂H_ii − E ∂S_ii),
@@ -9,7 +9,7 @@ each function in its own channel; K fixed) and, with c the S-normalised ground-s
 where ∂H_ij, ∂S_ij are the derivatives of function i's row (i as bra) and ∂H_ii, ∂S_ii those of
 its diagonal — exactly what Representation.row_gradient returns for function i against the basis.
 N such rows give the matrices and the gradient: the cost of ~(1 + W/4) matrix builds per step.
-A θ that leaves the valid region (refine.Parametrisation, Representation.plausible) or lets the
+A θ that leaves the valid region (Parametrisation, Representation.plausible) or lets the
 overlap matrix's condition number grow beyond max(10 × its start, 1e9) scores worse than the start:
 refinement may not buy energy with near-linear dependence, where rounding is amplified.
 """
@@ -18,31 +18,32 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize
 
-from . import eigen
-from .basis import Basis
-from .errors import PreboError
-from .refine import Parametrisation
+from .. import eigen
+from ..basis import Basis
+from ..errors import PreboError
+from .parametrisation import Parametrisation
 
 
 class Joint:
     """E(θ) and ∂E/∂θ of a whole basis; remembers the best basis seen."""
 
-    def __init__(self, state):
-        self.state = state
-        basis = state.basis
+    def __init__(self, expansion):
+        self.expansion = expansion
+        basis = expansion.basis
         self.ps = [Parametrisation.of(basis.subset([i])) for i in range(len(basis))]
         thetas = [p.theta() for p in self.ps]
         self.cut = np.cumsum([0] + [len(t) for t in thetas])
         self.theta0 = np.concatenate(thetas)
-        self.worse = state.energy + 1.0
-        self.max_condition = max(10 * state.eig.overlap_condition, 1e9)
-        self.best_E, self.best = state.energy, None
+        self.worse = expansion.energy + 1.0
+        self.max_condition = max(10 * expansion.eig.overlap_condition, 1e9)
+        self.best_E, self.best = expansion.energy, None
 
     def basis(self, theta: np.ndarray) -> Basis:
+        """The basis of the joint parameter vector θ = (θ_1, ..., θ_N)."""
         return Basis.concat([p.function(theta[a:b]) for p, a, b in zip(self.ps, self.cut[:-1], self.cut[1:])])
 
     def __call__(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
-        st, nb = self.state, len(self.ps)
+        st, nb = self.expansion, len(self.ps)
         fail = (self.worse, np.zeros_like(theta))
         try:
             basis = self.basis(theta)
@@ -74,12 +75,12 @@ class Joint:
         return E, np.concatenate(grad)
 
 
-def polish(state, iterations: int) -> bool:
-    """At most `iterations` L-BFGS iterations over all parameters; the state takes the best basis
+def polish(expansion, iterations: int) -> bool:
+    """At most `iterations` L-BFGS iterations over all parameters; the expansion takes the best basis
     seen (rebuilt from scratch, so it is a function of the basis alone). True if it improved."""
-    joint = Joint(state)
+    joint = Joint(expansion)
     minimize(joint, joint.theta0, jac=True, method="L-BFGS-B",
              options={"maxiter": iterations, "maxfun": 2 * iterations, "ftol": 1e-16, "gtol": 1e-12, "maxcor": 20})
-    if joint.best is None or not state.gains(joint.best_E):
+    if joint.best is None or not expansion.gains(joint.best_E):
         return False
-    return state.replace_basis(joint.best)
+    return expansion.replace_basis(joint.best)

@@ -1,0 +1,110 @@
+"""Where a run stands, and its checkpoint: out/basis.json holds the basis, the settings, the
+`Cursor` (the next unit of work), the random-number state, the history and the seconds spent,
+written atomically after every step; `load_checkpoint` reads it back for `prebo run --resume`,
+which continues the run bit for bit.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..basis import Basis
+from ..errors import BasisFileError, InputError, PreboError
+from ..system import System
+from ..validation import number
+from .settings import Optimiser
+
+CHECKPOINT = "basis.json"
+
+PHASES = ("grow", "sweep", "refine", "polish", "done")
+
+
+@dataclass
+class Cursor:
+    """The next unit of work: one competitive step ("grow"), function `index` of
+    replacement sweep / refinement sweep `sweep` ("sweep", "refine"), joint-refinement step
+    `sweep` ("polish") of the sweep-refine-polish block `cycle`, or "done"."""
+
+    phase: str = "grow"
+    sweep: int = 0
+    index: int = 0
+    cycle: int = 0
+
+    def __post_init__(self):
+        counts = (self.sweep, self.index, self.cycle)
+        if self.phase not in PHASES or not all(type(k) is int and k >= 0 for k in counts):
+            raise InputError(f"progress {vars(self)}: phase must be one of {', '.join(PHASES)}, "
+                             "sweep, index and cycle non-negative integers")
+
+    def advance(self, nb: int, opts: Optimiser) -> "Cursor":
+        """The unit of work after this one, for a basis of `nb` functions and the schedule of `opts`
+        (grow to `size`; per cycle `sweeps` replacement sweeps, `refine` refinement sweeps, `polish`
+        joint steps; `cycles` cycles)."""
+        if self.phase == "grow":
+            if nb < opts.size:
+                return self
+            return Cursor("sweep").settle(opts)
+        nxt = Cursor(self.phase, self.sweep, self.index + 1, self.cycle)
+        if nxt.index >= nb or self.phase == "polish":
+            nxt = Cursor(self.phase, self.sweep + 1, 0, self.cycle)
+        return nxt.settle(opts)
+
+    def settle(self, opts: Optimiser) -> "Cursor":
+        """Skip phases whose sweeps are used up; after the last polish step, the next cycle."""
+        if self.phase == "sweep" and self.sweep >= opts.sweeps:
+            return Cursor("refine", cycle=self.cycle).settle(opts)
+        if self.phase == "refine" and self.sweep >= opts.refine:
+            return Cursor("polish", cycle=self.cycle).settle(opts)
+        if self.phase == "polish" and self.sweep >= opts.polish:
+            if self.cycle + 1 < opts.cycles:
+                return Cursor("sweep", cycle=self.cycle + 1).settle(opts)
+            return Cursor("done")
+        return self
+
+
+
+def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> tuple:
+    """The basis, cursor, history and elapsed seconds of checkpoint content `d` (`rng` takes its
+    state); BasisFileError naming `where` for anything that does not fit."""
+    basis = Basis.from_dict(d, where, empty=True)
+    if basis.kind != opts.kind:
+        raise BasisFileError(f"{where}: a {basis.kind} basis, but the optimiser's kind is {opts.kind}")
+    try:
+        cursor = Cursor(**d["progress"])
+        rng.bit_generator.state = d["rng"]
+        history, elapsed = d["history"], number(d.get("elapsed", 0.0), "elapsed")
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
+        raise BasisFileError(f"{where}: malformed run state ({exc})") from exc
+    if not (isinstance(history, list) and all(isinstance(h, list) and len(h) >= 3 for h in history)):
+        raise BasisFileError(f"{where}: history must be a list of [size, energy, phase, seconds] rows")
+    nb = len(basis)
+    if (cursor.phase != "grow" and nb == 0) or (cursor.phase in ("sweep", "refine") and cursor.index >= nb):
+        raise BasisFileError(f"{where}: progress {vars(cursor)} does not fit a basis of {nb} functions")
+    return basis, cursor, history, elapsed
+
+
+def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
+    """The content of folder/basis.json with its system and settings, checked as a whole
+    (BasisFileError naming the file)."""
+    path = Path(folder) / CHECKPOINT
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise BasisFileError(f"{path}: no checkpoint to resume ({exc.strerror})") from exc
+    except UnicodeDecodeError as exc:
+        raise BasisFileError(f"{path}: not a text file ({exc.reason})") from exc
+    try:
+        d = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise BasisFileError(f"{path}: corrupt checkpoint (line {exc.lineno}: {exc.msg})") from exc
+    if not (isinstance(d, dict) and {"optimiser", "progress", "rng", "history"} <= set(d)):
+        raise BasisFileError(f"{path}: not a run checkpoint (no optimiser state)")
+    try:
+        opts = Optimiser.from_dict(d["optimiser"])
+    except PreboError as exc:
+        raise BasisFileError(f"{path}: {exc}") from exc
+    basis, *_ = resumed(d, opts, np.random.default_rng(), str(path))
+    return d, basis.system, opts

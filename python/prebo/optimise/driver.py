@@ -1,0 +1,90 @@
+"""The one driver: `optimise` runs the methods of the schedule (methods.py) one unit of work at a
+time, keeps the history and writes the checkpoint; `resume_from` continues a run.
+
+With an output folder, the basis, the random-number state and the position in the schedule are
+written atomically after every step: a killed run loses at most the step in flight, and
+`prebo run --resume` continues it bit for bit; every start removes the temporary files
+(basis.json.*.tmp) a write killed in flight left.
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..basis import Basis
+from ..errors import InputError
+from ..integrals import laboratory
+from ..io.basis_json import remove_stale_temporaries
+from ..system import System
+from .checkpoint import CHECKPOINT, Cursor, load_checkpoint, resumed
+from .expansion import Expansion
+from .methods import Run, methods
+from .report import Reporter
+from .sampler import Sampler
+from .settings import Optimiser
+
+
+def optimise(system: System, opts: Optimiser, out: Path | None = None, progress: bool = True,
+             resume: dict | None = None) -> Basis:
+    """Optimise a basis of `opts.kind` for the state of `system`: grow it to `opts.size` by
+    competitive selection, then run `opts.cycles` times `opts.sweeps` random replacement sweeps,
+    `opts.refine` refinement sweeps and `opts.polish` joint steps (methods.py).
+
+    out: folder of the checkpoint out/basis.json, written atomically after every step (None: no
+    checkpoint); progress: show a live line; resume: a checkpoint's content
+    (checkpoint.load_checkpoint) to continue exactly where it stopped.
+    Returns the basis with the ground state's coefficients; its energy (hartree) is
+    prebo.evaluate(basis)["energy"]. InputError for arguments of the wrong type, StalledError when
+    growth rejects every trial for STALL_STEPS steps, BasisFileError for a `resume` that does not fit."""
+    if not isinstance(system, System):
+        raise InputError(f"optimise: system = {system!r}: must be a prebo.System")
+    if not isinstance(opts, Optimiser):
+        raise InputError(f"optimise: opts = {opts!r}: must be a prebo.Optimiser")
+    rng = np.random.default_rng(opts.seed)
+    sampler = Sampler(system, opts, rng)
+    rep = laboratory(system)
+    if resume is None:
+        basis, cursor, history, elapsed = Basis.empty(system, opts.kind), Cursor().advance(0, opts), [], 0.0
+    else:
+        basis, cursor, history, elapsed = resumed(resume, opts, rng, "checkpoint")
+    if out is not None:
+        remove_stale_temporaries(Path(out) / CHECKPOINT)
+    t_start = time.perf_counter()
+
+    def wall() -> float:
+        """Seconds of optimisation so far, over all segments of a resumed run."""
+        return round(elapsed + time.perf_counter() - t_start, 1)
+
+    ex = Expansion(basis, rep, opts.threshold, opts.min_norm, opts.max_overlap)
+    sampler.learn(ex.basis)
+    run = Run(ex, sampler, Reporter(opts, progress))
+    steps = methods(opts)
+
+    def checkpoint():
+        if out is not None:
+            ex.basis.coefficients = ex.eig.vectors[:, 0] if ex.eig is not None else None
+            energy = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
+            ex.basis.save(Path(out) / CHECKPOINT, {
+                "energy": energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
+                "rng": rng.bit_generator.state, "history": history, "elapsed": wall()})
+
+    with run.report:
+        while cursor.phase != "done":
+            old = ex.energy
+            steps[cursor.phase].step(run, cursor)
+            if ex.energy < old:
+                history.append([len(ex.basis), ex.energy, cursor.phase, wall()])
+                run.report.step(ex, old, cursor)
+                sampler.learn(ex.basis)  # a function of the basis alone, so a resumed run learns the same
+            cursor = cursor.advance(len(ex.basis), opts)
+            checkpoint()
+    ex.basis.coefficients = ex.eig.vectors[:, 0]
+    return ex.basis
+
+
+def resume_from(folder: Path, progress: bool = True) -> tuple[Basis, Optimiser]:
+    """Continue the run whose checkpoint is folder/basis.json; the finished basis and its settings."""
+    d, system, opts = load_checkpoint(folder)
+    return optimise(system, opts, out=Path(folder), progress=progress, resume=d), opts

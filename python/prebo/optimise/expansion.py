@@ -1,0 +1,134 @@
+"""`Expansion`: the basis being optimised, with its matrices and the eigen-solution of H c = E S c.
+
+The wave function is expanded in the basis; every method (methods.py) proposes changes to it and
+the expansion keeps a change only if it lowers the energy by more than the energy's numerical
+uncertainty before and after it (eigen.energy_uncertainty): a gain rounding can fake is refused,
+never accepted. The matrices are a function of the basis alone (patched from oriented rows with
+the bits of a rebuild, or rebuilt), so a resumed run continues bit for bit. (Named to keep it
+apart from prebo.State, the quantum numbers of a system.)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import eigen
+from ..basis import Basis
+
+
+class Expansion:
+    """The basis `basis` with its matrices `m` (S, T, T_ti, V; hartree), eigen-solution `eig`, ground-state
+    `energy` (hartree) and `sigma`, the energy's numerical uncertainty (module docstring).
+
+    rep: the integrals' Representation (integrals.laboratory); threshold: eigen.solve's relative
+    overlap eigenvalue below which directions are dropped; min_norm, max_overlap: the
+    linear-dependence guard of `candidates` (Optimiser settings of the same names)."""
+
+    def __init__(self, basis: Basis, rep, threshold: float, min_norm: float = 1e-8, max_overlap: float = 0.99):
+        self.basis, self.rep, self.threshold = basis, rep, threshold
+        self.min_norm, self.max_overlap = min_norm, max_overlap
+        if len(basis):
+            self.m = rep.matrices(basis)
+        else:
+            self.m = {k: np.zeros((0, 0)) for k in ("S", "T", "T_ti", "V")}
+        self.solve()
+
+    def solve(self) -> None:
+        """Solve the eigenproblem of the current matrices (energy inf for no functions)."""
+        if len(self.basis) == 0:
+            self.eig, self.energy, self.sigma = None, np.inf, 0.0
+            return
+        self.eig = eigen.solve(self.m["T_ti"] + self.m["V"], self.m["S"], self.threshold)
+        self.energy = float(self.eig.energies[0])
+        self.sigma = eigen.energy_uncertainty(self.eig.vectors[:, 0], self.energy, self.m["S"], self.m["T_ti"],
+                                              self.m["V"])
+
+    def gains(self, energy: float) -> bool:
+        """Whether `energy` lies below the current energy by more than its uncertainty."""
+        return energy < self.energy - self.sigma
+
+    def _snapshot(self) -> tuple:
+        return (self.basis.subset(slice(None)), {k: v.copy() for k, v in self.m.items()}, self.eig, self.energy,
+                self.sigma)
+
+    def _keep_if_lower(self, before: tuple) -> bool:
+        """After a change: keep it if the energy fell by more than the uncertainty before and after
+        it; otherwise restore the state `before` (`_snapshot`). True if kept."""
+        if before[3] == np.inf or self.energy < before[3] - max(self.sigma, before[4]):
+            return True
+        self.basis, self.m, self.eig, self.energy, self.sigma = before
+        return False
+
+    def replace_basis(self, basis: Basis) -> bool:
+        """Take a whole new basis (matrices rebuilt) if it lowers the energy beyond the uncertainty."""
+        before = self._snapshot()
+        self.basis = basis
+        self.m = self.rep.matrices(basis)
+        self.solve()
+        return self._keep_if_lower(before)
+
+    def without(self, i: int):
+        """The eigen-solution of the basis without function i (None if that leaves nothing)."""
+        keep = np.arange(len(self.basis)) != i
+        if not keep.any():
+            return None
+        H = self.m["T_ti"] + self.m["V"]
+        return eigen.solve(H[np.ix_(keep, keep)], self.m["S"][np.ix_(keep, keep)], self.threshold)
+
+    def virial(self) -> float:
+        """|1 + <V>/(2<T_ti>)| of the ground state: 0 for an exact Coulomb eigenstate (virial theorem)."""
+        c = self.eig.vectors[:, 0]
+        return abs(1.0 + (c @ self.m["V"] @ c) / (2.0 * (c @ self.m["T_ti"] @ c)))
+
+    def candidates(self, trials: Basis, exclude: int | None = None, eig=None):
+        """Lowest energy with each trial added (to the basis without `exclude`, where the trial
+        would replace it), with the rows and diagonals for `put`. The linear-dependence guard
+        gives +inf to a trial whose normalised overlap with a function exceeds `max_overlap`
+        or whose part orthogonal to the basis is below `min_norm` of its norm, and so does a
+        trial whose elements fail `Representation.plausible`."""
+        position = len(self.basis) if exclude is None else exclude
+        rows, diag = self.rep.rows(trials, self.basis, position)
+        H = rows["T_ti"] + rows["V"]
+        S = rows["S"]
+        keep = np.ones(len(self.basis), bool)
+        if exclude is not None:
+            keep[exclude] = False
+        if eig is None:
+            eig = self.eig if exclude is None else self.without(exclude)
+        E, C = (eig.energies, eig.vectors) if eig is not None else (np.zeros(0), np.zeros((0, 0)))
+        energies = eigen.lowest_with_added_many(E, C, H[:, keep], S[:, keep], diag[:, 2] + diag[:, 3],
+                                                diag[:, 0], self.min_norm)
+        if keep.any():
+            overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(diag[:, 0], np.diag(self.m["S"])[keep]))
+            energies[overlap.max(axis=1) > self.max_overlap] = np.inf
+        energies[~self.rep.plausible({"S": S[:, keep]}, diag, np.diag(self.m["S"])[keep])] = np.inf
+        return energies, rows, diag
+
+    def put(self, i: int, f: Basis, row: dict | None = None, d=None) -> bool:
+        """Append (i == len) or replace function i by `f` if that lowers the energy beyond the
+        uncertainty (class docstring); True if it did. The matrices are patched from the
+        function's oriented row (`Representation.rows` with position i) or else rebuilt, so that
+        the state is a function of the basis alone and a resumed run continues bit for bit."""
+        before = self._snapshot()
+        nb = len(self.basis)
+        if i == nb:
+            self.basis.append(f)
+        else:
+            self.basis.replace(i, f)
+        if row is None or not self.rep.oriented(self.basis):
+            self.m = self.rep.matrices(self.basis)
+        else:
+            values = {"S": d[0], "T": d[1], "T_ti": d[2], "V": d[3]}
+            for k in self.m:
+                r = np.array(row[k], copy=True)
+                if i == nb:
+                    M = np.zeros((nb + 1, nb + 1))
+                    M[:nb, :nb] = self.m[k]
+                    M[nb, :nb] = M[:nb, nb] = r
+                    M[nb, nb] = values[k]
+                    self.m[k] = M
+                else:
+                    r[i] = values[k]
+                    self.m[k][i, :] = r
+                    self.m[k][:, i] = r
+        self.solve()
+        return self._keep_if_lower(before)

@@ -1,0 +1,135 @@
+"""The optimisation methods: small config objects, each doing one unit of work of the schedule
+(checkpoint.Cursor) on a `Run` when the driver (driver.optimise) calls its `step`.
+
+- `Grow`: competitive selection (Suzuki & Varga, Lect. Notes Phys. m54, ch. 4, the stochastic
+  variational method): `trials` random functions, each one's row against the basis from the
+  core (O(N_b) integrals) and the new lowest eigenvalue from the secular equation (O(N_b^2),
+  eigen.lowest_with_added_many); the best is appended if it lowers the energy beyond its
+  uncertainty and, with `refine`, refined.
+- `Sweep`: one step of a random replacement sweep: function i competes with `trials` random
+  replacements in the basis without it; with `refine`, the winner is refined and kept only if
+  it then beats the incumbent, which is refined otherwise (refine.regenerate_function).
+- `Refine`: one step of a refinement sweep, function i refined with all others fixed (refine.py).
+- `Polish`: one joint L-BFGS step over every parameter (polish.py).
+Replacements reach new basins, joint refinement converges within one; the sweep-refine-polish
+block is repeated `cycles` times (Optimiser).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import StalledError
+from .checkpoint import Cursor
+from .expansion import Expansion
+from .polish import polish
+from .refine import refine_function, regenerate_function
+from .report import Reporter
+from .sampler import Sampler
+from .settings import Optimiser
+
+STALL_STEPS = 100  # growth steps in a row without an accepted trial before the run stops (StalledError)
+
+
+@dataclass
+class Run:
+    """What the methods act on: the expansion, the sampler and the reporter; `stalled` counts the
+    growth steps in a row that added nothing."""
+
+    expansion: Expansion
+    sampler: Sampler
+    report: Reporter
+    stalled: int = 0
+
+
+@dataclass(frozen=True)
+class Refinement:
+    """The refinement of one function: at most `evaluations` energies by `method` ("gradient":
+    L-BFGS on exact gradients, or "powell")."""
+
+    evaluations: int
+    method: str
+
+
+@dataclass(frozen=True)
+class Grow:
+    """Append the best of `trials` random functions (module docstring); refine it with `refine`.
+    StalledError after STALL_STEPS steps in a row whose every trial was rejected."""
+
+    trials: int
+    refine: Refinement | None = None
+
+    def step(self, run: Run, cursor: Cursor) -> None:
+        """One unit of work on `run` at `cursor` (class docstring)."""
+        ex = run.expansion
+        trials = run.sampler.trials(self.trials)
+        energies, rows, diag = ex.candidates(trials)
+        best = int(np.argmin(energies))
+        run.report.trials(len(trials))
+        if (np.isfinite(energies[best]) and ex.gains(energies[best])
+                and ex.put(len(ex.basis), trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])):
+            run.stalled = 0
+            if self.refine:
+                refine_function(ex, len(ex.basis) - 1, self.refine.evaluations, self.refine.method)
+            return
+        run.stalled += 1
+        if run.stalled == STALL_STEPS:
+            raise StalledError(
+                f"optimiser: every trial of the last {run.stalled} growth steps was rejected at "
+                f"{len(ex.basis)} functions (linearly dependent on the basis or implausible); raise "
+                f"max_overlap (now {ex.max_overlap:g}), lower min_norm (now {ex.min_norm:g}) "
+                f"or change length_range (now {list(run.sampler.opts.length_range)})")
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """Replace function `cursor.index` by the best of `trials` random functions if that lowers the
+    energy; with `refine`, the winner is refined first (module docstring)."""
+
+    trials: int
+    refine: Refinement | None = None
+
+    def step(self, run: Run, cursor: Cursor) -> None:
+        """One unit of work on `run` at `cursor` (class docstring)."""
+        ex, i = run.expansion, cursor.index
+        trials = run.sampler.trials(self.trials)
+        rest = ex.without(i)
+        energies, rows, diag = ex.candidates(trials, exclude=i, eig=rest)
+        run.report.trials(len(trials))
+        best = int(np.argmin(energies))
+        if self.refine and np.isfinite(energies[best]):
+            regenerate_function(ex, i, trials.subset([best]), self.refine.evaluations, self.refine.method, rest)
+        elif np.isfinite(energies[best]) and ex.gains(energies[best]):
+            ex.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
+
+
+@dataclass(frozen=True)
+class Refine:
+    """Refine function `cursor.index` with all others fixed."""
+
+    refine: Refinement
+
+    def step(self, run: Run, cursor: Cursor) -> None:
+        """One unit of work on `run` at `cursor` (class docstring)."""
+        run.report.trials(1)
+        refine_function(run.expansion, cursor.index, self.refine.evaluations, self.refine.method)
+
+
+@dataclass(frozen=True)
+class Polish:
+    """At most `iterations` joint L-BFGS iterations over every parameter."""
+
+    iterations: int
+
+    def step(self, run: Run, cursor: Cursor) -> None:
+        """One unit of work on `run` at `cursor` (class docstring)."""
+        polish(run.expansion, self.iterations)
+
+
+def methods(opts: Optimiser) -> dict:
+    """The method of each phase of the schedule, configured by `opts`."""
+    refinement = Refinement(opts.refine_evaluations, opts.refine_method)
+    on_change = refinement if opts.refine else None  # refine grown and replacing functions too
+    return {"grow": Grow(opts.trials, on_change), "sweep": Sweep(opts.trials, on_change),
+            "refine": Refine(refinement), "polish": Polish(opts.polish_iterations)}

@@ -1,0 +1,129 @@
+"""Local refinement of one basis function with all others fixed (the paper's Powell step: Muolo,
+Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018), Sec. IV.E).
+
+The function moves in its parameters θ (parametrisation.py). The energy of a trial θ is the
+lowest root of the secular equation (eigen.lowest_with_added) against the basis without the
+function: one row of integrals and O(N_b^2) per evaluation.
+
+Two minimisers: Powell's method on the energy (the paper's), and L-BFGS on the energy and its
+exact gradient — the row's derivatives along ∂(A, u or s)/∂θ_p by forward-mode dual numbers
+in the Rust core (Representation.row_gradient), then eigen.lowest_with_added_gradient.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import minimize
+
+from .. import eigen
+from ..basis import Basis
+from ..errors import PreboError
+from .parametrisation import Parametrisation
+
+
+class Objective:
+    """The energy as a function of θ of function i, all others fixed: the lowest root of the
+    secular equation against the basis without i. Remembers the best function seen. A θ that
+    leaves the valid region (an ill-conditioned 𝒜, elements failing `Representation.plausible`),
+    or makes the function linearly dependent on the others, scores worse than the current energy (a finite value keeps the line searches sane).
+    `f`: parametrise this function (a newcomer for slot i) instead of function i; the expansion is
+    not changed, and the best seen starts at f's own energy."""
+
+    def __init__(self, expansion, i: int, rest=None, f: Basis | None = None):
+        self.expansion, self.i = expansion, i
+        basis = expansion.basis
+        self.keep = np.arange(len(basis)) != i
+        sub = expansion.without(i) if rest is None else rest
+        self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
+        self.rest = basis.subset(np.flatnonzero(self.keep))
+        self.S_rest = np.diag(expansion.m["S"])[self.keep]
+        self.p = Parametrisation.of(basis.subset([i]) if f is None else f)
+        self.worse = expansion.energy + 1.0
+        self.best_E, self.best_f = expansion.energy, None
+        if f is not None:
+            self.best_E = np.inf
+            self.energy(self.p.theta())
+
+    def _seen(self, e: float, f: Basis) -> None:
+        if e < self.best_E:
+            self.best_E, self.best_f = e, f
+
+    def energy(self, theta: np.ndarray) -> float:
+        """The lowest energy (hartree) with function i at θ (`worse` outside the valid region)."""
+        st = self.expansion
+        try:
+            f = self.p.function(theta)
+            rows, diag = st.rep.rows(f, st.basis, self.i)
+        except PreboError:
+            return self.worse
+        if not st.rep.plausible({"S": rows["S"][:, self.keep]}, diag, self.S_rest)[0]:
+            return self.worse
+        e = eigen.lowest_with_added(self.E, self.C, (rows["T_ti"] + rows["V"])[0, self.keep],
+                                    rows["S"][0, self.keep], diag[0, 2] + diag[0, 3], diag[0, 0], st.min_norm)
+        if not np.isfinite(e):
+            return self.worse
+        self._seen(e, f)
+        return e
+
+    def energy_and_gradient(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
+        """`energy` and its exact gradient ∂E/∂θ (hartree per unit of θ)."""
+        st = self.expansion
+        try:
+            f = self.p.function(theta)
+            dA, dv = self.p.directions(theta)
+            rows, diag = st.rep.row_gradient(f, dA, dv, self.rest)
+        except PreboError:
+            return self.worse, np.zeros_like(theta)
+        if not st.rep.plausible({"S": rows["S"][:1]}, diag[:1], self.S_rest)[0]:
+            return self.worse, np.zeros_like(theta)
+        H, S = rows["T_ti"] + rows["V"], rows["S"]
+        h_nn, s_nn = diag[:, 2] + diag[:, 3], diag[:, 0]
+        e, g = eigen.lowest_with_added_gradient(self.E, self.C, H[0], S[0], h_nn[0], s_nn[0], H[1:], S[1:],
+                                                h_nn[1:], s_nn[1:], st.min_norm)
+        if not (np.isfinite(e) and np.all(np.isfinite(g))):
+            return self.worse, np.zeros_like(theta)
+        self._seen(e, f)
+        return e, g
+
+
+def minimise(obj: Objective, max_evaluations: int, method: str) -> None:
+    """Powell's method, or L-BFGS with exact gradients, from the objective's function, with at
+    most `max_evaluations` energies; the best function seen is kept in the objective."""
+    theta0 = obj.p.theta()
+    if method == "gradient":
+        minimize(obj.energy_and_gradient, theta0, jac=True, method="L-BFGS-B",
+                 options={"maxfun": max_evaluations, "maxiter": max_evaluations, "ftol": 1e-16, "gtol": 1e-12,
+                          "maxcor": 20})
+    else:
+        minimize(obj.energy, theta0, method="Powell",
+                 options={"maxfev": max_evaluations, "xtol": 1e-4, "ftol": 1e-14, "direc": 0.1 * np.eye(len(theta0))})
+
+
+def accept(expansion, i: int, obj: Objective) -> bool:
+    """Put the objective's best function in slot i if it lowers the energy beyond its numerical
+    uncertainty (Expansion.put); True if it did."""
+    if obj.best_f is None or not expansion.gains(obj.best_E):
+        return False
+    rows, diag = expansion.rep.rows(obj.best_f, expansion.basis, i)  # oriented: patched matrices equal a rebuild
+    return expansion.put(i, obj.best_f, {k: v[0] for k, v in rows.items()}, diag[0])
+
+
+def refine_function(expansion, i: int, max_evaluations: int = 200, method: str = "gradient", rest=None) -> bool:
+    """Minimise the energy over the parameters of function i — Powell, or L-BFGS with exact
+    gradients — with at most `max_evaluations` energies; True if it improved. `rest`: the
+    eigen-solution of the basis without i (Expansion.without), if already at hand."""
+    obj = Objective(expansion, i, rest)
+    minimise(obj, max_evaluations, method)
+    return accept(expansion, i, obj)
+
+
+def regenerate_function(expansion, i: int, f: Basis, max_evaluations: int = 200, method: str = "gradient",
+                        rest=None) -> bool:
+    """A replacement sweep's step with refinement: `f` (the competitive winner for position i) is
+    refined in slot i and takes it if it then lowers the energy; otherwise function i is refined.
+    A refined newcomer can leave the basin the incumbent's refinement is confined to. True if it
+    improved. Both refinements share `rest`, the eigen-solution of the basis without i
+    (Expansion.without), and the expansion is changed (and its eigenproblem solved) once at most."""
+    rest = expansion.without(i) if rest is None else rest
+    newcomer = Objective(expansion, i, rest, f)
+    minimise(newcomer, max_evaluations, method)
+    return accept(expansion, i, newcomer) or refine_function(expansion, i, max_evaluations, method, rest)

@@ -1,0 +1,52 @@
+"""The live progress line of a run: basis size, energy, last improvement, virial, trials per second."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .checkpoint import Cursor
+from .expansion import Expansion
+from .settings import Optimiser
+
+
+class Reporter:
+    """A live line (rich) while `enabled`: basis size, energy, last improvement, virial, trials per second."""
+
+    def __init__(self, opts: Optimiser, enabled: bool):
+        self.opts, self.enabled = opts, enabled
+        self.n_trials, self.t0 = 0, time.perf_counter()
+        self.progress = None
+
+    def __enter__(self):
+        if self.enabled:
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+            self.progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                                     TimeElapsedColumn(), TextColumn("{task.fields[info]}"))
+            self.progress.__enter__()
+            self.task = self.progress.add_task("growing", total=self.opts.size, info="")
+        return self
+
+    def __exit__(self, *exc):
+        if self.progress is not None:
+            self.progress.__exit__(*exc)
+
+    def trials(self, k: int) -> None:
+        """Count `k` more trial functions (or refinements) for the rate."""
+        self.n_trials += k
+
+    def step(self, st: Expansion, old: float, cursor: Cursor) -> None:
+        """Show the expansion after a step that lowered the energy from `old`."""
+        if self.progress is None:
+            return
+        rate = self.n_trials / max(time.perf_counter() - self.t0, 1e-9)
+        gain = old - st.energy if np.isfinite(old) else float("nan")
+        info = f"E = {st.energy:.12f}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.1f} trials/s"
+        if cursor.phase == "grow":
+            self.progress.update(self.task, completed=len(st.basis), info=info)
+        elif cursor.phase == "polish":
+            self.progress.update(self.task, description=f"polish (cycle {cursor.cycle + 1})", completed=cursor.sweep + 1, total=self.opts.polish,
+                                 info=info)
+        else:
+            self.progress.update(self.task, description=f"{cursor.phase} {cursor.sweep + 1} (cycle {cursor.cycle + 1})",
+                                 completed=cursor.index + 1, total=len(st.basis), info=info)

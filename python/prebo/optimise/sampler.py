@@ -1,0 +1,162 @@
+"""Random basis functions: fresh draws in pair form or in coordinate sets, and draws from the
+distributions learned from the functions selected so far.
+
+- "pairs": A = Σ_{i<j} α_ij w_ij w_ij^T + c_A (m/m_tot)(m/m_tot)^T, α_ij = 1/b_ij^2,
+  b_ij log-uniform in [lo, hi] × a_ij with a_ij = 1/(min(μ_ij, 1) max(|q_i q_j|, 1));
+- a coordinate set x (coordinates.all_sets): 𝒜 = diag(1/b_k^2) in x, b_k log-uniform
+  over the same range with the lengths of the particles the coordinate joins, then
+  A^(r) = U_x^T blockdiag(𝒜, c_A) U_x.
+The family adds its own parameters (Family.draw_power, Family.drawn): ECG-GVR a power K and the
+global vector along the pair or coordinate drawn, floating ECGs centres displaced along it.
+After `learn_after` functions of a channel, a share `learned` of the trials is drawn from the
+normal distribution of the parameters θ (parametrisation.py) selected so far in that channel.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import coordinates as coords
+from ..basis import Basis, family
+from ..errors import IllConditionedError, InputError
+from ..system import System
+from .parametrisation import Parametrisation
+from .settings import Optimiser
+
+
+def coordinate_sets(system: System, channels) -> list[coords.CoordinateSet]:
+    """The coordinate sets of the `channels` setting ([] for "pairs"), checked against the system."""
+    m = system.masses
+    if channels == "pairs":
+        return []
+    if channels == "all":
+        return coords.all_sets(m, [p.name for p in system.particles])
+    try:
+        sets = [coords.by_name(m, name) for name in channels]
+        for x in sets:
+            x.check(m)
+    except InputError as exc:
+        raise InputError(f"channels: {exc}") from exc
+    return sets
+
+
+@dataclass
+class Sampler:
+    """Random functions of `system` with the settings `opts`, drawn with `rng` (module docstring)."""
+
+    system: System
+    opts: Optimiser
+    rng: np.random.Generator
+    sets: list = field(default_factory=list)
+    # θ of the functions at the last `learn`, by channel and parameters (a sweep step changes one)
+    _thetas: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self):
+        s, m, q = self.system, self.system.masses, self.system.charges
+        n = s.n
+        self.length = np.ones((n, n))
+        for i in range(n):
+            for j in range(n):
+                if i != j:
+                    mu = m[i] * m[j] / (m[i] + m[j])
+                    self.length[i, j] = 1.0 / (min(mu, 1.0) * max(abs(q[i] * q[j]), 1.0))
+        self.sets = coordinate_sets(s, self.opts.channels)
+        self.pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
+
+    def _b(self, a, size=None):
+        lo, hi = self.opts.length_range
+        return a * np.exp(self.rng.uniform(np.log(lo), np.log(hi), size))
+
+    def _pair_vector(self, i, j):
+        w = np.zeros(self.system.n)
+        w[i], w[j] = 1.0, -1.0
+        return w
+
+    def learn(self, basis: Basis) -> None:
+        """Per channel: the mean and spread of the parameters θ (Parametrisation) and the
+        powers K of the functions selected so far, for `draw`."""
+        self.learned = {}
+        if len(basis) == 0:
+            return
+        groups: dict[str, list[int]] = {}
+        for i, ch in enumerate(basis.channels):
+            groups.setdefault(ch, []).append(i)
+        seen, known = {}, self._thetas
+        for ch, idx in groups.items():
+            if len(idx) < self.opts.learn_after:
+                continue
+            thetas = []
+            for i in idx:  # θ of a function is remembered while it stays in the basis (a sweep step changes one)
+                key = (ch, basis.c_A[i], *(v[i].tobytes() for v in (basis.A, *basis.parameters.values())))
+                if key not in seen:
+                    seen[key] = known[key] if key in known else Parametrisation.of(basis.subset([i])).theta()
+                thetas.append(seen[key])
+            thetas = np.array(thetas)
+            Ks = basis.family.powers(basis, idx)
+            self.learned[ch] = (Parametrisation.of(basis.subset(idx[:1])), thetas.mean(axis=0), thetas.std(axis=0),
+                                Ks, len(idx))
+        self._thetas = seen
+
+    def trials(self, k: int) -> Basis:
+        """`k` functions of `draw` as one basis."""
+        return Basis.concat([self.draw() for _ in range(k)])
+
+    def draw(self) -> Basis:
+        """One function: with probability `opts.learned` from the learned per-channel
+        distributions (normal in θ, K from the selected ones ± 2), otherwise `fresh`."""
+        learned = getattr(self, "learned", {})
+        if learned and self.rng.random() < self.opts.learned:
+            names = list(learned)
+            weights = np.array([learned[c][4] for c in names], float)
+            p, mean, std, Ks, _ = learned[names[self.rng.choice(len(names), p=weights / weights.sum())]]
+            theta = mean + self.rng.normal(size=mean.shape) * np.maximum(std, 0.05)
+            K = None if Ks is None else family(self.opts.kind).draw_learned_power(self.rng, Ks, self.opts.K_max)
+            try:
+                return p.function(theta, K)
+            except IllConditionedError:
+                return self.fresh()
+        return self.fresh()
+
+    def fresh(self) -> Basis:
+        """One random function as a one-function Basis (module docstring)."""
+        s, c_A = self.system, self.opts.c_A
+        n = s.n
+        cm = s.cm_vector
+        fam = family(self.opts.kind)
+        # |v|^{2K+N} exp(-α v²) peaks at |v| = sqrt((K + N/2)/α): for the coordinate that carries
+        # the global vector, the drawn length b is that peak, α = (K + N/2)/b² (K + N/2 > 0)
+        K, power = fam.draw_power(self.rng, self.opts.K_max, s.state.N)
+        if not self.sets:
+            i0, j0 = self.pairs[self.rng.integers(len(self.pairs))]
+            A = c_A * np.outer(cm, cm)
+            for i, j in self.pairs:
+                w = self._pair_vector(i, j)
+                b = self._b(self.length[i, j])
+                A += np.outer(w, w) * (max(power, 1.0) if (i, j) == (i0, j0) else 1.0) / b**2
+            u = self._pair_vector(i0, j0)
+            # centres: particle j displaced from particle i by a random vector of its pair length
+            centres = np.zeros((n, 3))
+            centres[j0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(self.length[i0, j0])
+            channel = "pairs"
+        else:
+            x = self.sets[self.rng.integers(len(self.sets))]
+            # the length of coordinate k: that of the two particles its row weighs most
+            lengths = []
+            for k in range(n - 1):
+                i, j = np.argsort(-np.abs(x.U[k]))[:2]
+                lengths.append(self.length[i, j])
+            b = self._b(np.array(lengths))
+            alpha = 1.0 / b**2
+            k0 = int(self.rng.integers(n - 1))
+            alpha[k0] *= max(power, 1.0)
+            A = x.to_lab(np.diag(alpha), c_A)
+            ux = np.zeros(n)
+            ux[k0] = 1.0  # one internal coordinate, c_U = 0
+            u = x.U.T @ ux
+            # centres in x: coordinate k0 displaced by a random vector of its drawn length, CM at rest
+            sx = np.zeros((n, 3))
+            sx[k0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(lengths[k0])
+            centres = x.U_inv @ sx
+            channel = x.name
+        return Basis.single(s, A, c_A, channel, fam.name, fam.drawn(s, u, centres, K))

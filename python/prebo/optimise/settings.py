@@ -1,0 +1,127 @@
+"""The optimiser's settings: the `Optimiser` dataclass and `SETTINGS`, its table of types, ranges,
+meanings and TOML keys, used by `Optimiser.__post_init__` (Python API and checkpoints) and by
+the TOML reader. Every refusal is an InputError naming the argument or TOML key, the value and
+what is allowed.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+from ..basis import FAMILIES
+from ..basis.gvr import K_LIMIT
+from ..errors import InputError
+from ..validation import MATRICES, MAX_SIZE, Channels, Choice, Integer, Lengths, Real, Refused, strict_keywords
+
+REFINE_METHODS = ("powell", "gradient")
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One setting: its rule (type and range, with `.allowed`), meaning and TOML key."""
+
+    rule: object
+    meaning: str
+    key: str  # in a TOML input
+
+
+SETTINGS = {
+    "size": Setting(Integer(1, MAX_SIZE), f"basis functions; at most {MAX_SIZE}, what {MATRICES} nb x nb "
+                    "matrices in this machine's memory allow", "[basis] size"),
+    "trials": Setting(Integer(1, MAX_SIZE), "competitive trials per step", "[optimiser] trials"),
+    "sweeps": Setting(Integer(0), "random replacement sweeps per cycle", "[optimiser] sweeps"),
+    "seed": Setting(Integer(0), "seed of the random numbers", "[optimiser] seed"),
+    "channels": Setting(Channels(), "coordinate sets the functions are drawn in", "[optimiser] channels"),
+    "length_range": Setting(Lengths(), "range of the drawn lengths in bohr, scaled per pair",
+                            "[optimiser] length_range"),
+    "c_A": Setting(Real(0.0), "exponent of the centre-of-mass coordinate", "[basis] c_A"),
+    "kind": Setting(Choice(tuple(FAMILIES)), "basis type", "[basis] type"),
+    "K_max": Setting(Integer(0, K_LIMIT), "largest power K of an ECG-GVR function", "[basis] K_max"),
+    "refine": Setting(Integer(0), "refinement sweeps per cycle", "[optimiser] refine"),
+    "refine_evaluations": Setting(Integer(1), "energies per refinement of one function",
+                                  "[optimiser] refine_evaluations"),
+    "refine_method": Setting(Choice(REFINE_METHODS), "refinement minimiser", "[optimiser] refine_method"),
+    "polish": Setting(Integer(0), "joint refinement steps per cycle", "[optimiser] polish"),
+    "polish_iterations": Setting(Integer(1), "L-BFGS iterations per joint step", "[optimiser] polish_iterations"),
+    "cycles": Setting(Integer(1), "repetitions of the sweep-refine-polish block", "[optimiser] cycles"),
+    "learned": Setting(Real(0.0, 1.0, True, True), "share of trials from the learned distributions",
+                       "[optimiser] learned"),
+    "learn_after": Setting(Integer(1), "functions of a channel before its distribution is learned",
+                           "[optimiser] learn_after"),
+    "min_norm": Setting(Real(0.0, 1.0), "smallest part of a trial orthogonal to the basis, relative to its norm",
+                        "[optimiser] min_norm"),
+    "max_overlap": Setting(Real(0.0, 1.0, hi_closed=True), "largest normalised overlap of a trial with a function",
+                           "[optimiser] max_overlap"),
+    "threshold": Setting(Real(0.0, 1.0), "relative overlap eigenvalue below which directions are dropped",
+                         "[optimiser] threshold"),
+}
+
+
+def check(name: str, value, label: str | None = None):
+    """`value` of setting `name`, normalised (ints, floats, a tuple for length_range); InputError
+    naming `label` (default: the name), the value and what is allowed."""
+    s = SETTINGS[name]
+    try:
+        return s.rule(value)
+    except (Refused, TypeError, ValueError):
+        raise InputError(f"{label or name} = {value!r}: must be {s.rule.allowed} ({s.meaning})") from None
+
+
+@strict_keywords
+@dataclass
+class Optimiser:
+    """Settings of `optimise` (TOML table [optimiser]; `size`, `c_A`, `kind`, `K_max` from [basis]).
+    Checked on construction (InputError naming the setting, the value and what is allowed).
+
+    Basis: size — functions to grow to (≤ MAX_SIZE, what memory allows); kind — the basis
+    family ("pecg", "ecg-gvr", "fecg"); c_A — exponent of the CM coordinate in bohr⁻², shared by
+    every function (> 0); K_max — largest power K of an ECG-GVR function (0..60).
+    Sampling: trials — competitive trials per step; seed — of the random numbers; channels —
+    "pairs", "all" or a list of coordinate-set names the functions are drawn in; length_range —
+    [lo, hi] of the drawn lengths in bohr, scaled per pair; learned — share of trials from the
+    learned per-channel distributions (0..1); learn_after — functions of a channel before its
+    distribution is learned.
+    Schedule (methods.py): sweeps — replacement sweeps per cycle; refine — refinement sweeps per
+    cycle (and refinement of every grown or replacing function when > 0); refine_evaluations —
+    energies per refinement of one function; refine_method — "gradient" (L-BFGS, exact
+    gradients) or "powell"; polish — joint L-BFGS steps per cycle; polish_iterations — iterations
+    per joint step; cycles — repetitions of the sweep-refine-polish block.
+    Linear dependence: min_norm — smallest part of a trial orthogonal to the basis, relative to
+    its norm; max_overlap — largest normalised overlap of a trial with a function; threshold —
+    relative overlap eigenvalue below which eigen.solve drops directions.
+    """
+
+    size: int = 50
+    trials: int = 20
+    sweeps: int = 0
+    seed: int = 1
+    channels: str | list = "pairs"
+    length_range: tuple = (0.01, 15.0)
+    c_A: float = 1.0
+    kind: str = "pecg"
+    K_max: int = 0
+    refine: int = 0
+    refine_evaluations: int = 200
+    refine_method: str = "gradient"
+    polish: int = 0
+    polish_iterations: int = 20
+    cycles: int = 1
+    learned: float = 0.5
+    learn_after: int = 5
+    min_norm: float = 1e-8
+    max_overlap: float = 0.99
+    threshold: float = 1e-13
+
+    def to_dict(self) -> dict:
+        """The settings as a JSON-ready mapping (a checkpoint's "optimiser")."""
+        return vars(self) | {"length_range": list(self.length_range)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Optimiser":
+        """The settings of a mapping (`to_dict`'s); InputError for anything unknown or out of range."""
+        if not isinstance(d, dict):
+            raise InputError(f"optimiser settings must be a table, got {d!r}")
+        return cls(**d)
+
+    def __post_init__(self):
+        for f in fields(self):
+            setattr(self, f.name, check(f.name, getattr(self, f.name), f"Optimiser {f.name}"))
