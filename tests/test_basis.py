@@ -39,3 +39,23 @@ def test_basis_knows_its_family_and_keeps_its_kind():
     b = Basis(s, np.eye(2)[None], [1.0], kind="ecg-gvr", u=[[1.0, -1.0]], K=[2])
     assert b.family is family("ecg-gvr") and b.kind == "ecg-gvr"
     assert b.K.dtype == np.uint32 and set(b.parameters) == {"u", "K"}
+
+
+def test_no_module_outside_the_basis_package_tests_the_family_name():
+    """Family behaviour is dispatched through the Family object: no comparison with a family's
+    name (`kind == "fecg"`, `kind in ("pecg", ...)`) anywhere in prebo outside prebo/basis/."""
+    import ast
+    from pathlib import Path
+
+    root = Path(prebo.__file__).parent
+    found = []
+    for path in root.rglob("*.py"):
+        if path.parent.name == "basis":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Compare):
+                names = {c.value for side in (node.left, *node.comparators) for c in ast.walk(side)
+                         if isinstance(c, ast.Constant)}
+                if names & set(FAMILIES):
+                    found.append(f"{path.relative_to(root)}:{node.lineno}")
+    assert not found

@@ -79,6 +79,16 @@ class Representation:
             raise ValueError("row gradients are computed in the laboratory frame")
         return self.engine(f).row_gradient(self.arrays(f), dA, dv, self.arrays(basis))
 
+    def operator(self, name: str, f, w: np.ndarray) -> np.ndarray:
+        """Symmetrised (p, nb, nb) matrices of the core's registered operator `name` between the
+        normalised functions of the basis `f` ("r2": r_w² = |Σ_k w_k r_k|², bohr²), one per
+        laboratory-frame vector w (p, n), transformed into this representation like the Coulomb
+        vectors (w' = (U^-T w)_{1..n-1} in TICC)."""
+        w = np.atleast_2d(np.asarray(w, dtype=float))
+        if self.coords is not None:
+            w = self.coords.transform_vectors_to_x(w)[:, :-1]
+        return self.engine(f).operator(name, self.arrays(f), np.ascontiguousarray(w))
+
     def plausible(self, rows: dict, diag: np.ndarray, S_basis: np.ndarray) -> np.ndarray:
         """Per trial, whether its elements pass the bounds exact integrals obey: 0 < S_nn ≤ Σ_P |c_P|,
         T_nn, T_ti,nn ≥ 0, |S_nj| ≤ (S_nn S_jj)^{1/2} (Cauchy–Schwarz). Integrals of extreme

@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _core
+
 
 class Family:
     """One basis family. Subclasses set the class attributes and override the hooks they need;
@@ -73,11 +75,11 @@ class Family:
         """The extras in the TICC of `coords` (SeparabilityError where they have a CM part)."""
         return extras
 
-    def engine(self, ops: tuple, N: int):
-        """The engine of this family for the representation's operators `ops` = (Λ, pair_w, pair_q,
-        sym_t, sym_c, cm_mass) and the state's N: `.matrices(params)`, `.rows(trials, basis,
-        position)`, `.row_gradient(f, dA, dv, basis)`, `.oriented`."""
-        raise NotImplementedError
+    def engine(self, ops: tuple, N: int) -> _core.Engine:
+        """The core's engine of this family for the representation's operators `ops` = (Λ, pair_w,
+        pair_q, sym_t, sym_c, cm_mass) and the state's N: `.matrices(params)`, `.rows(trials, basis,
+        position)`, `.row_gradient(f, dA, dv, basis)`, `.angular(params, mu)`, `.oriented`."""
+        return _core.Engine(self.name, *ops, N=N)
 
     # --- sampling ------------------------------------------------------------------
     def draw_power(self, rng, K_max: int, N: int) -> tuple[int, float]:

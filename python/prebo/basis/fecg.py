@@ -1,14 +1,13 @@
 """Floating ECGs ("fecg"): φ(r) = exp(-(r - s)^T (A ⊗ I_3)(r - s)), centres s (n x 3) per function.
 
 Not eigenfunctions of the angular momentum: they take any state label, and the results report
-the translation-free <N²> instead (`Engine.angular`). The sampler and refinement keep the CM
+the translation-free <N²> instead (the engine's `angular`). The sampler and refinement keep the CM
 centre μ^T s at 0, so the functions separate in the CM coordinate.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .. import _core
 from ..errors import BasisFileError, SeparabilityError
 from .family import Family
 
@@ -32,9 +31,6 @@ class FloatingECG(Family):
                                     "no translationally invariant evaluation (use --coordinates lab)")
         return (sx[:, :-1],)
 
-    def engine(self, ops: tuple, N: int) -> "Engine":
-        return Engine(ops)
-
     def drawn(self, system, u: np.ndarray, centres: np.ndarray, K: int) -> dict:
         return {"s": (centres - system.cm_vector @ centres)[None]}  # no CM component: μ^T s = 0
 
@@ -55,30 +51,6 @@ class FloatingECG(Family):
             for k in range(3):
                 ds[offset + 3 * a + k, :, k] = x.U_inv[:, a]
         return ds
-
-
-class Engine:
-    """The core's floating-ECG functions for one representation; rows at a position in full-build
-    orientation (`oriented`)."""
-
-    oriented = True
-
-    def __init__(self, ops: tuple):
-        self.ops = ops
-
-    def matrices(self, params: tuple) -> dict:
-        return _core.fecg_matrices(*params, *self.ops)
-
-    def rows(self, trials: tuple, basis: tuple, position: int | None = None) -> tuple[dict, np.ndarray]:
-        return _core.fecg_rows(*trials, *basis, *self.ops, position)
-
-    def row_gradient(self, f: tuple, dA: np.ndarray, ds: np.ndarray, basis: tuple) -> tuple[dict, np.ndarray]:
-        c = np.ascontiguousarray
-        return _core.fecg_row_gradient(*f, c(dA), c(ds), *basis, *self.ops)
-
-    def angular(self, params: tuple, mu: np.ndarray) -> np.ndarray:
-        """The symmetrised translation-free <N²> matrix (laboratory frame)."""
-        return _core.fecg_angular(*params, np.ascontiguousarray(mu), *self.ops[:5])
 
 
 FAMILY = FloatingECG()

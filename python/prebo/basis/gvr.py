@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _core
 from ..errors import InputError, SeparabilityError
 from .family import Family
 
@@ -48,9 +47,6 @@ class GlobalVectorECG(Family):
             raise SeparabilityError("a global vector has a CM component (c_U != 0): "
                                     "no translationally invariant evaluation (use --coordinates lab)")
         return ux[:, :-1], K
-
-    def engine(self, ops: tuple, N: int) -> "Engine":
-        return Engine(ops, N)
 
     # sampling: the drawn length of the coordinate carrying u is the peak of |v|^{2K+N} exp(-α v²)
     def draw_power(self, rng, K_max: int, N: int) -> tuple[int, float]:
@@ -93,26 +89,6 @@ class GlobalVectorECG(Family):
         for k in range(n - 1):
             dv[offset + k] = x.U.T @ ((np.eye(n)[k] - v * v[k]) / norm)
         return dv
-
-
-class Engine:
-    """The core's ECG-GVR functions for one representation and the state's N. Rows at a position
-    are evaluated in full-build orientation (`oriented`), so patched matrices have a rebuild's bits."""
-
-    oriented = True
-
-    def __init__(self, ops: tuple, N: int):
-        self.ops, self.N = ops, N
-
-    def matrices(self, params: tuple) -> dict:
-        return _core.gvr_matrices(*params, self.N, *self.ops)
-
-    def rows(self, trials: tuple, basis: tuple, position: int | None = None) -> tuple[dict, np.ndarray]:
-        return _core.gvr_rows(*trials, *basis, self.N, *self.ops, position)
-
-    def row_gradient(self, f: tuple, dA: np.ndarray, du: np.ndarray, basis: tuple) -> tuple[dict, np.ndarray]:
-        c = np.ascontiguousarray
-        return _core.gvr_row_gradient(*f, c(dA), c(du), *basis, self.N, *self.ops)
 
 
 FAMILY = GlobalVectorECG()
