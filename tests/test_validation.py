@@ -333,7 +333,7 @@ def test_python_3_10_is_supported():
     assert project["requires-python"] == ">=3.10"
     assert any(d.replace(" ", "").startswith("tomli>=") and "python_version<'3.11'" in d.replace(" ", "").replace('"', "'")
                for d in project["dependencies"])
-    for path in [*(ROOT / "python" / "prebo").glob("*.py"), *(ROOT / "tests").glob("*.py")]:
+    for path in [*(ROOT / "python" / "prebo").rglob("*.py"), *(ROOT / "tests").glob("*.py")]:
         ast.parse(path.read_text(), str(path), feature_version=(3, 10))
 
 

@@ -12,7 +12,7 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.cli`, `prebo.plot`: the command line and convergence plots.
 
 Hartree atomic units: energies in Eh, lengths in bohr, masses in m_e. The method is that of
-Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018).
+Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018).
 """
 from .basis import Basis
 from .coordinates import CoordinateSet, all_sets, cm_centred, heavy_particle_centred, jacobi

@@ -32,6 +32,8 @@ def _print_result(r: dict) -> None:
     from rich.console import Console
     from rich.table import Table
 
+    from .expectation import OPERATORS
+
     t = Table(show_header=False, box=None)
     t.add_row("energy (translation-free)", f"{r['energy']:.12f} Eh")
     t.add_row("numerical uncertainty", f"{r['energy_uncertainty']:.1e} Eh")
@@ -41,6 +43,10 @@ def _print_result(r: dict) -> None:
     t.add_row("basis", f"{r['n_basis']} {r['basis_type']} functions")
     t.add_row("particles", " ".join(p["name"] for p in r["particles"]))
     t.add_row("overlap condition", f"{r['overlap_condition']:.2e} ({r['kept']} kept)")
+    for name, values in r.get("expectation", {}).items():
+        op = OPERATORS[name]
+        for pair, value in values.items():
+            t.add_row(f"{name} {pair}", f"{value:.10g} {op.unit}")
     Console().print(t)
 
 
@@ -86,7 +92,7 @@ def cmd_run(args) -> int:
 def cmd_import(args) -> int:
     """`prebo import FILE.inout.txt [--out X.json] [--c-A C]`: an ecgpack basis as basis.json."""
     from .io.ecgpack import read_inout
-    from .validation import check
+    from .optimise.settings import check
 
     basis = read_inout(args.file, c_A=check("c_A", args.c_A, "--c-A"))
     out = Path(args.out or str(args.file).removesuffix(".txt").removesuffix(".inout") + ".json")

@@ -1,4 +1,4 @@
-"""Coordinate sets x = U_x r (Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018),
+"""Coordinate sets x = U_x r (Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018),
 sec. II; equation numbers below are that paper's).
 
 Every U_x is N_p x N_p and dimensionless: rows 1..N_p-1 are translationally invariant

@@ -1,8 +1,8 @@
 """Symmetrised overlap, kinetic and Coulomb matrices from the Rust core, in two representations.
 
 - `laboratory(system)`: LFCC, kinetic matrix M; the core returns T (with CM motion) and T_ti,
-  the CM kinetic energy eliminated through c_A (Muolo, Mátyus & Reiher, J. Chem. Phys. 149,
-  184105 (2018), Sec. IV.B-D, the translationally invariant kinetic energy of a CM-separable
+  the CM kinetic energy eliminated through c_A (Muolo, Mátyus & Reiher, J. Chem. Phys. 148,
+  084112 (2018), Sec. IV.B-D, the translationally invariant kinetic energy of a CM-separable
   function; crates/prebo-core/src/pecg.rs).
 - `laboratory(system, kinetic="internal")`: LFCC with M - 1 1^T/(2 m_tot), the CM
   kinetic operator removed exactly (an independent check of the elimination).
@@ -132,7 +132,7 @@ def translationally_invariant(system: System, coords: CoordinateSet | None = Non
     """The translationally invariant representation of `system` in the coordinate set `coords`
     (default: Jacobi in input order): kinetic matrix μ = U M U^T without the CM row, Coulomb
     vectors w' = (U^-T w)_{1..n-1}, operations 𝒯 = (U Π U^-1)_{TI} (Muolo, Mátyus & Reiher,
-    J. Chem. Phys. 149, 184105 (2018), Sec. II). Its matrices need one c_A shared by every function."""
+    J. Chem. Phys. 148, 084112 (2018), Sec. II). Its matrices need one c_A shared by every function."""
     coords = coords or jacobi(system.masses)
     coords.check(system.masses)
     w, q = system.coulomb_pairs()

@@ -6,8 +6,10 @@ module because it uses every earlier stage and none of them uses it.
 
 result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_uncertainty
 (Eh, below), energy_lab (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential,
-n_basis, basis_type, particles, state, symmetry, coordinates, overlap_condition, kept; for
-floating ECGs also n2 = <N²>_TI (their functions are not angular-momentum eigenfunctions).
+n_basis, basis_type, particles, state, symmetry, coordinates, overlap_condition, kept,
+expectation ({operator: {pair: value}} of every operator registered in `expectation.OPERATORS`,
+e.g. ⟨r_ij²⟩ in bohr²); for floating ECGs also n2 = <N²>_TI (their functions are not
+angular-momentum eigenfunctions).
 
 The energy is the lowest eigenvalue of the stored matrices refined in extended precision
 (`eigen.solve`), the same to ~1e-15 relative on every machine. energy_uncertainty is the standard
@@ -23,6 +25,7 @@ import numpy as np
 from . import eigen
 from .basis import Basis
 from .errors import InputError
+from .expectation import OPERATORS, expectation
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
 
 
@@ -30,7 +33,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
     """The energies of `basis`'s lowest state.
 
     Parameters: `basis`, a non-empty `Basis`; `coordinates`, "lab" (LFCC with the CM kinetic
-    energy eliminated, Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018)) or "ti"
+    energy eliminated, Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018)) or "ti"
     (translationally invariant coordinates, only for one c_A shared by every function);
     `threshold`, the relative overlap eigenvalue below which directions are dropped
     (`eigen.solve`).
@@ -44,12 +47,14 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
         raise InputError(f"evaluate: basis = {basis!r}: must be a prebo.Basis with at least one function")
     system = basis.system
     if coordinates == "lab":
-        m = laboratory(system).matrices(basis)
+        rep = laboratory(system)
+        m = rep.matrices(basis)
         lab = eigen.solve(m["T"] + m["V"], m["S"], threshold)
         energy_lab = float(lab.energies[0])
     elif coordinates == "ti":
         c_A = require_shared_c_A(basis.c_A)
-        m = translationally_invariant(system).matrices(basis)
+        rep = translationally_invariant(system)
+        m = rep.matrices(basis)
         energy_lab = None  # filled below: CM factor exp(-c_A X^2) common to all functions
     else:
         raise InputError(f"evaluate: coordinates = {coordinates!r}: must be 'lab' or 'ti'")
@@ -78,6 +83,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
         "symmetry": system.symmetriser.as_dict(),
         "coordinates": coordinates,
         "overlap_condition": ti.overlap_condition,
+        "expectation": {name: expectation(rep, basis, c, name) for name in OPERATORS},
         "kept": ti.kept,
         "coefficients": c,
     }

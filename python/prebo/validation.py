@@ -189,11 +189,3 @@ def half_integer(value, label: str) -> Fraction:
         raise InputError(f"{label} = {value!r}: must be a spin 0, 1/2, 1, 3/2, ... (a number)") from None
     return Fraction(round(2 * x), 2)
 
-
-def __getattr__(name: str):
-    """SETTINGS and check for the modules that still import them from here (until io/toml.py,
-    io/ecgpack.py and cli.py import them from prebo.optimise.settings, which builds on this module)."""
-    if name in ("SETTINGS", "check"):
-        from .optimise import settings
-        return getattr(settings, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

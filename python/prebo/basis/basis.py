@@ -3,7 +3,7 @@ coordinates (LFCC, docs/conventions.md).
 
 Every function has an exponent matrix A^(r) (n x n, symmetric positive definite, in bohr⁻²) with
 A^(r) 1 = c_A m/m_tot, so that it factors into a centre-of-mass Gaussian exp(-c_A R_cm²) times an
-internal part (Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018), Sec. IV, the
+internal part (Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018), Sec. IV, the
 elimination of the CM); A^(r) = U_x^T blockdiag(𝒜, c_A) U_x for the coordinate set ("channel") x
 it was generated in. Its family (`Basis.family`) adds its own arrays (u and K, or s).
 """

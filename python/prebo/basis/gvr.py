@@ -1,7 +1,7 @@
 """ECG-GVR functions ("ecg-gvr"): φ(r) = |v|^{2K} (v_x + i v_y)^N exp(-r^T (A ⊗ I_3) r), v = u^T r.
 
 A global vector u (n) and a power K per function, the state's N (Muolo, Mátyus & Reiher,
-J. Chem. Phys. 149, 184105 (2018), Sec. III.C; docs/gvr.md). The functions have
+J. Chem. Phys. 148, 084112 (2018), Sec. III.C; docs/gvr.md). The functions have
 natural parity (-1)^N. The normalised function does not depend on the length of u; refinement
 keeps |(u', c_U)| = 1 in its coordinate set.
 """

@@ -84,7 +84,7 @@ from ..errors import BasisFileError, PreboError, UnsupportedError
 from ..system import KNOWN, State, System, particle
 from ..system.symmetry import implied_spins
 from ..system.young import young_operator, young_product, young_string
-from ..validation import check
+from ..optimise.settings import check
 from .basis_json import read_text, write_atomic
 
 __all__ = ["read_inout", "write_inout", "parse_inout", "InoutFile"]

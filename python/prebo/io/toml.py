@@ -5,7 +5,7 @@
     [basis]      type = "pecg", size = 100, c_A = 1.0, K_max = 20     -> Optimiser.kind (a prebo.basis.family), .size, .c_A, .K_max
     [optimiser]  trials = 20, sweeps = 1, seed = 1, channels = "pairs", length_range = [0.01, 15]
 
-Every value is checked against validation.SETTINGS, the basis family against the state and the
+Every value is checked against optimise.settings.SETTINGS, the basis family against the state and the
 coordinate sets against the particles before anything runs; errors name the file and the key.
 """
 from __future__ import annotations
@@ -23,7 +23,7 @@ from ..basis import family
 from ..errors import InputError
 from ..optimise import Optimiser, coordinate_sets
 from ..system import State, System
-from ..validation import SETTINGS, check
+from ..optimise.settings import SETTINGS, check
 from .basis_json import read_text
 
 #: [basis] key -> Optimiser setting; [optimiser] takes every other setting

@@ -2,7 +2,7 @@
 
 A function generated in coordinate set x is parametrised in x: θ = (ln diag L, strict lower L,
 tail) with 𝒜^(x) = L L^T (positive definite for every θ) and A^(r) = U_x^T blockdiag(𝒜, c_A) U_x
-(Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018), Sec. IV: the transformation of
+(Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018), Sec. IV: the transformation of
 exponents between coordinate sets); c_A stays fixed. The tail is the family's
 (Family.theta_tail): for ECG-GVR u' with u^(r) = U_x^T v/|v|, v = (u', c_U) (the normalised
 function does not depend on the length of u, which is kept at 1; c_U and K fixed), for floating

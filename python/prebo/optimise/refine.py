@@ -1,5 +1,5 @@
 """Local refinement of one basis function with all others fixed (the paper's Powell step: Muolo,
-Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018), Sec. IV.E).
+Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018), Sec. IV.E).
 
 The function moves in its parameters θ (parametrisation.py). The energy of a trial θ is the
 lowest root of the secular equation (eigen.lowest_with_added) against the basis without the

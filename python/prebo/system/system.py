@@ -1,7 +1,7 @@
 """A Coulomb system: particles, the state sought, and the groups of identical particles.
 
 Hartree atomic units throughout: masses in m_e, charges in e, spins and N in ħ, energies in Eh.
-Equation numbers refer to Muolo, Mátyus & Reiher, J. Chem. Phys. 149, 184105 (2018).
+Equation numbers refer to Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018).
 """
 from __future__ import annotations
 
