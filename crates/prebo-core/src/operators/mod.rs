@@ -10,6 +10,8 @@ use crate::error::{CoreError, Result};
 use crate::family::Family;
 use crate::plain::PlainEcg;
 
+pub mod r2;
+
 /// `<phi_I| O(w) |phi_J>` for normalised functions of family `F` and one operator vector `w`
 /// (in the representation's coordinates, like the Coulomb vectors).
 pub type ElementFn<const D: usize, F> = fn(
@@ -21,7 +23,7 @@ pub type ElementFn<const D: usize, F> = fn(
 
 /// The registered operators: name and element function.
 fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, ElementFn<D, F>)> {
-    vec![]
+    vec![(r2::NAME, r2::element::<D, F>)]
 }
 
 /// The names of the registered operators.
