@@ -9,7 +9,7 @@ waits up to --wait-idle seconds for a 90 % idle machine and reports the idle sha
 Each measurement runs in a fresh subprocess with RAYON_NUM_THREADS set (rayon's pool
 is fixed when it starts) and times what prebo.evaluate uses: the laboratory-frame
 representation's `matrices` call (prebo.integrals.laboratory(system).matrices(basis):
-S, T, T_TI and V of the symmetrised basis through prebo._core.matrices, from the basis
+S, T, T_TI and V of the symmetrised basis through prebo._core.Engine.matrices, from the basis
 object to the four numpy arrays; freeing them afterwards is not timed), best of
 `--repeat` after one warm-up. `--representation ti` times the translationally invariant
 (Jacobi) representation instead. Speed is in matrix elements per second, ecgpack's

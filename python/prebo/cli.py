@@ -10,16 +10,19 @@ import time
 from pathlib import Path
 
 from .errors import NonFiniteError, OutputError, PreboError
+from .expectation import OPERATORS
 
 
-def _result(basis, where, coordinates: str = "lab") -> dict:
-    """The JSON-ready result of `basis`; NonFiniteError naming the keys that are not finite
-    numbers, and every error prefixed with `where` (the basis file)."""
+def _result(basis, where, coordinates: str = "lab", operators=()) -> dict:
+    """The JSON-ready result of `basis` (with the expectation values of `operators`); NonFiniteError
+    naming the keys that are not finite numbers, and every error prefixed with `where` (the basis file)."""
     from .results import evaluate, public
 
     try:
-        r = public(evaluate(basis, coordinates=coordinates))
-        bad = [f"{k} = {v}" for k, v in r.items() if isinstance(v, float) and not math.isfinite(v)]
+        r = public(evaluate(basis, coordinates=coordinates, operators=operators))
+        flat = r | {f"{name} {pair}": v for name, values in r.get("expectation", {}).items()
+                    for pair, v in values.items()}
+        bad = [f"{k} = {v}" for k, v in flat.items() if isinstance(v, float) and not math.isfinite(v)]
         if bad:
             raise NonFiniteError(f"the result is not finite ({', '.join(bad)}): the basis's integrals "
                                  "overflow or lost their digits")
@@ -31,8 +34,6 @@ def _result(basis, where, coordinates: str = "lab") -> dict:
 def _print_result(r: dict) -> None:
     from rich.console import Console
     from rich.table import Table
-
-    from .expectation import OPERATORS
 
     t = Table(show_header=False, box=None)
     t.add_row("energy (translation-free)", f"{r['energy']:.12f} Eh")
@@ -136,9 +137,10 @@ def load_basis(path):
 
 
 def cmd_energy(args) -> int:
-    """`prebo energy BASIS [--coordinates lab|ti] [--json]`: re-evaluate a stored basis (Eh)."""
+    """`prebo energy BASIS [--coordinates lab|ti] [--operator NAME ...] [--json]`: re-evaluate a
+    stored basis (Eh), with the expectation values of registered operators."""
     basis = load_basis(args.basis)
-    r = _result(basis, args.basis, args.coordinates)
+    r = _result(basis, args.basis, args.coordinates, args.operator)
     if args.json:
         print(json.dumps(r, allow_nan=False))
     else:
@@ -168,6 +170,10 @@ def parser() -> argparse.ArgumentParser:
     en.add_argument("basis", help="basis.json, or an ecgpack FILE.inout.txt")
     en.add_argument("--coordinates", choices=["lab", "ti"], default="lab",
                     help="lab: LFCC with CM elimination (default); ti: translationally invariant (shared c_A only)")
+    en.add_argument("--operator", action="append", default=[], choices=list(OPERATORS),
+                    help="add the expectation value of a registered operator, per class of equivalent "
+                         "particle pairs (repeatable): " + "; ".join(f"{k}: {op.meaning} ({op.unit})"
+                                                                     for k, op in OPERATORS.items()))
     en.add_argument("--json", action="store_true", help="print one JSON object")
     en.set_defaults(func=cmd_energy)
     im = sub.add_parser("import", help="convert an ecgpack / ATOM-MOL-nonBO FILE.inout.txt to basis.json")

@@ -1,13 +1,17 @@
 """Expectation values ⟨Ψ|O|Ψ⟩ of the registered operators: the Python end of the operator axis.
 
 An operator registered here is evaluated for every basis family by the core's generic path
-(`prebo._core.Engine.operator`, crates/prebo-core/src/operators/), symmetrised like the overlap,
-in the laboratory frame or in translationally invariant coordinates. `results.evaluate` reports
-every registered operator for the state it solved, so a new operator is one core module plus one
-registration line per layer (docs/architecture.md, "Add an operator").
+(`prebo._core.Engine.operator`, crates/prebo-core/src/operators/), in the laboratory frame or in
+translationally invariant coordinates; `results.evaluate(basis, operators=...)` and
+`prebo energy --operator NAME` report it for the state they solve. A new operator is one core
+module plus one registration line per layer (docs/architecture.md, "Add an operator").
 
-Pair operators act on r_w = Σ_k w_k r_k with w = e_i − e_j, i.e. on the inter-particle vector
-r_ij = r_i − r_j, one value per pair i < j (hartree atomic units: lengths in bohr).
+Pair operators act on r_w = Σ_k w_k r_k with w = e_i − e_j, the inter-particle vector
+r_ij = r_i − r_j (hartree atomic units: lengths in bohr). The core symmetrises a matrix like the
+overlap, Σ_P c_P ⟨φ_I|O|Pφ_J⟩, which is ⟨Yφ_I|O|Yφ_J⟩ only for an O that commutes with the
+permutations of identical particles. A single r_ij² does not when particle i or j has an identical
+partner, and is not an observable then; its average over the class of equivalent pairs (all pairs
+of the same two particle names) does commute, and is what is reported, one value per class.
 """
 from __future__ import annotations
 
@@ -20,7 +24,7 @@ from .errors import InputError
 
 @dataclass(frozen=True)
 class PairOperator:
-    """An operator of the inter-particle vectors, one expectation value per pair i < j.
+    """An operator of the inter-particle vectors, one expectation value per class of equivalent pairs.
 
     name: the core's operator name; unit: of its expectation value; meaning: one line for reports."""
 
@@ -29,31 +33,40 @@ class PairOperator:
     meaning: str
 
     @staticmethod
-    def pairs(system) -> tuple[list[str], np.ndarray]:
-        """Pair labels "i-j" (1-based, particle names in brackets) and LFCC vectors w = e_i − e_j (p, n)."""
-        labels, w = [], []
+    def classes(system) -> dict[str, np.ndarray]:
+        """{"a-b": LFCC vectors w = e_i − e_j (p, n) of every pair i < j of a particle named a and
+        one named b}, in the order the pairs first occur."""
+        out: dict[str, list] = {}
         for i in range(system.n):
             for j in range(i + 1, system.n):
+                names = sorted((system.particles[i].name, system.particles[j].name))
                 e = np.zeros(system.n)
                 e[i], e[j] = 1.0, -1.0
-                names = system.particles[i].name, system.particles[j].name
-                labels.append(f"{i + 1}-{j + 1} ({names[0]},{names[1]})")
-                w.append(e)
-        return labels, np.array(w).reshape(len(labels), system.n)
+                out.setdefault("-".join(names), []).append(e)
+        return {label: np.array(w) for label, w in out.items()}
 
 
 OPERATORS: dict[str, PairOperator] = {
 }
 
 
+def operator(name: str) -> PairOperator:
+    """The registered operator `name`; InputError naming the registered ones otherwise."""
+    if name not in OPERATORS:
+        raise InputError(f"unknown operator {name!r}: registered are {', '.join(OPERATORS)}")
+    return OPERATORS[name]
+
+
 def expectation(rep, basis, c: np.ndarray, name: str) -> dict[str, float]:
-    """⟨Ψ|O|Ψ⟩ of the registered operator `name` for Ψ = Σ_k c_k φ_k with cᵀSc = 1.
+    """⟨Ψ|O|Ψ⟩ of the registered operator `name` for Ψ = Σ_k c_k Yφ_k with cᵀSc = 1.
 
     rep: the representation (integrals.laboratory or translationally_invariant) whose matrices gave
-    c; basis: a prebo.Basis; returns {pair label: value in the operator's unit}."""
-    if name not in OPERATORS:
-        raise InputError(f"unknown operator {name!r}: known are {', '.join(OPERATORS)}")
-    op = OPERATORS[name]
-    labels, w = op.pairs(basis.system)
-    O = rep.operator(op.name, basis, w)
-    return {label: float(c @ O[k] @ c) for k, label in enumerate(labels)}
+    c; basis: a prebo.Basis. Returns {pair class "a-b": the class average, in the operator's unit}."""
+    op = operator(name)
+    classes = op.classes(basis.system)
+    O = rep.operator(op.name, basis, np.concatenate(list(classes.values())))
+    values, k = {}, 0
+    for label, w in classes.items():
+        values[label] = float(np.mean([c @ O[k + m] @ c for m in range(len(w))]))
+        k += len(w)
+    return values

@@ -6,10 +6,10 @@ module because it uses every earlier stage and none of them uses it.
 
 result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_uncertainty
 (Eh, below), energy_lab (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential,
-n_basis, basis_type, particles, state, symmetry, coordinates, overlap_condition, kept,
-expectation ({operator: {pair: value}} of every operator registered in `expectation.OPERATORS`,
-e.g. ⟨r_ij²⟩ in bohr²); for floating ECGs also n2 = <N²>_TI (their functions are not
-angular-momentum eigenfunctions).
+n_basis, basis_type, particles, state, symmetry, coordinates, overlap_condition, kept; with
+`operators`, expectation ({operator: {pair class: value}} of operators registered in
+`expectation.OPERATORS`, e.g. ⟨r_ij²⟩ in bohr²); for floating ECGs also n2 = <N²>_TI (their
+functions are not angular-momentum eigenfunctions).
 
 The energy is the lowest eigenvalue of the stored matrices refined in extended precision
 (`eigen.solve`), the same to ~1e-15 relative on every machine. energy_uncertainty is the standard
@@ -25,26 +25,30 @@ import numpy as np
 from . import eigen
 from .basis import Basis
 from .errors import InputError
-from .expectation import OPERATORS, expectation
+from .expectation import expectation, operator
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
 
 
-def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -> dict:
+def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13, operators=()) -> dict:
     """The energies of `basis`'s lowest state.
 
     Parameters: `basis`, a non-empty `Basis`; `coordinates`, "lab" (LFCC with the CM kinetic
     energy eliminated, Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018)) or "ti"
     (translationally invariant coordinates, only for one c_A shared by every function);
     `threshold`, the relative overlap eigenvalue below which directions are dropped
-    (`eigen.solve`).
+    (`eigen.solve`); `operators`, names of registered operators (`expectation.OPERATORS`, e.g.
+    "r2") whose expectation values to add.
 
     Returns a dict with the keys of the module docstring — energy, energy_uncertainty,
     energy_lab, kinetic and potential in Eh; virial, overlap_condition dimensionless; n2
-    in ħ² — and `coefficients`, the S-normalised ground-state vector. InputError for a
-    basis that is not a non-empty `Basis` or an unknown `coordinates`; NonFiniteError and
-    the eigen errors as `eigen.solve` raises them."""
+    in ħ²; expectation in each operator's unit — and `coefficients`, the S-normalised
+    ground-state vector. InputError for a basis that is not a non-empty `Basis`, an unknown
+    `coordinates` or operator; NonFiniteError and the eigen errors as `eigen.solve` raises them."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"evaluate: basis = {basis!r}: must be a prebo.Basis with at least one function")
+    operators = (operators,) if isinstance(operators, str) else tuple(operators)
+    for name in operators:
+        operator(name)
     system = basis.system
     if coordinates == "lab":
         rep = laboratory(system)
@@ -69,6 +73,8 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
     if not basis.family.conserves_L:  # not an angular-momentum eigenfunction: report <N²>_TI
         n2 = laboratory(system).angular(basis, system.cm_vector)
         extra["n2"] = float(c @ n2 @ c)
+    if operators:
+        extra["expectation"] = {name: expectation(rep, basis, c, name) for name in operators}
     return extra | {
         "energy": energy,
         "energy_uncertainty": uncertainty,
@@ -83,7 +89,6 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13) -
         "symmetry": system.symmetriser.as_dict(),
         "coordinates": coordinates,
         "overlap_condition": ti.overlap_condition,
-        "expectation": {name: expectation(rep, basis, c, name) for name in OPERATORS},
         "kept": ti.kept,
         "coefficients": c,
     }

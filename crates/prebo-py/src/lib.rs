@@ -3,7 +3,6 @@
 //! arrays are converted once (`convert`), the GIL is released around every build, and core
 //! errors map to `prebo.errors` through one `From`.
 mod convert;
-mod legacy;
 
 use convert::{blocks, dict, floats, floats_shaped, matrix, OwnedParams, Result, Rows, ShapeError};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
@@ -226,5 +225,5 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add("MAX_DIM", engine::MAX_DIM)?;
     m.add("OPERATORS", prebo_core::operators::names())?;
-    legacy::register(m)
+    Ok(())
 }
