@@ -47,6 +47,7 @@ class PairOperator:
 
 
 OPERATORS: dict[str, PairOperator] = {
+    "r2": PairOperator("r2", "bohr²", "⟨r_ij²⟩, the mean square distance of particles i and j"),
 }
 
 
