@@ -1,3 +1,4 @@
+"""`python -m prebo`: the command line (prebo.cli.main)."""
 import sys
 
 from .cli import main
