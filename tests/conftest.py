@@ -3,8 +3,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import prebo
-from prebo.io.toml import tomllib  # tomli before Python 3.11
+pytest.register_assert_rewrite("gvr_reference", "fecg_reference")  # helper modules' asserts explained
+
+import prebo  # noqa: E402
+from prebo.io.toml import tomllib  # noqa: E402  (tomli before Python 3.11)
 
 ROOT = Path(__file__).resolve().parents[1]
 
