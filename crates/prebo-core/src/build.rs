@@ -9,31 +9,38 @@
 //! computed by a function compiled for the best instruction set the CPU has (AVX-512:
 //! `W = 8`, AVX2: `W = 4`, otherwise plain x86-64 / other targets: `W = 4`), chosen
 //! once per build. All of them give the same bits (see `pecg`).
+//!
+//! Element `(i, j)`, `i <= j`, of a full build has function `i` as bra and the images of `j` as
+//! kets. Rows of a trial that will sit at `position` keep that orientation: before it, `W` basis
+//! functions in lanes are the bras of the trial's images (`col`); after it, the trial is the bra
+//! (`row`). Patched into the matrices they give the bits of a full build.
 use rayon::prelude::*;
 
 use crate::ecg::{Element, Gaussian, Operators};
 use crate::images::Images;
 use crate::matrices::Matrices;
-use crate::pecg::{self, Accumulator, Bra, KetLanes, Prepared};
+use crate::pecg::{self, bra_lanes, Accumulator, Bra, Ket, KetLanes, Prepared};
 
 /// Plain ECGs with their images under every symmetry operation.
 pub type Symmetrised<const D: usize> = Images<Gaussian<D>>;
 
-/// The kets of a build: every image of every function in blocks of `W`, and the coefficients.
+/// The kets of a build: every image of the functions from block `first` on in blocks of `W`,
+/// and the coefficients.
 struct Kets<const D: usize, const W: usize> {
-    /// `blocks[c * n_ops + p]`: functions `c W .. c W + W - 1` under operation `p`
+    /// `blocks[(c - first) * n_ops + p]`: functions `c W .. c W + W - 1` under operation `p`
     blocks: Vec<KetLanes<D, W>>,
     coef: Vec<f64>,
+    first: usize,
     n_blocks: usize,
 }
 
 impl<const D: usize, const W: usize> Kets<D, W> {
-    fn new(basis: &Symmetrised<D>) -> Self {
+    fn new(basis: &Symmetrised<D>, first: usize) -> Self {
         let nb = basis.len();
         let n_ops = basis.coef.len();
         let n_blocks = nb.div_ceil(W);
-        let mut blocks = Vec::with_capacity(n_blocks * n_ops);
-        for c in 0..n_blocks {
+        let mut blocks = Vec::with_capacity(n_blocks.saturating_sub(first) * n_ops);
+        for c in first..n_blocks {
             for p in 0..n_ops {
                 let kets: Vec<&Gaussian<D>> = (c * W..((c + 1) * W).min(nb)).map(|j| &basis.images[j][p]).collect();
                 blocks.push(KetLanes::from_gaussians(&kets));
@@ -42,6 +49,7 @@ impl<const D: usize, const W: usize> Kets<D, W> {
         Self {
             blocks,
             coef: basis.coef.clone(),
+            first,
             n_blocks,
         }
     }
@@ -50,6 +58,18 @@ impl<const D: usize, const W: usize> Kets<D, W> {
 /// One row: the symmetrised elements of `bra` against ket blocks `first..first + out.len()`.
 type RowFn<const D: usize, const W: usize> =
     unsafe fn(&Kets<D, W>, &Prepared<D>, &Bra<D>, usize, &mut [Accumulator<W>]);
+
+/// One column: the symmetrised elements of bra blocks `first..first + out.len()` against one
+/// ket's images (with their coefficients).
+type ColFn<const D: usize, const W: usize> =
+    unsafe fn(&[Bra<D, [f64; W]>], &[Ket<D>], &[f64], &Prepared<D>, usize, &mut [Accumulator<W>]);
+
+/// The kernels of one instruction set.
+#[derive(Clone, Copy)]
+struct Kernels<const D: usize, const W: usize> {
+    row: RowFn<D, W>,
+    col: ColFn<D, W>,
+}
 
 #[inline(always)]
 fn row_generic<const D: usize, const W: usize>(
@@ -61,7 +81,7 @@ fn row_generic<const D: usize, const W: usize>(
 ) {
     let n_ops = kets.coef.len();
     for (k, acc) in out.iter_mut().enumerate() {
-        let base = (first + k) * n_ops;
+        let base = (first + k - kets.first) * n_ops;
         let mut a = Accumulator::<W>::default();
         let cm = pecg::cm_terms(bra, &kets.blocks[base], ops);
         for (p, coef) in kets.coef.iter().enumerate() {
@@ -71,40 +91,70 @@ fn row_generic<const D: usize, const W: usize>(
     }
 }
 
-/// Safety: callers must pass only to a CPU with the feature (checked in `dispatch`).
-unsafe fn row_plain<const D: usize, const W: usize>(
-    kets: &Kets<D, W>,
+/// `row_generic` mirrored: the bras in lanes, the ket's images one at a time, in the same order.
+#[inline(always)]
+fn col_generic<const D: usize, const W: usize>(
+    bras: &[Bra<D, [f64; W]>],
+    images: &[Ket<D>],
+    coef: &[f64],
     ops: &Prepared<D>,
-    bra: &Bra<D>,
     first: usize,
     out: &mut [Accumulator<W>],
 ) {
-    row_generic::<D, W>(kets, ops, bra, first, out)
+    for (k, acc) in out.iter_mut().enumerate() {
+        let bra = &bras[first + k];
+        let mut a = Accumulator::<W>::default();
+        let cm = pecg::cm_terms(bra, &images[0], ops);
+        for (ket, c) in images.iter().zip(coef) {
+            pecg::lanes::<D, W>(bra, ket, ops, &cm, *c, &mut a);
+        }
+        *acc = a;
+    }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn row_avx2<const D: usize>(
-    kets: &Kets<D, 4>,
-    ops: &Prepared<D>,
-    bra: &Bra<D>,
-    first: usize,
-    out: &mut [Accumulator<4>],
-) {
-    row_generic::<D, 4>(kets, ops, bra, first, out)
+/// The kernels compiled for one instruction set (lanes `W`, target feature), in module `$isa`.
+macro_rules! isa_kernels {
+    ($isa:ident, $w:literal $(, $feature:literal)?) => {
+        mod $isa {
+            use super::*;
+
+            /// Safety: callers must pass only to a CPU with the feature (checked in `dispatch`).
+            $(#[target_feature(enable = $feature)])?
+            unsafe fn row<const D: usize>(
+                kets: &Kets<D, $w>,
+                ops: &Prepared<D>,
+                bra: &Bra<D>,
+                first: usize,
+                out: &mut [Accumulator<$w>],
+            ) {
+                row_generic::<D, $w>(kets, ops, bra, first, out)
+            }
+
+            /// Safety: as `row`.
+            $(#[target_feature(enable = $feature)])?
+            unsafe fn col<const D: usize>(
+                bras: &[Bra<D, [f64; $w]>],
+                images: &[Ket<D>],
+                coef: &[f64],
+                ops: &Prepared<D>,
+                first: usize,
+                out: &mut [Accumulator<$w>],
+            ) {
+                col_generic::<D, $w>(bras, images, coef, ops, first, out)
+            }
+
+            pub(super) fn kernels<const D: usize>() -> Kernels<D, $w> {
+                Kernels { row: row::<D>, col: col::<D> }
+            }
+        }
+    };
 }
 
+isa_kernels!(plain, 4);
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn row_avx512<const D: usize>(
-    kets: &Kets<D, 8>,
-    ops: &Prepared<D>,
-    bra: &Bra<D>,
-    first: usize,
-    out: &mut [Accumulator<8>],
-) {
-    row_generic::<D, 8>(kets, ops, bra, first, out)
-}
+isa_kernels!(avx2, 4, "avx2");
+#[cfg(target_arch = "x86_64")]
+isa_kernels!(avx512, 8, "avx512f");
 
 /// The instruction sets a build can use, best first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -134,10 +184,10 @@ macro_rules! dispatch {
     ($isa:expr, $f:ident :: <$d:ident> ( $($arg:expr),* )) => {{
         match $isa {
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => $f::<$d, 8>($($arg,)* row_avx512::<$d>),
+            Isa::Avx512 => $f::<$d, 8>($($arg,)* avx512::kernels::<$d>()),
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => $f::<$d, 4>($($arg,)* row_avx2::<$d>),
-            _ => $f::<$d, 4>($($arg,)* row_plain::<$d, 4>),
+            Isa::Avx2 => $f::<$d, 4>($($arg,)* avx2::kernels::<$d>()),
+            _ => $f::<$d, 4>($($arg,)* plain::kernels::<$d>()),
         }
     }};
 }
@@ -168,7 +218,7 @@ fn isa_available(isa: Isa) -> bool {
 fn matrices_w<const D: usize, const W: usize>(
     basis: &Symmetrised<D>,
     ops: &Operators<D>,
-    row: RowFn<D, W>,
+    kernels: Kernels<D, W>,
 ) -> Matrices {
     let nb = basis.len();
     let mut m = Matrices::zeros(nb, nb);
@@ -176,7 +226,7 @@ fn matrices_w<const D: usize, const W: usize>(
         return m;
     }
     let prep = Prepared::new(ops);
-    let kets = Kets::<D, W>::new(basis);
+    let kets = Kets::<D, W>::new(basis, 0);
     let (s, t, t_ti, v) = (&mut m.s, &mut m.t, &mut m.t_ti, &mut m.v);
     s.par_chunks_mut(nb)
         .zip(t.par_chunks_mut(nb))
@@ -188,8 +238,8 @@ fn matrices_w<const D: usize, const W: usize>(
             let bra = Bra::new(&basis.functions[i], &prep);
             let first = i / W;
             let mut acc = vec![Accumulator::<W>::default(); kets.n_blocks - first];
-            // Safety: `row` was chosen for an instruction set this CPU has.
-            unsafe { row(&kets, &prep, &bra, first, &mut acc) };
+            // Safety: the kernels were chosen for an instruction set this CPU has.
+            unsafe { (kernels.row)(&kets, &prep, &bra, first, &mut acc) };
             for (k, a) in acc.iter().enumerate() {
                 let j0 = (first + k) * W;
                 for l in 0..W {
@@ -252,13 +302,17 @@ fn mirror_upper(m: &mut Matrices) {
     });
 }
 
-/// Rows of trial functions against a basis, and each trial's symmetrised diagonal element.
+
+/// Rows of trial functions against a basis for a trial that will sit at `position` (`None`:
+/// appended), oriented as in a full build (module docstring), and each trial's symmetrised
+/// diagonal element.
 pub fn rows<const D: usize>(
     trials: &Symmetrised<D>,
     basis: &Symmetrised<D>,
     ops: &Operators<D>,
+    position: Option<usize>,
 ) -> (Matrices, Vec<Element>) {
-    rows_with(trials, basis, ops, best_isa())
+    rows_with(trials, basis, ops, position, best_isa())
 }
 
 /// `rows` with a chosen instruction set (falls back to plain code where unavailable).
@@ -266,34 +320,54 @@ pub fn rows_with<const D: usize>(
     trials: &Symmetrised<D>,
     basis: &Symmetrised<D>,
     ops: &Operators<D>,
+    position: Option<usize>,
     isa: Isa,
 ) -> (Matrices, Vec<Element>) {
     let isa = if isa_available(isa) { isa } else { Isa::Plain };
-    dispatch!(isa, rows_w::<D>(trials, basis, ops))
+    let pos = position.unwrap_or(basis.len()).min(basis.len());
+    dispatch!(isa, rows_w::<D>(trials, basis, ops, pos))
 }
 
 fn rows_w<const D: usize, const W: usize>(
     trials: &Symmetrised<D>,
     basis: &Symmetrised<D>,
     ops: &Operators<D>,
-    row: RowFn<D, W>,
+    pos: usize,
+    kernels: Kernels<D, W>,
 ) -> (Matrices, Vec<Element>) {
-    /// ket blocks per task: rows are split so that a few trials still use every thread
+    /// blocks per task: rows are split so that a few trials still use every thread
     const SPAN: usize = 16;
     let (k, nb) = (trials.len(), basis.len());
     let prep = Prepared::new(ops);
-    let kets = Kets::<D, W>::new(basis);
-    let own = Kets::<D, W>::new(trials);
-    let bras: Vec<Bra<D>> = trials.functions.iter().map(|f| Bra::new(f, &prep)).collect();
-    let spans = kets.n_blocks.div_ceil(SPAN);
-    let parts: Vec<Vec<Accumulator<W>>> = (0..k * spans)
+    // j < pos: basis functions as bras (blocks of W) against the trial's images
+    let below: Vec<Bra<D>> = basis.functions[..pos].iter().map(|f| Bra::new(f, &prep)).collect();
+    let bras: Vec<Bra<D, [f64; W]>> = below.chunks(W).map(bra_lanes).collect();
+    let images: Vec<Vec<Ket<D>>> = trials.images.iter().map(|im| im.iter().map(Ket::new).collect()).collect();
+    // j >= pos: the trial as bra against the images of the basis functions
+    let kets = Kets::<D, W>::new(basis, pos / W);
+    let own = Kets::<D, W>::new(trials, 0);
+    let trial_bras: Vec<Bra<D>> = trials.functions.iter().map(|f| Bra::new(f, &prep)).collect();
+    // tasks per trial: (mirrored, first block, blocks)
+    let mut spans = Vec::new();
+    for c in (0..bras.len()).step_by(SPAN) {
+        spans.push((true, c, (bras.len() - c).min(SPAN)));
+    }
+    for c in (pos / W..kets.n_blocks).step_by(SPAN) {
+        spans.push((false, c, (kets.n_blocks - c).min(SPAN)));
+    }
+    let parts: Vec<Vec<Accumulator<W>>> = (0..k * spans.len())
         .into_par_iter()
         .map(|task| {
-            let (i, c) = (task / spans.max(1), task % spans.max(1));
-            let first = c * SPAN;
-            let mut acc = vec![Accumulator::<W>::default(); (kets.n_blocks - first).min(SPAN)];
-            // Safety: `row` was chosen for an instruction set this CPU has.
-            unsafe { row(&kets, &prep, &bras[i], first, &mut acc) };
+            let (i, (col, first, count)) = (task / spans.len(), spans[task % spans.len()]);
+            let mut acc = vec![Accumulator::<W>::default(); count];
+            // Safety: the kernels were chosen for an instruction set this CPU has.
+            unsafe {
+                if col {
+                    (kernels.col)(&bras, &images[i], &trials.coef, &prep, first, &mut acc)
+                } else {
+                    (kernels.row)(&kets, &prep, &trial_bras[i], first, &mut acc)
+                }
+            }
             acc
         })
         .collect();
@@ -302,33 +376,18 @@ fn rows_w<const D: usize, const W: usize>(
         .map(|i| {
             let mut acc = [Accumulator::<W>::default()];
             // Safety: as above.
-            unsafe { row(&own, &prep, &bras[i], i / W, &mut acc) };
-            let l = i % W;
-            Element {
-                s: acc[0].s[l],
-                t: acc[0].t[l],
-                t_ti: acc[0].t_ti[l],
-                v: acc[0].v[l],
-            }
+            unsafe { (kernels.row)(&own, &prep, &trial_bras[i], i / W, &mut acc) };
+            lane(&acc[0], i % W)
         })
         .collect();
     let mut m = Matrices::zeros(k, nb);
     for (task, acc) in parts.iter().enumerate() {
-        let (i, c) = (task / spans, task % spans);
+        let (i, (col, first, _)) = (task / spans.len(), spans[task % spans.len()]);
         for (b, a) in acc.iter().enumerate() {
             for l in 0..W {
-                let j = (c * SPAN + b) * W + l;
-                if j < nb {
-                    m.set(
-                        i,
-                        j,
-                        &Element {
-                            s: a.s[l],
-                            t: a.t[l],
-                            t_ti: a.t_ti[l],
-                            v: a.v[l],
-                        },
-                    );
+                let j = (first + b) * W + l;
+                if j < nb && (j < pos) == col {
+                    m.set(i, j, &lane(a, l));
                 }
             }
         }
@@ -336,127 +395,16 @@ fn rows_w<const D: usize, const W: usize>(
     (m, diag)
 }
 
-#[cfg(test)]
-mod tests {
-    //! Every instruction set gives the same bits; matrices, rows and `Symmetrised::element` agree.
-    use super::*;
-    use crate::ecg::{Mat, Vector};
-
-    fn lcg(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((*state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-
-    /// `nb` random functions of 4 particles, two protons and two electrons (1 ± P12)(1 + P34).
-    fn setup(nb: usize, seed: u64) -> (Symmetrised<4>, Operators<4>) {
-        let mut s = seed;
-        let funcs: Vec<Gaussian<4>> = (0..nb)
-            .map(|i| {
-                let l = Mat::<4>::from_fn(|r, c| if c <= r { lcg(&mut s) } else { 0.0 });
-                Gaussian::new(l * l.transpose() + Mat::<4>::identity() * 0.05, 1.0, i).unwrap()
-            })
-            .collect();
-        let perm = |p: [usize; 4]| Mat::<4>::from_fn(|i, j| if p[i] == j { 1.0 } else { 0.0 });
-        let sym = [
-            (perm([0, 1, 2, 3]), 1.0),
-            (perm([1, 0, 2, 3]), -1.0),
-            (perm([0, 1, 3, 2]), 1.0),
-            (perm([1, 0, 3, 2]), -1.0),
-        ];
-        let masses = [1836.15, 1836.15, 1.0, 1.0];
-        let mut pairs = Vec::new();
-        let q = [1.0, 1.0, -1.0, -1.0];
-        for i in 0..4 {
-            for j in (i + 1)..4 {
-                let mut w = Vector::<4>::zeros();
-                w[i] = 1.0;
-                w[j] = -1.0;
-                pairs.push((w, q[i] * q[j]));
-            }
-        }
-        let lambda = Mat::<4>::from_fn(|i, j| if i == j { 0.5 / masses[i] } else { 0.0 });
-        let ops = Operators {
-            lambda,
-            pairs,
-            cm_mass: Some(masses.iter().sum()),
-        };
-        (Symmetrised::new(funcs, &sym, &()).unwrap(), ops)
-    }
-
-    fn bits(m: &Matrices) -> Vec<u64> {
-        [&m.s, &m.t, &m.t_ti, &m.v]
-            .iter()
-            .flat_map(|v| v.iter().map(|x| x.to_bits()))
-            .collect()
-    }
-
-    #[test]
-    fn instruction_sets_agree_bit_for_bit() {
-        for nb in [1, 7, 19] {
-            let (basis, ops) = setup(nb, 11 + nb as u64);
-            let plain = matrices_with(&basis, &ops, Isa::Plain);
-            for isa in [Isa::Avx2, Isa::Avx512] {
-                assert_eq!(bits(&matrices_with(&basis, &ops, isa)), bits(&plain), "{isa:?}");
-            }
-            let (trials, _) = setup(3, 5);
-            let (r0, d0) = rows_with(&trials, &basis, &ops, Isa::Plain);
-            for isa in [Isa::Avx2, Isa::Avx512] {
-                let (r, d) = rows_with(&trials, &basis, &ops, isa);
-                assert_eq!(bits(&r), bits(&r0), "{isa:?}");
-                assert_eq!(d, d0);
-            }
-        }
-    }
-
-    #[test]
-    fn matrices_rows_and_elements_agree() {
-        let (basis, ops) = setup(21, 3);
-        let m = matrices(&basis, &ops);
-        let nb = basis.len();
-        for i in 0..nb {
-            for j in 0..nb {
-                let k = i * nb + j;
-                let e = basis.element(&basis.functions[i.min(j)], i.max(j), |x, y| pecg::element(x, y, &ops));
-                assert_eq!(
-                    [m.s[k], m.t[k], m.t_ti[k], m.v[k]],
-                    [e.s, e.t, e.t_ti, e.v],
-                    "({i}, {j})"
-                );
-            }
-        }
-        // rows of the basis's own functions are its matrix rows (bit for bit on and above the
-        // diagonal; below it the matrix holds the mirrored element); diagonals its diagonal
-        let (trials, _) = setup(21, 3);
-        let (r, d) = rows(&trials, &basis, &ops);
-        for i in 0..nb {
-            for j in 0..nb {
-                let k = i * nb + j;
-                for (x, y) in [(&r.s, &m.s), (&r.t, &m.t), (&r.t_ti, &m.t_ti), (&r.v, &m.v)] {
-                    if j >= i {
-                        assert_eq!(x[k].to_bits(), y[k].to_bits(), "({i}, {j})");
-                    } else {
-                        assert!((x[k] - y[k]).abs() <= 1e-13 * (y[i * nb + i] * y[j * nb + j]).abs().sqrt());
-                    }
-                }
-            }
-        }
-        for (i, e) in d.iter().enumerate() {
-            assert_eq!(
-                [e.s, e.t, e.t_ti, e.v],
-                [m.s[i * nb + i], m.t[i * nb + i], m.t_ti[i * nb + i], m.v[i * nb + i]]
-            );
-        }
-    }
-
-    #[test]
-    fn empty_basis() {
-        let (basis, ops) = setup(0, 1);
-        let m = matrices(&basis, &ops);
-        assert_eq!((m.rows, m.cols, m.s.len()), (0, 0, 0));
-        let (trials, _) = setup(2, 1);
-        let (r, d) = rows(&trials, &basis, &ops);
-        assert_eq!((r.rows, r.cols, d.len()), (2, 0, 2));
+/// The element in lane `l` of `a`.
+fn lane<const W: usize>(a: &Accumulator<W>, l: usize) -> Element {
+    Element {
+        s: a.s[l],
+        t: a.t[l],
+        t_ti: a.t_ti[l],
+        v: a.v[l],
     }
 }
+
+#[cfg(test)]
+#[path = "build_tests.rs"]
+mod tests;

@@ -14,10 +14,12 @@
 //! whose functions are CM-separable, whatever their `c_A` (tests/test_elimination.py).
 //!
 //! # The kernel
-//! [`lanes`] evaluates one bra against `W` kets at once, lane by lane in structure-of-arrays
-//! form, so that the compiler vectorises it (build.rs instantiates it for AVX-512, AVX2 and
-//! plain x86-64 and picks one at run time). Per element it needs no `ln`, no `exp` and no
-//! general inverse:
+//! [`lanes`] evaluates `W` elements at once, lane by lane in structure-of-arrays form, so that
+//! the compiler vectorises it (build.rs instantiates it for AVX-512, AVX2 and plain x86-64 and
+//! picks one at run time): one bra against `W` kets (full builds, rows after the trial) or `W`
+//! bras against one ket (rows before it). Either side is a scalar or `W` lanes ([`Lane`]) with
+//! the same operations in the same order, so an element has the same bits either way. Per
+//! element it needs no `ln`, no `exp` and no general inverse:
 //! - `A_IJ = L D L^T` (root-free Cholesky), `|A_IJ| = Π d_k`, `B = L^{-T} D^{-1} L^{-1}`
 //!   (upper triangle only);
 //! - `S = n_I n_J / (|A_IJ| sqrt|A_IJ|)` with the per-function `n = (2^{D/2} |A|^{1/2})^{3/2}`
@@ -113,15 +115,47 @@ pub fn norm_factor<const D: usize>(g: &Gaussian<D>) -> f64 {
     (0.75 * (D as f64 * LN_2 + g.log_det)).exp()
 }
 
-/// A bra with its per-function precomputations.
+/// A value of the kernel's operands: one scalar for every lane (`f64`) or one per lane (`[f64; W]`).
+pub trait Lane<const W: usize>: Copy {
+    fn at(&self, l: usize) -> f64;
+}
+
+impl<const W: usize> Lane<W> for f64 {
+    #[inline(always)]
+    fn at(&self, _: usize) -> f64 {
+        *self
+    }
+}
+
+impl<const W: usize> Lane<W> for [f64; W] {
+    #[inline(always)]
+    fn at(&self, l: usize) -> f64 {
+        self[l]
+    }
+}
+
+/// A bra with its per-function precomputations: one function (`X = f64`) or `W` (`X = [f64; W]`).
 #[derive(Clone, Debug)]
-pub struct Bra<const D: usize> {
-    pub a: [[f64; D]; D],
+pub struct Bra<const D: usize, X = f64> {
+    pub a: [[X; D]; D],
     /// `A Λ`
-    pub a_lambda: [[f64; D]; D],
-    pub norm: f64,
-    pub log_det: f64,
-    pub c_a: f64,
+    pub a_lambda: [[X; D]; D],
+    pub norm: X,
+    pub log_det: X,
+    pub c_a: X,
+}
+
+/// Lanes of `W` bras from up to `W` bras (`Bra::new`, same bits); missing lanes repeat the last.
+pub fn bra_lanes<const D: usize, const W: usize>(bras: &[Bra<D>]) -> Bra<D, [f64; W]> {
+    assert!(!bras.is_empty() && bras.len() <= W);
+    let lane = |f: &dyn Fn(&Bra<D>) -> f64| std::array::from_fn(|l| f(&bras[l.min(bras.len() - 1)]));
+    Bra {
+        a: std::array::from_fn(|i| std::array::from_fn(|j| lane(&|b| b.a[i][j]))),
+        a_lambda: std::array::from_fn(|i| std::array::from_fn(|j| lane(&|b| b.a_lambda[i][j]))),
+        norm: lane(&|b| b.norm),
+        log_det: lane(&|b| b.log_det),
+        c_a: lane(&|b| b.c_a),
+    }
 }
 
 impl<const D: usize> Bra<D> {
@@ -152,16 +186,31 @@ impl<const D: usize> Bra<D> {
     }
 }
 
-/// `W` kets in structure-of-arrays form: `a[i][j][lane]` (upper triangle used).
+/// A ket: one function (`X = f64`) or `W` in structure-of-arrays form (`X = [f64; W]`,
+/// `a[i][j][lane]`); the upper triangle of `a` is used.
 #[derive(Clone, Debug)]
-pub struct KetLanes<const D: usize, const W: usize> {
-    pub a: [[[f64; W]; D]; D],
-    pub norm: [f64; W],
-    pub log_det: [f64; W],
-    pub c_a: [f64; W],
+pub struct Ket<const D: usize, X = f64> {
+    pub a: [[X; D]; D],
+    pub norm: X,
+    pub log_det: X,
+    pub c_a: X,
 }
 
-impl<const D: usize, const W: usize> KetLanes<D, W> {
+/// `W` kets in lanes.
+pub type KetLanes<const D: usize, const W: usize> = Ket<D, [f64; W]>;
+
+impl<const D: usize> Ket<D> {
+    pub fn new(g: &Gaussian<D>) -> Self {
+        Self {
+            a: std::array::from_fn(|i| std::array::from_fn(|j| g.a[(i, j)])),
+            norm: norm_factor(g),
+            log_det: g.log_det,
+            c_a: g.c_a,
+        }
+    }
+}
+
+impl<const D: usize, const W: usize> Ket<D, [f64; W]> {
     /// Lanes from up to `W` functions; missing lanes repeat the last one.
     pub fn from_gaussians(kets: &[&Gaussian<D>]) -> Self {
         assert!(!kets.is_empty() && kets.len() <= W);
@@ -208,11 +257,16 @@ impl<const W: usize> Default for Accumulator<W> {
 
 /// `3 c_I c_J / ((c_I + c_J) m_tot)` per lane: the CM kinetic term of `T_TI` over `S` (zero without `cm_mass`).
 #[inline(always)]
-pub fn cm_terms<const D: usize, const W: usize>(bra: &Bra<D>, ket: &KetLanes<D, W>, ops: &Prepared<D>) -> [f64; W] {
+pub fn cm_terms<const D: usize, const W: usize>(
+    bra: &Bra<D, impl Lane<W>>,
+    ket: &Ket<D, impl Lane<W>>,
+    ops: &Prepared<D>,
+) -> [f64; W] {
     let mut cm = [0.0f64; W];
     if let Some(m_tot) = ops.cm_mass {
         for l in 0..W {
-            cm[l] = 3.0 * bra.c_a * ket.c_a[l] / ((bra.c_a + ket.c_a[l]) * m_tot);
+            let (ci, cj) = (bra.c_a.at(l), ket.c_a.at(l));
+            cm[l] = 3.0 * ci * cj / ((ci + cj) * m_tot);
         }
     }
     cm
@@ -225,8 +279,8 @@ pub fn cm_terms<const D: usize, const W: usize>(bra: &Bra<D>, ket: &KetLanes<D, 
 /// other D run the loops.
 #[inline(always)]
 pub fn lanes<const D: usize, const W: usize>(
-    bra: &Bra<D>,
-    ket: &KetLanes<D, W>,
+    bra: &Bra<D, impl Lane<W>>,
+    ket: &Ket<D, impl Lane<W>>,
     ops: &Prepared<D>,
     cm: &[f64; W],
     coef: f64,
@@ -235,9 +289,9 @@ pub fn lanes<const D: usize, const W: usize>(
     // Safety of the casts: the types are identical when D is the matched value.
     unsafe {
         match D {
-            2 => unrolled::lanes_d2::<W>(cast(bra), cast(ket), cast(ops), cm, coef, acc),
-            3 => unrolled::lanes_d3::<W>(cast(bra), cast(ket), cast(ops), cm, coef, acc),
-            4 => unrolled::lanes_d4::<W>(cast(bra), cast(ket), cast(ops), cm, coef, acc),
+            2 => unrolled::lanes_d2::<W>(bra.dim(), ket.dim(), cast(ops), cm, coef, acc),
+            3 => unrolled::lanes_d3::<W>(bra.dim(), ket.dim(), cast(ops), cm, coef, acc),
+            4 => unrolled::lanes_d4::<W>(bra.dim(), ket.dim(), cast(ops), cm, coef, acc),
             _ => lanes_generic::<D, W>(bra, ket, ops, cm, coef, acc),
         }
     }
@@ -249,11 +303,27 @@ unsafe fn cast<T, U>(x: &T) -> &U {
     &*(x as *const T as *const U)
 }
 
+impl<const D: usize, X> Bra<D, X> {
+    /// Safety: only for `E == D`.
+    #[inline(always)]
+    unsafe fn dim<const E: usize>(&self) -> &Bra<E, X> {
+        cast(self)
+    }
+}
+
+impl<const D: usize, X> Ket<D, X> {
+    /// Safety: only for `E == D`.
+    #[inline(always)]
+    unsafe fn dim<const E: usize>(&self) -> &Ket<E, X> {
+        cast(self)
+    }
+}
+
 /// The kernel with loops over the coordinates (any D); the reference for the unrolled copies.
 #[inline(always)]
 pub fn lanes_generic<const D: usize, const W: usize>(
-    bra: &Bra<D>,
-    ket: &KetLanes<D, W>,
+    bra: &Bra<D, impl Lane<W>>,
+    ket: &Ket<D, impl Lane<W>>,
     ops: &Prepared<D>,
     cm: &[f64; W],
     coef: f64,
@@ -264,7 +334,7 @@ pub fn lanes_generic<const D: usize, const W: usize>(
     for i in 0..D {
         for j in i..D {
             for l in 0..W {
-                m[i][j][l] = bra.a[i][j] + ket.a[i][j][l];
+                m[i][j][l] = bra.a[i][j].at(l) + ket.a[i][j].at(l);
             }
         }
     }
@@ -336,7 +406,7 @@ pub fn lanes_generic<const D: usize, const W: usize>(
             for c in 0..D {
                 let ajc = if c <= a { &ket.a[c][a] } else { &ket.a[a][c] };
                 for l in 0..W {
-                    y[l] += bra.a_lambda[bb][c] * ajc[l];
+                    y[l] += bra.a_lambda[bb][c].at(l) * ajc.at(l);
                 }
             }
             for l in 0..W {
@@ -351,8 +421,8 @@ pub fn lanes_generic<const D: usize, const W: usize>(
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn finish<const D: usize, const W: usize>(
-    bra: &Bra<D>,
-    ket: &KetLanes<D, W>,
+    bra: &Bra<D, impl Lane<W>>,
+    ket: &Ket<D, impl Lane<W>>,
     ops: &Prepared<D>,
     cm: &[f64; W],
     coef: f64,
@@ -379,7 +449,7 @@ fn finish<const D: usize, const W: usize>(
     let mut s = [0.0f64; W];
     let mut bad = false;
     for l in 0..W {
-        s[l] = bra.norm * ket.norm[l] / (det[l] * det[l].sqrt());
+        s[l] = bra.norm.at(l) * ket.norm.at(l) / (det[l] * det[l].sqrt());
         bad |=
             !((det[l] >= f64::MIN_POSITIVE) & (det[l] <= f64::MAX) & (s[l] >= f64::MIN_POSITIVE) & (s[l] <= f64::MAX));
     }
@@ -387,7 +457,7 @@ fn finish<const D: usize, const W: usize>(
         for l in 0..W {
             if !(det[l].is_normal() && s[l].is_normal()) {
                 let log_det: f64 = dk.iter().map(|d| d[l].ln()).sum();
-                s[l] = (1.5 * (D as f64 * LN_2 + 0.5 * (bra.log_det + ket.log_det[l]) - log_det)).exp();
+                s[l] = (1.5 * (D as f64 * LN_2 + 0.5 * (bra.log_det.at(l) + ket.log_det.at(l)) - log_det)).exp();
             }
         }
     }
@@ -403,12 +473,12 @@ fn finish<const D: usize, const W: usize>(
 
 // --- lane helpers for the unrolled kernels: one vector operation each --------------------
 #[inline(always)]
-fn adds<const W: usize>(x: f64, y: &[f64; W]) -> [f64; W] {
-    std::array::from_fn(|l| x + y[l])
+fn adds<const W: usize>(x: &impl Lane<W>, y: &impl Lane<W>) -> [f64; W] {
+    std::array::from_fn(|l| x.at(l) + y.at(l))
 }
 #[inline(always)]
-fn muls<const W: usize>(x: f64, y: &[f64; W]) -> [f64; W] {
-    std::array::from_fn(|l| x * y[l])
+fn muls<const W: usize>(x: &impl Lane<W>, y: &impl Lane<W>) -> [f64; W] {
+    std::array::from_fn(|l| x.at(l) * y.at(l))
 }
 #[inline(always)]
 fn add<const W: usize>(x: &[f64; W], y: &[f64; W]) -> [f64; W] {

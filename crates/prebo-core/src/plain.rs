@@ -30,8 +30,8 @@ fn gaussians<const D: usize>(p: &Params, sym: &Symmetry<D>) -> Result<Images<Gau
 
 impl<const D: usize> Family<D> for PlainEcg {
     const NAME: &'static str = "pecg";
-    /// Rows have the trial as bra (the SIMD kernel runs one bra against blocks of kets).
-    const ORIENTED: bool = false;
+    /// Rows in full-build orientation from the SIMD kernel (`build::rows`).
+    const ORIENTED: bool = true;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
 
@@ -75,8 +75,8 @@ impl<const D: usize> Family<D> for PlainEcg {
         sym: &Symmetry<D>,
         trials: &Params,
         basis: &Params,
-        _: Option<usize>,
+        position: Option<usize>,
     ) -> Result<(Matrices, Vec<Element>)> {
-        Ok(build::rows(&gaussians(trials, sym)?, &gaussians(basis, sym)?, &go.ops))
+        Ok(build::rows(&gaussians(trials, sym)?, &gaussians(basis, sym)?, &go.ops, position))
     }
 }
