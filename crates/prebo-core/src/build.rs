@@ -343,30 +343,28 @@ fn rows_w<const D: usize, const W: usize>(
     let below: Vec<Bra<D>> = basis.functions[..pos].iter().map(|f| Bra::new(f, &prep)).collect();
     let bras: Vec<Bra<D, [f64; W]>> = below.chunks(W).map(bra_lanes).collect();
     let images: Vec<Vec<Ket<D>>> = trials.images.iter().map(|im| im.iter().map(Ket::new).collect()).collect();
-    // j >= pos: the trial as bra against the images of the basis functions
-    let kets = Kets::<D, W>::new(basis, pos / W);
+    // j >= pos: the trial as bra against the images of the basis functions (blocks from `first_row`)
+    let first_row = if pos < nb { pos / W } else { nb.div_ceil(W) };
+    let kets = Kets::<D, W>::new(basis, first_row);
     let own = Kets::<D, W>::new(trials, 0);
     let trial_bras: Vec<Bra<D>> = trials.functions.iter().map(|f| Bra::new(f, &prep)).collect();
-    // tasks per trial: (mirrored, first block, blocks)
-    let mut spans = Vec::new();
-    for c in (0..bras.len()).step_by(SPAN) {
-        spans.push((true, c, (bras.len() - c).min(SPAN)));
-    }
-    for c in (pos / W..kets.n_blocks).step_by(SPAN) {
-        spans.push((false, c, (kets.n_blocks - c).min(SPAN)));
-    }
-    let parts: Vec<Vec<Accumulator<W>>> = (0..k * spans.len())
+    // a trial's row is `n_col` bra blocks (j < pos), then the ket blocks from `first_row` on;
+    // block `v` of that sequence is (mirrored, block index)
+    let n_col = bras.len();
+    let block = |v: usize| if v < n_col { (true, v) } else { (false, first_row + v - n_col) };
+    let total = n_col + kets.n_blocks - first_row;
+    let spans = total.div_ceil(SPAN);
+    let parts: Vec<Vec<Accumulator<W>>> = (0..k * spans)
         .into_par_iter()
         .map(|task| {
-            let (i, (col, first, count)) = (task / spans.len(), spans[task % spans.len()]);
-            let mut acc = vec![Accumulator::<W>::default(); count];
+            let (i, v0) = (task / spans, task % spans * SPAN);
+            let v1 = (v0 + SPAN).min(total);
+            let mut acc = vec![Accumulator::<W>::default(); v1 - v0];
+            let (col, row) = acc.split_at_mut(n_col.clamp(v0, v1) - v0);
             // Safety: the kernels were chosen for an instruction set this CPU has.
             unsafe {
-                if col {
-                    (kernels.col)(&bras, &images[i], &trials.coef, &prep, first, &mut acc)
-                } else {
-                    (kernels.row)(&kets, &prep, &trial_bras[i], first, &mut acc)
-                }
+                (kernels.col)(&bras, &images[i], &trials.coef, &prep, v0, col);
+                (kernels.row)(&kets, &prep, &trial_bras[i], block(v0.max(n_col)).1, row);
             }
             acc
         })
@@ -382,10 +380,11 @@ fn rows_w<const D: usize, const W: usize>(
         .collect();
     let mut m = Matrices::zeros(k, nb);
     for (task, acc) in parts.iter().enumerate() {
-        let (i, (col, first, _)) = (task / spans.len(), spans[task % spans.len()]);
-        for (b, a) in acc.iter().enumerate() {
+        let (i, v0) = (task / spans, task % spans * SPAN);
+        for (v, a) in acc.iter().enumerate() {
+            let (col, c) = block(v0 + v);
             for l in 0..W {
-                let j = (first + b) * W + l;
+                let j = c * W + l;
                 if j < nb && (j < pos) == col {
                     m.set(i, j, &lane(a, l));
                 }
