@@ -37,12 +37,9 @@ class PairOperator:
         """{"a-b": LFCC vectors w = e_i − e_j (p, n) of every pair i < j of a particle named a and
         one named b}, in the order the pairs first occur."""
         out: dict[str, list] = {}
-        for i in range(system.n):
-            for j in range(i + 1, system.n):
-                names = sorted((system.particles[i].name, system.particles[j].name))
-                e = np.zeros(system.n)
-                e[i], e[j] = 1.0, -1.0
-                out.setdefault("-".join(names), []).append(e)
+        for i, j, w in system.pairs():
+            names = sorted((system.particles[i].name, system.particles[j].name))
+            out.setdefault("-".join(names), []).append(w)
         return {label: np.array(w) for label, w in out.items()}
 
 

@@ -150,19 +150,22 @@ class System:
         """m / m_tot: the last row of every U_x (eq. (4))."""
         return self.masses / self.m_total
 
+    def pairs(self) -> list[tuple[int, int, np.ndarray]]:
+        """Every pair i < j with its LFCC vector w = e_i - e_j (r_ij = r_i - r_j = Σ_k w_k r_k)."""
+        out = []
+        for i in range(self.n):
+            for j in range(i + 1, self.n):
+                w = np.zeros(self.n)
+                w[i], w[j] = 1.0, -1.0
+                out.append((i, j, w))
+        return out
+
     def coulomb_pairs(self) -> tuple[np.ndarray, np.ndarray]:
         """The Coulomb terms of eq. (1): LFCC vectors w = e_i - e_j, shape (pairs, N), and charge
         products q_i q_j (e²) of every pair i < j with q_i q_j ≠ 0."""
-        w, q = [], []
-        for i in range(self.n):
-            for j in range(i + 1, self.n):
-                qq = self.particles[i].charge * self.particles[j].charge
-                if qq != 0.0:
-                    e = np.zeros(self.n)
-                    e[i], e[j] = 1.0, -1.0
-                    w.append(e)
-                    q.append(qq)
-        return np.array(w).reshape(len(q), self.n), np.array(q)
+        terms = [(w, self.particles[i].charge * self.particles[j].charge) for i, j, w in self.pairs()]
+        terms = [(w, qq) for w, qq in terms if qq != 0.0]
+        return np.array([w for w, _ in terms]).reshape(len(terms), self.n), np.array([qq for _, qq in terms])
 
     # --- I/O -----------------------------------------------------------------
     def to_dict(self) -> dict:
