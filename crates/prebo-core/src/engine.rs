@@ -164,7 +164,7 @@ fn row_gradient_d<const D: usize, F: Family<D>>(
     basis: &Params,
 ) -> Result<(Matrices, Vec<Element>)> {
     let (ops, sym) = e.rep.operators::<D>();
-    path::row_gradient::<D, F>(&F::context(ops, e.n_ang, &[trial, basis])?, &sym, trial, dir, basis)
+    F::row_gradient(&F::context(ops, e.n_ang, &[trial, basis])?, &sym, trial, dir, basis)
 }
 
 fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &Params, w: &[f64]) -> Result<Vec<f64>> {

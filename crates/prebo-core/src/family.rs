@@ -148,4 +148,16 @@ pub trait Family<const D: usize>: Sized + 'static {
     ) -> Result<(Matrices, Vec<Element>)> {
         path::rows::<D, Self>(ctx, sym, trials, basis, position)
     }
+
+    /// The row of one function against a basis and its diagonal, with their derivatives along
+    /// the directions `dir` (default: dual numbers through `element`, `path::row_gradient`).
+    fn row_gradient(
+        ctx: &Self::Context,
+        sym: &Symmetry<D>,
+        trial: &Params,
+        dir: &Directions,
+        basis: &Params,
+    ) -> Result<(Matrices, Vec<Element>)> {
+        path::row_gradient::<D, Self>(ctx, sym, trial, dir, basis)
+    }
 }
