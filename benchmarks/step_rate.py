@@ -1,0 +1,54 @@
+"""Optimiser steps per minute on a run's checkpoint: `--steps` consecutive steps of one phase
+("sweep": replacement with `trials` random functions, the winner refined; "refine": L-BFGS
+refinement of one function) from function `--first` on, with the checkpoint's settings, random
+state and basis — the quantity the optimiser feels. The matrices of the basis are built before
+the clock starts. The energy after the steps shows that two builds took the same path.
+
+    python benchmarks/step_rate.py benchmarks/checkpoints/h2-cycles --phase refine --first 100 --steps 10
+    python benchmarks/step_rate.py benchmarks/checkpoints/h2-cycles --phase sweep --first 100 --steps 5
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from prebo.integrals import laboratory
+from prebo.optimise.checkpoint import Cursor, load_checkpoint, resumed
+from prebo.optimise.expansion import Expansion
+from prebo.optimise.methods import Run, methods
+from prebo.optimise.report import Reporter
+from prebo.optimise.sampler import Sampler
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("checkpoint", help="a run's folder (its basis.json)")
+    ap.add_argument("--phase", choices=("sweep", "refine"), default="refine")
+    ap.add_argument("--first", type=int, default=100, help="the function of the first step")
+    ap.add_argument("--steps", type=int, default=10)
+    args = ap.parse_args()
+    d, system, opts = load_checkpoint(args.checkpoint)
+    rng = np.random.default_rng(opts.seed)
+    sampler = Sampler(system, opts, rng)
+    basis, *_ = resumed(d, opts, rng, args.checkpoint)
+    ex = Expansion(basis, laboratory(system), opts.threshold, opts.min_norm, opts.max_overlap)
+    sampler.learn(ex.basis)
+    run = Run(ex, sampler, Reporter(opts, False))
+    step = methods(opts)[args.phase]
+    e0, times = ex.energy, []
+    for i in range(args.first, args.first + args.steps):
+        t0 = time.perf_counter()
+        step.step(run, Cursor(args.phase, index=i))
+        times.append(time.perf_counter() - t0)
+    t = np.array(times)
+    print(f"{args.checkpoint}: {args.steps} {args.phase} steps from function {args.first} "
+          f"({opts.kind}, {len(ex.basis)} functions, trials {opts.trials}, "
+          f"{opts.refine_evaluations} energies per refinement)")
+    print(f"steps per minute {60 / t.mean():.1f} (seconds per step: mean {t.mean():.2f}, "
+          f"min {t.min():.2f}, max {t.max():.2f}); E {e0:.12f} -> {ex.energy:.12f}")
+
+
+if __name__ == "__main__":
+    main()
