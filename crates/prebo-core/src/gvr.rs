@@ -396,6 +396,17 @@ impl<const D: usize> Family<D> for EcgGvr {
         g.a += m;
         g
     }
+
+    /// Hand-derived reverse mode (`gvr_gradient`) instead of dual numbers.
+    fn row_gradient(
+        go: &GvrOps<D>,
+        sym: &crate::family::Symmetry<D>,
+        trial: &Params,
+        dir: &crate::family::Directions,
+        basis: &Params,
+    ) -> Result<(crate::matrices::Matrices, Vec<Element>)> {
+        crate::gvr_gradient::row_gradient(go, sym, trial, dir, basis)
+    }
 }
 
 /// The m positive nodes of the 2m-point Gauss–Legendre rule on [−1, 1] with their weights:
