@@ -142,7 +142,7 @@ impl<const D: usize, T: Real> Gvr<D, T> {
 /// derivatives (`omega`, `quadrature_partials`), for one pair (K_I, K_J) and N; all non-negative.
 /// At `r = ρ²`: `G = Σ ĉ_k r^k`, `G_x = Σ ĉ_k (K_I−k) r^k`, `G_y = Σ ĉ_k (K_J−k) r^k`,
 /// `G_z = Σ ĉ_k (N+2k) r^k`, for N = 0 divided by r (its k = 0 term vanishes).
-struct Coefficients {
+pub(crate) struct Coefficients {
     ki: u32,
     kj: u32,
     n: u32,
@@ -156,7 +156,7 @@ struct Coefficients {
 }
 
 impl Coefficients {
-    fn new(ki: u32, kj: u32, n: u32) -> Self {
+    pub(crate) fn new(ki: u32, kj: u32, n: u32) -> Self {
         let alpha = n as f64 + 0.5;
         let mut c = Vec::with_capacity(ki.min(kj) as usize + 1);
         let mut ck = 1.0;
@@ -236,10 +236,32 @@ fn quadrature_partials(inputs: [f64; 5], rule: &[(f64, f64)], series: &Coefficie
     }
     (f, d)
 }
+/// The ĉ_k of the pair (K_I, K_J) and the context's N (module docs), k = 0..=min(K_I, K_J).
+pub(crate) fn series_coefficients<const D: usize>(go: &GvrOps<D>, ki: u32, kj: u32) -> Vec<f64> {
+    Coefficients::new(ki, kj, go.n_ang).c
+}
+
+/// The Coulomb τ-integral `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ / e^L` of one pair
+/// (K_I, K_J) for each of `inputs` = `[x, y, z, γ_I, γ_J]` (`quadrature`), with its partial
+/// derivatives with respect to the five inputs (`quadrature_partials`), into `out`.
+pub(crate) fn coulomb_partials<const D: usize>(
+    go: &GvrOps<D>,
+    ki: u32,
+    kj: u32,
+    inputs: &[[f64; 5]],
+    out: &mut [(f64, [f64; 5])],
+) {
+    let series = Coefficients::new(ki, kj, go.n_ang);
+    let rule = go.legendre[(ki + kj + go.n_ang) as usize];
+    for (x, o) in inputs.iter().zip(out.iter_mut()) {
+        *o = quadrature_partials(*x, rule, &series);
+    }
+}
+
 /// Ω and its derivatives divided by `e^L`, `L = (K_I+N/2) ln x + (K_J+N/2) ln y`:
 /// returns `(L, ω, ω_x, ω_y, ω_z)`.
 #[inline]
-fn omega<T: Real>(series: &Coefficients, x: T, y: T, z: T) -> (T, T, T, T, T) {
+pub(crate) fn omega<T: Real>(series: &Coefficients, x: T, y: T, z: T) -> (T, T, T, T, T) {
     let (ki, kj, n) = (series.ki, series.kj, series.n);
     let nf = n as f64;
     let rt = (x * y).sqrt();
@@ -373,6 +395,17 @@ impl<const D: usize> Family<D> for EcgGvr {
         let mut g: Gvr<D, T> = f.cast();
         g.a += m;
         g
+    }
+
+    /// Hand-derived reverse mode (`gvr_gradient`) instead of dual numbers.
+    fn row_gradient(
+        go: &GvrOps<D>,
+        sym: &crate::family::Symmetry<D>,
+        trial: &Params,
+        dir: &crate::family::Directions,
+        basis: &Params,
+    ) -> Result<(crate::matrices::Matrices, Vec<Element>)> {
+        crate::gvr_gradient::row_gradient(go, sym, trial, dir, basis)
     }
 }
 
