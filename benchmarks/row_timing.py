@@ -3,6 +3,9 @@ derivatives along the function's own parameter directions (`row_gradient`, dual 
 the basis's K and with every K set to 0 (ECG-GVR: what the Coulomb quadrature over K costs).
 
     python benchmarks/row_timing.py benchmarks/checkpoints/h2-cycles/basis.json --function 100
+
+The basis is a prebo basis file (JSON) or an ecgpack / ATOM-MOL-nonBO `.inout` file (plain ECGs,
+read with prebo.io.ecgpack), e.g. tests/data/ecgpack/ecgpack-He4-490.inout.txt.
 """
 from __future__ import annotations
 
@@ -14,6 +17,7 @@ import numpy as np
 
 from prebo.basis import Basis
 from prebo.integrals import laboratory
+from prebo.io import ecgpack
 from prebo.optimise.parametrisation import Parametrisation
 
 
@@ -23,6 +27,13 @@ def seconds(call, repeat: int) -> float:
     for _ in range(repeat):
         call()
     return (time.perf_counter() - t0) / repeat
+
+
+def load(path: str) -> Basis:
+    """A prebo basis file, or an ecgpack `.inout` file (the name contains `.inout`)."""
+    if ".inout" in path:
+        return ecgpack.read_inout(path)
+    return Basis.from_dict(json.loads(open(path).read()), path)
 
 
 def with_K(b: Basis, K) -> Basis:
@@ -35,7 +46,7 @@ def main():
     ap.add_argument("--function", type=int, default=100, help="the function timed as the trial")
     ap.add_argument("--repeat", type=int, default=20)
     args = ap.parse_args()
-    basis = Basis.from_dict(json.loads(open(args.basis).read()), args.basis)
+    basis = load(args.basis)
     rep, i = laboratory(basis.system), args.function
     p = Parametrisation.of(basis.subset([i]))
     theta = p.theta()

@@ -4,7 +4,8 @@
 //! Two axes: basis families (`family`: `plain`, `gvr`, `fecg`) and operators (the Hamiltonian
 //! in each family's element, further ones in `operators`). One path (`path`) builds symmetrised
 //! matrices, oriented rows, row gradients and operator matrices for any pair; plain ECGs
-//! specialise the builds with the SIMD kernel (`pecg`, `build`). `engine` is the flat-array
+//! specialise the builds with the SIMD kernel (`pecg`, `build`) and their row gradients
+//! (`pecg_gradient`). `engine` is the flat-array
 //! entry point of the `prebo._core` binding.
 pub mod assemble;
 pub mod build;
@@ -22,6 +23,7 @@ pub mod matrices;
 pub mod operators;
 pub mod path;
 pub mod pecg;
+pub mod pecg_gradient;
 pub mod plain;
 pub mod secular;
 

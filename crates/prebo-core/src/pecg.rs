@@ -338,6 +338,34 @@ pub fn lanes_generic<const D: usize, const W: usize>(
             }
         }
     }
+    let (b, det, dk) = inverse::<D, W>(&m);
+    // Tr(B A_I Λ A_J) = Σ_ab B_ab Σ_c (A_I Λ)_bc (A_J)_ca
+    let mut tr = [0.0f64; W];
+    for a in 0..D {
+        for bb in 0..D {
+            let bab = if a <= bb { &b[a][bb] } else { &b[bb][a] };
+            let mut y = [0.0f64; W];
+            for c in 0..D {
+                let ajc = if c <= a { &ket.a[c][a] } else { &ket.a[a][c] };
+                for l in 0..W {
+                    y[l] += bra.a_lambda[bb][c].at(l) * ajc.at(l);
+                }
+            }
+            for l in 0..W {
+                tr[l] += bab[l] * y[l];
+            }
+        }
+    }
+    finish::<D, W>(bra, ket, ops, cm, coef, acc, &b, &det, &dk, &tr);
+}
+
+/// `B = A_IJ^{-1}` (upper triangle), `|A_IJ|` and the pivots `d_k` from the upper triangle `m` of
+/// `A_IJ = L D L^T` (root-free Cholesky; module docs): the factorisation of `lanes_generic`, shared
+/// with the row gradient (`pecg_gradient`).
+#[inline(always)]
+pub(crate) fn inverse<const D: usize, const W: usize>(
+    m: &[[[f64; W]; D]; D],
+) -> ([[[f64; W]; D]; D], [f64; W], [[f64; W]; D]) {
     // A_IJ = L D L^T: e[i][k] = L_ik d_k, lo[i][k] = L_ik (i > k), rd[k] = 1/d_k
     let mut lo = [[[0.0f64; W]; D]; D];
     let mut e = [[[0.0f64; W]; D]; D];
@@ -397,24 +425,7 @@ pub fn lanes_generic<const D: usize, const W: usize>(
             b[a][bb] = x;
         }
     }
-    // Tr(B A_I Λ A_J) = Σ_ab B_ab Σ_c (A_I Λ)_bc (A_J)_ca
-    let mut tr = [0.0f64; W];
-    for a in 0..D {
-        for bb in 0..D {
-            let bab = if a <= bb { &b[a][bb] } else { &b[bb][a] };
-            let mut y = [0.0f64; W];
-            for c in 0..D {
-                let ajc = if c <= a { &ket.a[c][a] } else { &ket.a[a][c] };
-                for l in 0..W {
-                    y[l] += bra.a_lambda[bb][c].at(l) * ajc.at(l);
-                }
-            }
-            for l in 0..W {
-                tr[l] += bab[l] * y[l];
-            }
-        }
-    }
-    finish::<D, W>(bra, ket, ops, cm, coef, acc, &b, &det, &dk, &tr);
+    (b, det, dk)
 }
 
 /// Coulomb terms, S (with the logarithmic fallback), T, T_TI; adds to `acc`.
@@ -445,7 +456,25 @@ fn finish<const D: usize, const W: usize>(
             v[l] += q2 / (PI * c[l]).sqrt();
         }
     }
-    // S from the determinants; lanes outside the normal range use logarithms
+    let s = overlap::<D, W>(bra, ket, det, dk);
+    for l in 0..W {
+        let t = 6.0 * tr[l] * s[l];
+        let t_ti = t - cm[l] * s[l];
+        acc.s[l] += coef * s[l];
+        acc.t[l] += coef * t;
+        acc.t_ti[l] += coef * t_ti;
+        acc.v[l] += coef * (v[l] * s[l]);
+    }
+}
+
+/// `S` per lane from `|A_IJ|` and its pivots `d_k`; lanes outside the normal range use logarithms.
+#[inline(always)]
+pub(crate) fn overlap<const D: usize, const W: usize>(
+    bra: &Bra<D, impl Lane<W>>,
+    ket: &Ket<D, impl Lane<W>>,
+    det: &[f64; W],
+    dk: &[[f64; W]; D],
+) -> [f64; W] {
     let mut s = [0.0f64; W];
     let mut bad = false;
     for l in 0..W {
@@ -461,14 +490,7 @@ fn finish<const D: usize, const W: usize>(
             }
         }
     }
-    for l in 0..W {
-        let t = 6.0 * tr[l] * s[l];
-        let t_ti = t - cm[l] * s[l];
-        acc.s[l] += coef * s[l];
-        acc.t[l] += coef * t;
-        acc.t_ti[l] += coef * t_ti;
-        acc.v[l] += coef * (v[l] * s[l]);
-    }
+    s
 }
 
 // --- lane helpers for the unrolled kernels: one vector operation each --------------------
@@ -506,4 +528,4 @@ mod unrolled;
 
 #[cfg(test)]
 #[path = "pecg_tests.rs"]
-mod tests;
+pub(crate) mod tests;

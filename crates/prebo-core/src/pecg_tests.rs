@@ -30,21 +30,21 @@ fn element_reference<const D: usize>(bra: &Gaussian<D>, ket: &Gaussian<D>, ops: 
 }
 
 /// xorshift64*: deterministic numbers in [0, 1) without a dependency.
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 impl Rng {
-    fn next(&mut self) -> f64 {
+    pub(crate) fn next(&mut self) -> f64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
         (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
     }
-    fn normal(&mut self) -> f64 {
+    pub(crate) fn normal(&mut self) -> f64 {
         self.next() * 2.0 - 1.0
     }
 }
 
 /// A positive-definite exponent: L L^T + 0.05 I with scaled random L, and c_A.
-fn gaussian<const D: usize>(rng: &mut Rng, scale: f64) -> Gaussian<D> {
+pub(crate) fn gaussian<const D: usize>(rng: &mut Rng, scale: f64) -> Gaussian<D> {
     let mut l = Mat::<D>::zeros();
     for i in 0..D {
         for j in 0..=i {
@@ -57,7 +57,7 @@ fn gaussian<const D: usize>(rng: &mut Rng, scale: f64) -> Gaussian<D> {
 
 /// Λ = diag(1/(2 m)) (laboratory) or a symmetric positive matrix (internal coordinates),
 /// LFCC-style pairs e_i - e_j with charges, or dense vectors.
-fn operators<const D: usize>(rng: &mut Rng, lab: bool) -> Operators<D> {
+pub(crate) fn operators<const D: usize>(rng: &mut Rng, lab: bool) -> Operators<D> {
     let mut lambda = Mat::<D>::zeros();
     let mut pairs = Vec::new();
     if lab {

@@ -1,5 +1,6 @@
-//! The plain-ECG family. Its matrices and rows come from the SIMD kernel (`build`, `pecg`);
-//! its generic elements (row gradients by dual numbers, extra operators) from the ECG-GVR
+//! The plain-ECG family. Its matrices and rows come from the SIMD kernel (`build`, `pecg`), its
+//! row gradients from the hand-derived kernel in the same lanes (`pecg_gradient`); its generic
+//! elements (the diagonal of a row gradient by dual numbers, extra operators) from the ECG-GVR
 //! kernel at K = N = 0 with `u = e_1`, where `u` drops out and the elements are those of plain
 //! ECGs (gvr.rs: "For K = N = 0 this is the plain-ECG ...").
 use nalgebra::SMatrix;
@@ -7,11 +8,12 @@ use nalgebra::SMatrix;
 use crate::build;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::family::{Family, Params, Symmetry};
+use crate::family::{check, Directions, Family, Params, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::gvr::{EcgGvr, Gvr, GvrOps};
 use crate::images::Images;
 use crate::matrices::Matrices;
+use crate::{path, pecg_gradient};
 
 /// The plain-ECG family: parameters `A` (`k x n x n`) and `c_A`.
 pub struct PlainEcg;
@@ -78,5 +80,21 @@ impl<const D: usize> Family<D> for PlainEcg {
         position: Option<usize>,
     ) -> Result<(Matrices, Vec<Element>)> {
         Ok(build::rows(&gaussians(trials, sym)?, &gaussians(basis, sym)?, &go.ops, position))
+    }
+
+    /// The row from `pecg_gradient` (directions of `A` only, as `seeded`); the diagonal, where
+    /// both sides move, by dual numbers (`path::row_gradient` against no basis).
+    fn row_gradient(
+        go: &GvrOps<D>,
+        sym: &Symmetry<D>,
+        trial: &Params,
+        dir: &Directions,
+        basis: &Params,
+    ) -> Result<(Matrices, Vec<Element>)> {
+        check(trial.len(), 1, "trial functions")?;
+        let (_, diag) = path::row_gradient::<D, Self>(go, sym, trial, dir, &Params::default())?;
+        let f = Gaussian::new(trial.exponents::<D>()?[0], trial.c_a[0], 0)?;
+        let (da, _) = dir.exponents::<D>()?;
+        Ok((pecg_gradient::row_gradient(&f, &da, &gaussians(basis, sym)?, &go.ops), diag))
     }
 }
