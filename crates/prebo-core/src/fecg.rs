@@ -22,9 +22,10 @@ use nalgebra::SMatrix;
 
 use crate::ecg::{dot_f, inverse_log_det, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
-use crate::family::{matrices_of, Family, Params};
+use crate::family::{matrices_of, Directions, Family, Params, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::images::Transform;
+use crate::matrices::Matrices;
 
 pub type Centres<const D: usize, T = f64> = SMatrix<T, D, 3>;
 
@@ -110,6 +111,17 @@ impl<const D: usize> Family<D> for FloatingEcg {
         Fecg::new(seed_matrix(&f.a, da), seed_matrix(&f.s, &ds), f.c_a, 0)
     }
 
+    /// The hand-derived row gradient (`fecg_gradient`); the diagonal by dual numbers.
+    fn row_gradient(
+        ops: &Operators<D>,
+        sym: &Symmetry<D>,
+        trial: &Params,
+        dir: &Directions,
+        basis: &Params,
+    ) -> Result<(Matrices, Vec<Element>)> {
+        crate::fecg_gradient::row_gradient(ops, sym, trial, dir, basis)
+    }
+
     /// `(r-s)^T A (r-s) + r^T M r = r^T (A+M) r - 2 r^T A s + s^T A s`: `A` grows, `A s`, `s^T A s`
     /// and `ln|A|` (the normalisation) stay.
     fn damped<T: Real>(f: &Fecg<D>, m: &SMatrix<T, D, D>) -> Fecg<D, T> {
@@ -121,7 +133,7 @@ impl<const D: usize> Family<D> for FloatingEcg {
 
 /// `erf(|m|/√c)/|m|` with the small-argument series (module docs).
 #[inline]
-fn coulomb_factor<T: Real>(m2: T, c: T) -> T {
+pub(crate) fn coulomb_factor<T: Real>(m2: T, c: T) -> T {
     let z2 = m2 / c;
     if z2 < re(1e-6) {
         let series = T::one() - z2 / 3.0 + z2 * z2 / 10.0 - z2 * z2 * z2 / 42.0 + z2.powi(4) / 216.0;
@@ -201,7 +213,7 @@ fn row<const D: usize>(m: &Centres<D>, i: usize) -> [f64; 3] {
 /// Cholesky factor in floating point (possible only for near-singular functions, whose
 /// elements are then NaN and the caller rejects them).
 #[inline]
-fn pair<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>) -> Option<(T, SMatrix<T, D, D>, Centres<D, T>)> {
+pub(crate) fn pair<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>) -> Option<(T, SMatrix<T, D, D>, Centres<D, T>)> {
     let (binv, log_det) = inverse_log_det(&(bra.a + ket.a))?;
     let v = bra.a_s + ket.a_s;
     let rbar = mul(&binv, &v);
@@ -210,40 +222,84 @@ fn pair<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>) -> Option<(
     Some((s, binv, rbar))
 }
 
-/// `<phi_I| 1, T, V |phi_J>` for one pair of normalised floating ECGs.
-pub fn element<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops: &Operators<D>) -> Element<T> {
-    let Some((s, binv, rbar)) = pair(bra, ket) else { return Element::nan() };
-    let w = mul(&bra.a, &mul(&ops.lambda, &ket.a)); // A_I Λ A_J
+/// The kinetic pieces of one pair (module docs): `W = A_I Λ A_J`, `d_I = r̄ - s_I`,
+/// `d_J = r̄ - s_J`, `W d_J`, and `τ = 6R + Q` (`T = τ S`).
+pub(crate) struct Kinetic<const D: usize, T: Real> {
+    pub w: SMatrix<T, D, D>,
+    pub di: Centres<D, T>,
+    pub dj: Centres<D, T>,
+    pub w_dj: Centres<D, T>,
+    pub tau: T,
+}
+
+#[inline]
+pub(crate) fn kinetic<const D: usize, T: Real>(
+    bra: &Fecg<D, T>,
+    ket: &Fecg<D, T>,
+    lambda: &Mat<D>,
+    binv: &SMatrix<T, D, D>,
+    rbar: &Centres<D, T>,
+) -> Kinetic<D, T> {
+    let w = mul(&bra.a, &mul(lambda, &ket.a)); // A_I Λ A_J
     let r = binv.component_mul(&w.transpose()).sum();
     let di = rbar - bra.s;
     let dj = rbar - ket.s;
-    let q = di.component_mul(&mul(&w, &dj)).sum() * 4.0;
-    let t = (r * 6.0 + q) * s;
-    let t_ti = match ops.cm_mass {
-        Some(m) => {
-            let (ci, cj) = (bra.c_a, ket.c_a);
-            let sum = ci + cj;
-            // |μ^T (s_I - s_J)|²; μ = (A 1)/c_A, so μ^T s = 1^T A s / c_A
-            let mut d2 = T::zero();
-            for k in 0..3 {
-                let (mut xi, mut xj) = (T::zero(), T::zero());
-                for i in 0..D {
-                    xi += bra.a_s[(i, k)];
-                    xj += ket.a_s[(i, k)];
-                }
-                d2 += (xi / ci - xj / cj).powi(2);
-            }
-            let r_cm = 3.0 * ci * cj / (m * sum);
-            let q_cm = d2 * (-2.0 / m * (ci * cj / sum).powi(2));
-            t - (q_cm + r_cm) * s
+    let w_dj = mul(&w, &dj);
+    let q = di.component_mul(&w_dj).sum() * 4.0;
+    Kinetic { w, di, dj, w_dj, tau: r * 6.0 + q }
+}
+
+/// The CM elimination of one pair (module docs), `T_TI = T - κ S` with `κ = Q_cm + R_cm`,
+/// `Q_cm = q_per_d2 |e|²`, `e = μ^T s_I - μ^T s_J` (`μ^T s = 1^T A s / c_A`).
+pub(crate) struct CmShift<T> {
+    pub kappa: T,
+    pub e: [T; 3],
+    pub q_per_d2: f64,
+}
+
+#[inline]
+pub(crate) fn cm_shift<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, m: f64) -> CmShift<T> {
+    let (ci, cj) = (bra.c_a, ket.c_a);
+    let sum = ci + cj;
+    let mut e = [T::zero(); 3];
+    let mut d2 = T::zero();
+    for k in 0..3 {
+        let (mut xi, mut xj) = (T::zero(), T::zero());
+        for i in 0..D {
+            xi += bra.a_s[(i, k)];
+            xj += ket.a_s[(i, k)];
         }
+        e[k] = xi / ci - xj / cj;
+        d2 += e[k].powi(2);
+    }
+    let r_cm = 3.0 * ci * cj / (m * sum);
+    let q_per_d2 = -2.0 / m * (ci * cj / sum).powi(2);
+    CmShift { kappa: d2 * q_per_d2 + r_cm, e, q_per_d2 }
+}
+
+/// `(b, c, m)` of one Coulomb pair `w`: `b = B^{-1} w`, `c = w^T B^{-1} w`, `m = w^T r̄`.
+#[inline]
+pub(crate) fn coulomb_moments<const D: usize, T: Real>(
+    w: &Vector<D>,
+    binv: &SMatrix<T, D, D>,
+    rbar: &Centres<D, T>,
+) -> (SMatrix<T, D, 1>, T, SMatrix<T, 1, 3>) {
+    let b = mul(&w.transpose(), binv).transpose();
+    (b, dot_f(&b, w), mul(&w.transpose(), rbar))
+}
+
+/// `<phi_I| 1, T, V |phi_J>` for one pair of normalised floating ECGs.
+pub fn element<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops: &Operators<D>) -> Element<T> {
+    let Some((s, binv, rbar)) = pair(bra, ket) else { return Element::nan() };
+    let t = kinetic(bra, ket, &ops.lambda, &binv, &rbar).tau * s;
+    let t_ti = match ops.cm_mass {
+        Some(m) => t - cm_shift(bra, ket, m).kappa * s,
         None => t,
     };
     let mut v = T::zero();
-    for (wv, qq) in &ops.pairs {
-        let c = dot_f(&mul(&wv.transpose(), &binv).transpose(), wv); // w^T B^{-1} w
-        let m = mul(&wv.transpose(), &rbar); // 3-vector w^T r̄
-        v += coulomb_factor(m.norm_squared(), c) * *qq;
+    for (w, q) in &ops.pairs {
+        let (_, c, m) = coulomb_moments(w, &binv, &rbar);
+        v += coulomb_factor(m.norm_squared(), c) * *q;
     }
     Element { s, t, t_ti, v: v * s }
 }

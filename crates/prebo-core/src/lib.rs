@@ -15,6 +15,7 @@ pub mod engine;
 pub mod error;
 pub mod family;
 pub mod fecg;
+pub mod fecg_gradient;
 pub mod gradient;
 pub mod gvr;
 pub mod gvr_gradient;
