@@ -16,6 +16,7 @@ pub mod family;
 pub mod fecg;
 pub mod gradient;
 pub mod gvr;
+pub mod gvr_coulomb;
 pub mod images;
 pub mod matrices;
 pub mod operators;
