@@ -18,6 +18,9 @@ pub mod fecg;
 pub mod fecg_gradient;
 pub mod gradient;
 pub mod gvr;
+/// The closed-form Coulomb τ-integral (docs/gvr.md): slower than the quadrature it checks.
+#[cfg(test)]
+mod gvr_coulomb;
 pub mod gvr_gradient;
 pub mod images;
 pub mod matrices;
