@@ -16,6 +16,8 @@ pub mod family;
 pub mod fecg;
 pub mod gradient;
 pub mod gvr;
+pub mod gvr_build;
+pub mod gvr_kernel;
 pub mod images;
 pub mod matrices;
 pub mod operators;
