@@ -220,9 +220,10 @@ pub fn integrals<const W: usize>(s: &Series, inputs: &[[f64; 4]], out: &mut [f64
                 r[j][l] = if ab > 0.0 { (zeta[j][l] * zeta[j][l] / ab).min(1.0) } else { 1.0 };
             }
         }
+        // all SLOTS blocks (unused ones at r = 0): a fixed trip count keeps the blocks in registers
         let mut g = [[0.0f64; W]; SLOTS];
         for ck in s.c.iter().rev() {
-            for j in 0..n {
+            for j in 0..SLOTS {
                 for l in 0..W {
                     g[j][l] = g[j][l] * r[j][l] + ck;
                 }
