@@ -1,4 +1,4 @@
-"""Plain-ECG rows are oriented: a trial's row at position p, patched into the matrices of the basis
+"""Plain-ECG and ECG-GVR rows are oriented: a trial's row at position p, patched into the matrices of the basis
 without it (or holding another function at p), gives exactly (==) the matrices of a full build, for
 every instruction set of the kernel on this machine (PREBO_ISA caps it, read at every build)."""
 from pathlib import Path
@@ -30,7 +30,7 @@ def patched(m: dict, row: dict, diag, p: int, insert: bool) -> dict:
 
 
 @pytest.mark.parametrize("isa", ["avx512", "avx2", "plain"])
-@pytest.mark.parametrize("name", ["h", "ps-", "h2plus-pecg", "h2-pecg"])
+@pytest.mark.parametrize("name", ["h", "ps-", "h2plus-pecg", "h2-pecg", "h2plus-gvr"])
 def test_patched_rows_have_the_bits_of_a_full_build(name, isa, monkeypatch):
     monkeypatch.setenv("PREBO_ISA", isa)
     basis = prebo.Basis.load(ROOT / "examples" / "bases" / name / "basis.json")

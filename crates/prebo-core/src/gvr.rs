@@ -53,7 +53,11 @@ use nalgebra::{Cholesky, SMatrix, SVector};
 
 use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
-use crate::family::{check, matrices_of, Family, Params};
+use crate::build::best_isa;
+use crate::family::{check, matrices_of, Family, Params, Symmetry};
+use crate::gvr_build;
+use crate::gvr_kernel::MAX_W;
+use crate::matrices::Matrices;
 use crate::gradient::{seed_matrix, Dual};
 use crate::images::Transform;
 
@@ -100,6 +104,11 @@ impl<const D: usize> GvrOps<D> {
     fn k_max(&self) -> u32 {
         ((self.legendre.len() - 1) as u32 - self.n_ang) / 2
     }
+
+    /// The rule for the Coulomb integrand of K_I + K_J + N = `d`.
+    pub(crate) fn rule(&self, d: u32) -> &'static [(f64, f64)] {
+        self.legendre[d as usize]
+    }
 }
 
 impl<const D: usize, T: Real> Gvr<D, T> {
@@ -116,7 +125,7 @@ impl<const D: usize, T: Real> Gvr<D, T> {
         }
         let log_det_2a = log_det_cholesky(&chol) + (D as f64) * 2f64.ln();
         let n = go.n_ang as f64;
-        let g = horner(&Coefficients::new(k, k, go.n_ang).c, 1.0);
+        let g = series_at_one(k, go.n_ang);
         let log_s0 = (log_det_2a - D as f64 * PI.ln()) * -1.5;
         let log_norm = (log_s0 + x.ln() * (2.0 * k as f64 + n) + g.ln()) * 0.5;
         Ok(Self { a, u, k, c_a, c_u: u.sum(), log_norm })
@@ -147,12 +156,12 @@ pub(crate) struct Coefficients {
     kj: u32,
     n: u32,
     /// `ĉ_k`
-    c: Vec<f64>,
+    pub(crate) c: Vec<f64>,
     /// `ĉ_k (K_I − k)`, `ĉ_k (K_J − k)`
-    cx: Vec<f64>,
-    cy: Vec<f64>,
+    pub(crate) cx: Vec<f64>,
+    pub(crate) cy: Vec<f64>,
     /// `ĉ_k (N + 2k)`; for N = 0 shifted by one, `ĉ_{k+1} 2(k+1)` (G_z / r)
-    cz: Vec<f64>,
+    pub(crate) cz: Vec<f64>,
 }
 
 impl Coefficients {
@@ -169,6 +178,22 @@ impl Coefficients {
         let cz = if n == 0 { scaled(&|k| (2 * k) as f64)[1..].to_vec() } else { scaled(&|k| (n + 2 * k) as f64) };
         Self { ki, kj, n, c, cx, cy, cz }
     }
+}
+
+/// `G(1) = Σ_k ĉ_k` of the pair (K, K) (`Coefficients`), summed from the top as `horner` at 1,
+/// without allocation for K < 64.
+fn series_at_one(k: u32, n: u32) -> f64 {
+    if k >= 64 {
+        return horner(&Coefficients::new(k, k, n).c, 1.0);
+    }
+    let alpha = n as f64 + 0.5;
+    let mut c = [0.0f64; 64];
+    let mut ck = 1.0;
+    for i in 0..=k {
+        c[i as usize] = ck;
+        ck *= ((k - i) as f64) * ((k - i) as f64) / (((i + 1) as f64) * (i as f64 + 1.0 + alpha));
+    }
+    horner(&c[..=k as usize], 1.0)
 }
 
 /// `Σ_k coef_k r^k` (Horner).
@@ -243,7 +268,8 @@ pub(crate) fn series_coefficients<const D: usize>(go: &GvrOps<D>, ki: u32, kj: u
 
 /// The Coulomb τ-integral `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ / e^L` of one pair
 /// (K_I, K_J) for each of `inputs` = `[x, y, z, γ_I, γ_J]` (`quadrature`), with its partial
-/// derivatives with respect to the five inputs (`quadrature_partials`), into `out`.
+/// derivatives with respect to the five inputs (the maths of `quadrature_partials`), into
+/// `out`: nodes in lanes of the f64 kernel (`gvr_kernel::integral_partials`, `gvr_build::partials`).
 pub(crate) fn coulomb_partials<const D: usize>(
     go: &GvrOps<D>,
     ki: u32,
@@ -251,11 +277,12 @@ pub(crate) fn coulomb_partials<const D: usize>(
     inputs: &[[f64; 5]],
     out: &mut [(f64, [f64; 5])],
 ) {
-    let series = Coefficients::new(ki, kj, go.n_ang);
+    let c = Coefficients::new(ki, kj, go.n_ang).c;
     let rule = go.legendre[(ki + kj + go.n_ang) as usize];
-    for (x, o) in inputs.iter().zip(out.iter_mut()) {
-        *o = quadrature_partials(*x, rule, &series);
-    }
+    let padded = rule.len().div_ceil(MAX_W) * MAX_W;
+    let tau2: Vec<f64> = (0..padded).map(|i| rule.get(i).map_or(0.0, |(t, _)| t * t)).collect();
+    let weight: Vec<f64> = (0..padded).map(|i| rule.get(i).map_or(0.0, |(_, w)| *w)).collect();
+    gvr_build::partials(&c, (ki, kj, go.n_ang), &tau2, &weight, inputs, out);
 }
 
 /// Ω and its derivatives divided by `e^L`, `L = (K_I+N/2) ln x + (K_J+N/2) ln y`:
@@ -363,6 +390,22 @@ pub struct EcgGvr;
 
 impl<const D: usize> Family<D> for EcgGvr {
     const NAME: &'static str = "ecg-gvr";
+
+    /// The f64 kernel (`gvr_build`, `gvr_kernel`).
+    fn matrices(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &Params) -> Result<Matrices> {
+        gvr_build::matrices(go, sym, basis, best_isa())
+    }
+
+    /// The f64 kernel, oriented as `path::rows` (`gvr_build`).
+    fn rows(
+        go: &GvrOps<D>,
+        sym: &Symmetry<D>,
+        trials: &Params,
+        basis: &Params,
+        position: Option<usize>,
+    ) -> Result<(Matrices, Vec<Element>)> {
+        gvr_build::rows(go, sym, trials, basis, position, best_isa())
+    }
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
 
@@ -498,6 +541,43 @@ mod tests {
             for k in 0..5 {
                 let tol = 1e-12 * (eps[k].abs() + scale);
                 assert!((d[k] - eps[k]).abs() < tol, "K=({ki},{kj}) N={n}: ∂/∂input {k}: {} vs {}", d[k], eps[k]);
+            }
+        }
+    }
+
+    #[test]
+    fn coulomb_partials_match_the_node_loop() {
+        // valid covariance inputs as in `quadrature_partials_match_dual_numbers`, several per call
+        let dot = |a: &[f64; 3], b: &[f64; 3]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let e = [0.6, 0.0, 0.8];
+        let inputs: Vec<[f64; 5]> = [([0.9, -0.3, 0.4], [0.2, 0.7, -0.5]), ([0.1, 0.5, 0.3], [0.6, 0.2, 0.1]), ([0.6, 0.0, 0.8], [0.5, 0.1, 0.7])]
+            .iter()
+            .map(|(p, q)| [dot(p, p), dot(q, q), dot(p, q), dot(p, &e), dot(q, &e)])
+            .collect();
+        let ops = Operators { lambda: Mat::<2>::identity(), pairs: vec![], cm_mass: None };
+        for n in 0..3 {
+            let go = GvrOps::new(ops.clone(), n, 40).unwrap();
+            for (ki, kj) in [(0, 0), (1, 0), (0, 3), (2, 2), (7, 4), (19, 12), (30, 24), (40, 40)] {
+                let mut out = vec![(0.0, [0.0; 5]); inputs.len()];
+                coulomb_partials(&go, ki, kj, &inputs, &mut out);
+                let series = Coefficients::new(ki, kj, n);
+                let rule = go.legendre[(ki + kj + n) as usize];
+                for (x, (f, d)) in inputs.iter().zip(&out) {
+                    let (f0, d0) = quadrature_partials(*x, rule, &series);
+                    assert!((f - f0).abs() <= 1e-13 * f0.abs(), "K=({ki},{kj}) N={n}: {f} vs {f0}");
+                    for k in 0..5 {
+                        assert!((d[k] - d0[k]).abs() <= 1e-13 * d0[k].abs().max(f0.abs()), "K=({ki},{kj}) N={n} ∂{k}: {} vs {}", d[k], d0[k]);
+                    }
+                }
+                // the same bits on every instruction set
+                let padded = rule.len().div_ceil(MAX_W) * MAX_W;
+                let tau2: Vec<f64> = (0..padded).map(|i| rule.get(i).map_or(0.0, |(t, _)| t * t)).collect();
+                let weight: Vec<f64> = (0..padded).map(|i| rule.get(i).map_or(0.0, |(_, w)| *w)).collect();
+                for isa in [crate::build::Isa::Plain, crate::build::Isa::Avx2, crate::build::Isa::Avx512] {
+                    let mut o = vec![(0.0, [0.0; 5]); inputs.len()];
+                    gvr_build::partials_with(isa, &series.c, (ki, kj, n), &tau2, &weight, &inputs, &mut o);
+                    assert_eq!(o, out, "{isa:?}");
+                }
             }
         }
     }

@@ -18,10 +18,12 @@ pub mod fecg;
 pub mod fecg_gradient;
 pub mod gradient;
 pub mod gvr;
+pub mod gvr_build;
 /// The closed-form Coulomb τ-integral (docs/gvr.md): slower than the quadrature it checks.
 #[cfg(test)]
 mod gvr_coulomb;
 pub mod gvr_gradient;
+pub mod gvr_kernel;
 pub mod images;
 pub mod matrices;
 pub mod operators;

@@ -1,0 +1,181 @@
+//! The f64 kernel against `gvr::element` (the generic path), the same bits on every instruction
+//! set, and rows patched into matrices with the bits of a full build.
+use super::*;
+use crate::ecg::{Mat, Operators, Vector};
+use crate::build;
+use crate::family::Family;
+
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
+/// Flat parameters of `nb` random functions: `A = L Lᵀ + 0.05`, `u`, K in `0..=k_max`, `c_A`.
+struct Basis {
+    a: Vec<f64>,
+    c_a: Vec<f64>,
+    u: Vec<f64>,
+    k: Vec<u32>,
+}
+
+impl Basis {
+    fn random<const D: usize>(rng: &mut Rng, nb: usize, k_max: u32) -> Self {
+        let mut b = Basis { a: vec![], c_a: vec![], u: vec![], k: vec![] };
+        for _ in 0..nb {
+            let l = Mat::<D>::from_fn(|r, c| if c <= r { rng.next() } else { 0.0 });
+            let a = l * l.transpose() + Mat::<D>::identity() * 0.05;
+            b.a.extend(a.transpose().iter());
+            b.u.extend((0..D).map(|_| rng.next()));
+            b.c_a.push(0.5 + rng.next().abs());
+            b.k.push(((rng.next().abs() * (k_max + 1) as f64) as u32).min(k_max));
+        }
+        b
+    }
+
+    fn params(&self) -> Params<'_> {
+        Params { a: &self.a, c_a: &self.c_a, v: &self.u, k_pow: &self.k }
+    }
+
+    /// Function `i` alone, and the others.
+    fn split<const D: usize>(&self, i: usize) -> (Basis, Basis) {
+        let pick = |keep: &dyn Fn(usize) -> bool| Basis {
+            a: (0..self.k.len()).filter(|&j| keep(j)).flat_map(|j| self.a[j * D * D..(j + 1) * D * D].to_vec()).collect(),
+            c_a: (0..self.k.len()).filter(|&j| keep(j)).map(|j| self.c_a[j]).collect(),
+            u: (0..self.k.len()).filter(|&j| keep(j)).flat_map(|j| self.u[j * D..(j + 1) * D].to_vec()).collect(),
+            k: (0..self.k.len()).filter(|&j| keep(j)).map(|j| self.k[j]).collect(),
+        };
+        (pick(&|j| j == i), pick(&|j| j != i))
+    }
+}
+
+/// Particle permutations of D particles with coefficients (all of them for D <= 3, the four of
+/// (1 − P12)(1 + P34)-type for D = 4 with unequal weights), laboratory-frame operators.
+fn system<const D: usize>(rng: &mut Rng, cm: bool) -> (Vec<(Mat<D>, f64)>, Operators<D>) {
+    let perm = |p: &[usize]| Mat::<D>::from_fn(|i, j| if p[i] == j { 1.0 } else { 0.0 });
+    let ident: Vec<usize> = (0..D).collect();
+    let mut swap01 = ident.clone();
+    swap01.swap(0, 1);
+    let mut sym = vec![(perm(&ident), 1.0), (perm(&swap01), -0.7)];
+    if D >= 4 {
+        let mut swap23 = ident.clone();
+        swap23.swap(2, 3);
+        let mut both = swap01.clone();
+        both.swap(2, 3);
+        sym.push((perm(&swap23), 0.6));
+        sym.push((perm(&both), -0.4));
+    }
+    let masses: Vec<f64> = (0..D).map(|i| if i < D / 2 { 1836.15 } else { 1.0 + 0.3 * rng.next().abs() }).collect();
+    let q: Vec<f64> = (0..D).map(|i| if i < D / 2 { 1.0 } else { -1.0 }).collect();
+    let mut pairs = Vec::new();
+    for i in 0..D {
+        for j in (i + 1)..D {
+            let mut w = Vector::<D>::zeros();
+            w[i] = 1.0;
+            w[j] = -1.0;
+            pairs.push((w, q[i] * q[j]));
+        }
+    }
+    let lambda = Mat::<D>::from_fn(|i, j| if i == j { 0.5 / masses[i] } else { 0.0 });
+    (sym, Operators { lambda, pairs, cm_mass: cm.then(|| masses.iter().sum()) })
+}
+
+fn bits(m: &Matrices) -> Vec<u64> {
+    [&m.s, &m.t, &m.t_ti, &m.v].iter().flat_map(|v| v.iter().map(|x| x.to_bits())).collect()
+}
+
+const ISAS: [Isa; 3] = [Isa::Plain, Isa::Avx2, Isa::Avx512];
+
+/// Kernel matrices against the generic path's, element (i, j) to 1e-13 of the bound of its
+/// terms: by Cauchy–Schwarz `|c_P <i|X|P j>| <= |c_P| sqrt(U_ii U_jj)` for the positive operators
+/// S, T, T_ti with their unsymmetrised diagonals `U`, and for V (indefinite: attraction and
+/// repulsion cancel in its diagonal) `Σ_pairs |q| <i|1/r|P j>` bounds it, the V of charges `|q|`.
+fn against_generic<const D: usize>(seed: u64, nb: usize, k_max: u32, n: u32, cm: bool) {
+    let mut rng = Rng(seed);
+    let (sym, ops) = system::<D>(&mut rng, cm);
+    let basis = Basis::random::<D>(&mut rng, nb, k_max);
+    let go = <EcgGvr as Family<D>>::context(ops, n, &[&basis.params()]).unwrap();
+    let reference = path::matrices::<D, EcgGvr>(&go, &sym, &basis.params()).unwrap();
+    let ident = [(Mat::<D>::identity(), 1.0)];
+    let u = path::matrices::<D, EcgGvr>(&go, &ident, &basis.params()).unwrap();
+    let mut ops_abs = go.ops.clone();
+    ops_abs.pairs.iter_mut().for_each(|(_, q)| *q = q.abs());
+    let go_abs = <EcgGvr as Family<D>>::context(ops_abs, n, &[&basis.params()]).unwrap();
+    let v_abs = path::matrices::<D, EcgGvr>(&go_abs, &ident, &basis.params()).unwrap();
+    let c_sum: f64 = sym.iter().map(|(_, c)| c.abs()).sum();
+    let fast = matrices(&go, &sym, &basis.params(), Isa::Plain).unwrap();
+    let cases = [
+        ("S", &fast.s, &reference.s, &u.s),
+        ("T", &fast.t, &reference.t, &u.t),
+        ("T_ti", &fast.t_ti, &reference.t_ti, &u.t_ti),
+        ("V", &fast.v, &reference.v, &v_abs.v),
+    ];
+    for (name, x, r, u) in cases {
+        for i in 0..nb {
+            for j in 0..nb {
+                let scale = c_sum * (u[i * nb + i] * u[j * nb + j]).abs().sqrt();
+                let (a, b) = (x[i * nb + j], r[i * nb + j]);
+                assert!(
+                    (a - b).abs() <= 1e-13 * scale,
+                    "D={D} N={n} cm={cm} {name}[{i},{j}] (K {}, {}): {a} vs {b} (scale {scale})",
+                    basis.k[i],
+                    basis.k[j]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn kernel_matches_the_generic_element() {
+    for (seed, n, cm) in [(1, 0, true), (2, 1, false), (3, 2, true), (4, 0, false)] {
+        against_generic::<2>(seed, 12, 40, n, cm);
+        against_generic::<3>(seed + 10, 12, 40, n, cm);
+        against_generic::<4>(seed + 20, 12, 40, n, cm);
+        against_generic::<4>(seed + 30, 10, 3, n, cm);
+    }
+}
+
+#[test]
+fn instruction_sets_agree_bit_for_bit() {
+    let mut rng = Rng(7);
+    let (sym, ops) = system::<4>(&mut rng, true);
+    let basis = Basis::random::<4>(&mut rng, 9, 25);
+    let trials = Basis::random::<4>(&mut rng, 2, 25);
+    let go = <EcgGvr as Family<4>>::context(ops, 1, &[&basis.params(), &trials.params()]).unwrap();
+    let m0 = matrices(&go, &sym, &basis.params(), Isa::Plain).unwrap();
+    for pos in [None, Some(0), Some(4)] {
+        let (r0, d0) = rows(&go, &sym, &trials.params(), &basis.params(), pos, Isa::Plain).unwrap();
+        for isa in ISAS {
+            assert_eq!(bits(&matrices(&go, &sym, &basis.params(), isa).unwrap()), bits(&m0), "{isa:?}");
+            let (r, d) = rows(&go, &sym, &trials.params(), &basis.params(), pos, isa).unwrap();
+            assert_eq!(bits(&r), bits(&r0), "{isa:?} {pos:?}");
+            assert_eq!(d, d0, "{isa:?}");
+        }
+    }
+}
+
+#[test]
+fn rows_patched_into_matrices_give_the_full_build() {
+    let mut rng = Rng(5);
+    let (sym, ops) = system::<4>(&mut rng, true);
+    let nb = 11;
+    let basis = Basis::random::<4>(&mut rng, nb, 30);
+    let go = <EcgGvr as Family<4>>::context(ops, 0, &[&basis.params()]).unwrap();
+    let full = matrices(&go, &sym, &basis.params(), build::best_isa()).unwrap();
+    for p in [0, 5, nb - 1] {
+        let (trial, rest) = basis.split::<4>(p);
+        let (r, d) = rows(&go, &sym, &trial.params(), &rest.params(), Some(p), build::best_isa()).unwrap();
+        for (x, row) in [(&full.s, &r.s), (&full.t, &r.t), (&full.t_ti, &r.t_ti), (&full.v, &r.v)] {
+            for j in 0..nb - 1 {
+                let col = if j < p { j } else { j + 1 };
+                assert_eq!(row[j].to_bits(), x[p * nb + col].to_bits(), "function {p}, column {col}");
+            }
+        }
+        let diag = [full.s[p * nb + p], full.t[p * nb + p], full.t_ti[p * nb + p], full.v[p * nb + p]];
+        assert_eq!([d[0].s, d[0].t, d[0].t_ti, d[0].v].map(f64::to_bits), diag.map(f64::to_bits));
+    }
+}

@@ -1,0 +1,475 @@
+//! The f64 ECG-GVR kernel of `EcgGvr::matrices` and `EcgGvr::rows`: the maths of `gvr::element`
+//! (module docs there, docs/gvr.md) without allocation, logarithms of the series or `powi`
+//! libcalls per element.
+//!
+//! - Per call, once: every function and symmetry image as a [`Prepared`] (`A`, `u`, `AΛ`, `Λu`,
+//!   its normalisation), and a [`Table`] with, for every pair (K_I, K_J) the call meets, the
+//!   series ĉ_k and the coefficients of G_x, G_y, G_z (`gvr::Coefficients`), and the even
+//!   Gauss–Legendre rule of degree K_I + K_J + N as `τ²` and weights, padded with zero weights to
+//!   a multiple of [`MAX_W`] nodes.
+//! - Per element: `B = A_I + A_J = L D Lᵀ` (root-free Cholesky), `B⁻¹ = L⁻ᵀ D⁻¹ L⁻¹`,
+//!   `ln|B| = ln Π d_k`; `x, y, z`, Ω and its derivatives by Horner in `ρ²`, the kinetic
+//!   scalars of the gvr.rs formula; per Coulomb pair `c = wᵀB⁻¹w` and `γ_I, γ_J`.
+//! - The Coulomb τ-quadrature (`integrals`) in lanes of `W` nodes, several pairs and node
+//!   blocks at once: at a node,
+//!   with `α_I = γ_I²/x`, `α_J = γ_J²/y`, `β = z/√(xy)`, `δ = γ_Iγ_J/√(xy)`,
+//!   `a = 1 − α_I τ²`, `b = 1 − α_J τ²`, `ζ = β − δ τ²`, the integrand is
+//!   `a^{K_I} b^{K_J} ζ^N G(ζ²/(ab))` (`gvr::quadrature_partials`); the integer powers by
+//!   binary exponentiation ([`pow`]), the same squarings and products in every lane. The lane
+//!   values are summed node by node in order, so the integral has the same bits for every `W`.
+//!
+//! The lanes are `[f64; W]` arrays (no fused multiply-add), instantiated per instruction set
+//! (`kernels`, chosen with `build::best_isa`): every path gives the same bits.
+#![allow(clippy::needless_range_loop)]
+use std::f64::consts::PI;
+
+use crate::ecg::{Element, Operators};
+use crate::gvr::{Coefficients, Gvr, GvrOps};
+
+/// The widest lane count (AVX-512); rules are padded to a multiple of it.
+pub const MAX_W: usize = 8;
+
+/// One function (or symmetry image) prepared for the kernel.
+#[derive(Clone, Debug)]
+pub struct Prepared<const D: usize> {
+    pub a: [[f64; D]; D],
+    pub u: [f64; D],
+    /// `A Λ`
+    pub a_lambda: [[f64; D]; D],
+    /// `Λ u`
+    pub lambda_u: [f64; D],
+    pub k: u32,
+    pub log_norm: f64,
+    pub c_a: f64,
+    pub c_u: f64,
+}
+
+impl<const D: usize> Prepared<D> {
+    pub fn new(f: &Gvr<D>, ops: &Operators<D>) -> Self {
+        let a: [[f64; D]; D] = std::array::from_fn(|i| std::array::from_fn(|j| f.a[(i, j)]));
+        let u: [f64; D] = std::array::from_fn(|i| f.u[i]);
+        let lam = &ops.lambda;
+        let a_lambda = std::array::from_fn(|i| std::array::from_fn(|j| (0..D).map(|k| a[i][k] * lam[(k, j)]).sum()));
+        let lambda_u = std::array::from_fn(|i| (0..D).map(|k| lam[(i, k)] * u[k]).sum());
+        Self { a, u, a_lambda, lambda_u, k: f.k, log_norm: f.log_norm, c_a: f.c_a, c_u: f.c_u }
+    }
+}
+
+/// A slice of the table's storage.
+#[derive(Clone, Copy, Debug, Default)]
+struct Span(usize, usize);
+
+/// The series and the rule of one pair (K_I, K_J) (module docs).
+#[derive(Clone, Copy, Debug, Default)]
+struct Entry {
+    c: Span,
+    cx: Span,
+    cy: Span,
+    cz: Span,
+    tau2: Span,
+    weight: Span,
+}
+
+/// Series and rules of the pairs (K_I, K_J) met in one call, in one flat storage.
+pub struct Table {
+    n: u32,
+    /// `index[K_I * stride + K_J]`: the entry of the pair, if tabulated
+    index: Vec<Option<Entry>>,
+    stride: usize,
+    data: Vec<f64>,
+}
+
+/// One pair's series and rule as slices.
+pub struct Series<'a> {
+    pub ki: u32,
+    pub kj: u32,
+    pub n: u32,
+    pub c: &'a [f64],
+    pub cx: &'a [f64],
+    pub cy: &'a [f64],
+    pub cz: &'a [f64],
+    pub tau2: &'a [f64],
+    pub weight: &'a [f64],
+}
+
+impl Table {
+    /// The table for the pairs (K_I, K_J) of `pairs` (repeats are tabulated once).
+    pub fn new<const D: usize>(go: &GvrOps<D>, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> Self {
+        let stride = pairs.clone().map(|(ki, kj)| ki.max(kj)).max().unwrap_or(0) as usize + 1;
+        let mut table = Self { n: go.n_ang, index: vec![None; stride * stride], stride, data: Vec::new() };
+        for (ki, kj) in pairs {
+            let at = ki as usize * stride + kj as usize;
+            if table.index[at].is_none() {
+                table.index[at] = Some(table.push(go, ki, kj));
+            }
+        }
+        table
+    }
+
+    fn push<const D: usize>(&mut self, go: &GvrOps<D>, ki: u32, kj: u32) -> Entry {
+        let s = Coefficients::new(ki, kj, go.n_ang);
+        let rule = go.rule(ki + kj + go.n_ang);
+        let padded = rule.len().div_ceil(MAX_W) * MAX_W;
+        let span = |data: &mut Vec<f64>, values: &mut dyn Iterator<Item = f64>| {
+            let start = data.len();
+            data.extend(values);
+            Span(start, data.len())
+        };
+        let d = &mut self.data;
+        Entry {
+            c: span(d, &mut s.c.iter().copied()),
+            cx: span(d, &mut s.cx.iter().copied()),
+            cy: span(d, &mut s.cy.iter().copied()),
+            cz: span(d, &mut s.cz.iter().copied()),
+            tau2: span(d, &mut (0..padded).map(|i| rule.get(i).map_or(0.0, |(t, _)| t * t))),
+            weight: span(d, &mut (0..padded).map(|i| rule.get(i).map_or(0.0, |(_, w)| *w))),
+        }
+    }
+
+    /// The series and rule of (K_I, K_J); the pair must have been tabulated.
+    #[inline]
+    pub fn series(&self, ki: u32, kj: u32) -> Series<'_> {
+        let e = self.index[ki as usize * self.stride + kj as usize].expect("pair (K_I, K_J) tabulated");
+        let s = |sp: Span| &self.data[sp.0..sp.1];
+        Series {
+            ki,
+            kj,
+            n: self.n,
+            c: s(e.c),
+            cx: s(e.cx),
+            cy: s(e.cy),
+            cz: s(e.cz),
+            tau2: s(e.tau2),
+            weight: s(e.weight),
+        }
+    }
+}
+
+/// The Coulomb pairs in the kernel's form: `2q`, `w`, and the non-zero terms `(a, b, f)` of
+/// `wᵀB⁻¹w = Σ f B⁻¹_ab` (`a <= b`, doubled off the diagonal).
+pub struct Pairs<const D: usize> {
+    pub pairs: Vec<(f64, [f64; D], Vec<(usize, usize, f64)>)>,
+}
+
+impl<const D: usize> Pairs<D> {
+    pub fn new(ops: &Operators<D>) -> Self {
+        let pre = crate::pecg::Prepared::new(ops);
+        let pairs = ops
+            .pairs
+            .iter()
+            .zip(pre.pairs)
+            .map(|((w, _), (q2, terms))| (q2, std::array::from_fn(|i| w[i]), terms))
+            .collect::<Vec<_>>();
+        assert!(pairs.len() <= MAX_PAIRS, "at most {MAX_PAIRS} Coulomb pairs");
+        Self { pairs }
+    }
+}
+
+/// `Σ_k coef_k r^k` (Horner, as `gvr::horner`).
+#[inline(always)]
+fn horner(coef: &[f64], r: f64) -> f64 {
+    coef.iter().rev().fold(0.0, |acc, ck| acc * r + ck)
+}
+
+/// `x^k` by binary exponentiation, every lane with the same operations.
+#[inline(always)]
+pub fn pow<const W: usize>(x: [f64; W], k: u32) -> [f64; W] {
+    let (mut r, mut base, mut k) = ([1.0; W], x, k);
+    loop {
+        if k & 1 == 1 {
+            r = std::array::from_fn(|l| r[l] * base[l]);
+        }
+        k >>= 1;
+        if k == 0 {
+            return r;
+        }
+        base = std::array::from_fn(|l| base[l] * base[l]);
+    }
+}
+
+/// Most Coulomb pairs of a call (`integrals`' stack storage).
+pub const MAX_PAIRS: usize = 64;
+
+/// Lane blocks evaluated together: independent Horner chains that hide the latency.
+const SLOTS: usize = 8;
+
+/// `∫_0^1 a^{K_I} b^{K_J} ζ^N G(ζ²/(ab)) dτ` (module docs) for every pair `p` of `inputs` =
+/// `[α_I, α_J, β, δ]`, into `out[p]`. The jobs (pair, block of `W` nodes) run `SLOTS` at a time;
+/// each pair's lane values are summed node by node, so `out` has the same bits for every `W`.
+#[inline(always)]
+pub fn integrals<const W: usize>(s: &Series, inputs: &[[f64; 4]], out: &mut [f64]) {
+    let blocks = s.tau2.len() / W;
+    let jobs = inputs.len() * blocks;
+    out.iter_mut().for_each(|o| *o = 0.0);
+    let mut first = 0;
+    while first < jobs {
+        let n = SLOTS.min(jobs - first);
+        let mut a = [[0.0f64; W]; SLOTS];
+        let mut b = [[0.0f64; W]; SLOTS];
+        let mut zeta = [[0.0f64; W]; SLOTS];
+        let mut r = [[0.0f64; W]; SLOTS];
+        for j in 0..n {
+            let (p, c) = ((first + j) / blocks, (first + j) % blocks);
+            let [al_i, al_j, beta, delta] = inputs[p];
+            let t2 = &s.tau2[c * W..(c + 1) * W];
+            for l in 0..W {
+                a[j][l] = (1.0 - al_i * t2[l]).max(0.0);
+                b[j][l] = (1.0 - al_j * t2[l]).max(0.0);
+                zeta[j][l] = beta - delta * t2[l];
+                let ab = a[j][l] * b[j][l];
+                r[j][l] = if ab > 0.0 { (zeta[j][l] * zeta[j][l] / ab).min(1.0) } else { 1.0 };
+            }
+        }
+        // all SLOTS blocks (unused ones at r = 0): a fixed trip count keeps the blocks in registers
+        let mut g = [[0.0f64; W]; SLOTS];
+        for ck in s.c.iter().rev() {
+            for j in 0..SLOTS {
+                for l in 0..W {
+                    g[j][l] = g[j][l] * r[j][l] + ck;
+                }
+            }
+        }
+        for j in 0..n {
+            let (p, c) = ((first + j) / blocks, (first + j) % blocks);
+            let (pa, pb, pz) = (pow(a[j], s.ki), pow(b[j], s.kj), pow(zeta[j], s.n));
+            let wt = &s.weight[c * W..(c + 1) * W];
+            for l in 0..W {
+                out[p] += wt[l] * pa[l] * pb[l] * pz[l] * g[j][l];
+            }
+        }
+        first += n;
+    }
+}
+
+/// `B⁻¹` (full) and `|B|` of `B = L D Lᵀ`; `None` unless every pivot is positive and finite.
+#[inline(always)]
+fn inverse_det<const D: usize>(m: &[[f64; D]; D]) -> Option<([[f64; D]; D], f64, [f64; D])> {
+    let mut lo = [[0.0f64; D]; D];
+    let mut e = [[0.0f64; D]; D];
+    let mut rd = [0.0f64; D];
+    let mut dk = [0.0f64; D];
+    let mut det = 1.0;
+    for k in 0..D {
+        for i in k..D {
+            let mut v = m[k][i];
+            for r in 0..k {
+                v -= e[i][r] * lo[k][r];
+            }
+            if i == k {
+                if !(v > 0.0 && v.is_finite()) {
+                    return None;
+                }
+                rd[k] = 1.0 / v;
+                dk[k] = v;
+                det *= v;
+            } else {
+                e[i][k] = v;
+                lo[i][k] = v * rd[k];
+            }
+        }
+    }
+    // L⁻¹ (unit lower triangular)
+    let mut inv = [[0.0f64; D]; D];
+    for k in 0..D {
+        inv[k][k] = 1.0;
+        for i in (k + 1)..D {
+            let mut x = -lo[i][k];
+            for r in (k + 1)..i {
+                x -= lo[i][r] * inv[r][k];
+            }
+            inv[i][k] = x;
+        }
+    }
+    // B⁻¹_ab = Σ_{k >= max(a, b)} (L⁻¹)_ka (L⁻¹)_kb / d_k
+    let mut b = [[0.0f64; D]; D];
+    for a in 0..D {
+        for c in a..D {
+            let mut x = 0.0;
+            for k in c..D {
+                x += inv[k][a] * inv[k][c] * rd[k];
+            }
+            b[a][c] = x;
+            b[c][a] = x;
+        }
+    }
+    Some((b, det, dk))
+}
+
+#[inline(always)]
+fn dot<const D: usize>(p: &[f64; D], q: &[f64; D]) -> f64 {
+    (0..D).fold(0.0, |acc, k| acc + p[k] * q[k])
+}
+
+#[inline(always)]
+fn mat_vec<const D: usize>(m: &[[f64; D]; D], v: &[f64; D]) -> [f64; D] {
+    std::array::from_fn(|i| dot(&m[i], v))
+}
+
+/// `<φ_I| 1, T, T_TI, V |φ_J>` of two prepared functions (`gvr::element`'s formulas).
+#[inline(always)]
+pub fn element<const D: usize, const W: usize>(
+    bra: &Prepared<D>,
+    ket: &Prepared<D>,
+    table: &Table,
+    pairs: &Pairs<D>,
+    cm_mass: Option<f64>,
+) -> Element {
+    let bsum: [[f64; D]; D] = std::array::from_fn(|i| std::array::from_fn(|j| bra.a[i][j] + ket.a[i][j]));
+    let Some((binv, det, dk)) = inverse_det(&bsum) else {
+        return Element::nan();
+    };
+    let log_det = if det.is_normal() { det.ln() } else { dk.iter().map(|d| d.ln()).sum() };
+    let gi = mat_vec(&binv, &bra.u);
+    let gj = mat_vec(&binv, &ket.u);
+    let x = dot(&bra.u, &gi) * 0.5;
+    let y = dot(&ket.u, &gj) * 0.5;
+    let z = dot(&bra.u, &gj) * 0.5;
+    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
+    let s = table.series(bra.k, ket.k);
+    let (l, om, ox, oy, oz) = omega(&s, x, y, z);
+    let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
+
+    // kinetic with Λ (gvr.rs module docs)
+    let zl = mat_vec(&ket.a, &bra.lambda_u); // A_J Λ u_I
+    let zr = mat_vec(&bra.a, &ket.lambda_u); // A_I Λ u_J
+    let w: [[f64; D]; D] = std::array::from_fn(|i| std::array::from_fn(|j| (0..D).fold(0.0, |acc, k| acc + bra.a_lambda[i][k] * ket.a[k][j])));
+    let mut tr_wc = 0.0;
+    for a in 0..D {
+        for b in 0..D {
+            tr_wc += binv[a][b] * w[b][a];
+        }
+    }
+    let tr_wc = tr_wc * 0.5;
+    let hi: [f64; D] = std::array::from_fn(|k| gi[k] * 0.5);
+    let hj: [f64; D] = std::array::from_fn(|k| gj[k] * 0.5);
+    let (w_hi, w_hj) = (mat_vec(&w, &hi), mat_vec(&w, &hj));
+    let t = dot(&bra.u, &ket.lambda_u) * oz - 4.0 * dot(&zl, &hi) * ox - 2.0 * dot(&zl, &hj) * oz
+        - 4.0 * dot(&zr, &hj) * oy
+        - 2.0 * dot(&zr, &hi) * oz
+        + 12.0 * tr_wc * om
+        + 8.0 * dot(&hi, &w_hi) * ox
+        + 4.0 * (dot(&hi, &w_hj) + dot(&hj, &w_hi)) * oz
+        + 8.0 * dot(&hj, &w_hj) * oy;
+    let t = scale * t;
+    let t_ti = match cm_mass {
+        Some(m) => t - scale * cm_kinetic(bra.c_a, ket.c_a, bra.c_u, ket.c_u, m, (om, ox, oy, oz)),
+        None => t,
+    };
+
+    // Coulomb: the τ-quadrature of every pair
+    let rt = (x * y).sqrt();
+    let np = pairs.pairs.len();
+    let mut inputs = [[0.0f64; 4]; MAX_PAIRS];
+    let mut factor = [0.0f64; MAX_PAIRS];
+    for (p, (q2, wv, terms)) in pairs.pairs.iter().enumerate() {
+        let c = terms.iter().fold(0.0, |acc, &(a, b, f)| acc + f * binv[a][b]);
+        let sq = (c * 2.0).sqrt();
+        let (gam_i, gam_j) = (dot(&gi, wv) / sq, dot(&gj, wv) / sq);
+        inputs[p] = [gam_i * gam_i / x, gam_j * gam_j / y, z / rt, gam_i * gam_j / rt];
+        factor[p] = q2 / (c * PI).sqrt();
+    }
+    let mut integral = [0.0f64; MAX_PAIRS];
+    integrals::<W>(&s, &inputs[..np], &mut integral[..np]);
+    let v = (0..np).fold(0.0, |acc, p| acc + factor[p] * integral[p]);
+    Element { s: scale * om, t, t_ti, v: scale * v }
+}
+
+/// `gvr::omega` from the tabulated series: `(L, ω, ω_x, ω_y, ω_z)`.
+#[inline(always)]
+fn omega(s: &Series, x: f64, y: f64, z: f64) -> (f64, f64, f64, f64, f64) {
+    let nf = s.n as f64;
+    let rt = (x * y).sqrt();
+    let rho = (z / rt).clamp(-1.0, 1.0);
+    let r2 = rho * rho;
+    let (g, gx, gy, gz) = (horner(s.c, r2), horner(s.cx, r2), horner(s.cy, r2), horner(s.cz, r2));
+    let rho_n = pow([rho], s.n)[0];
+    let l = x.ln() * (s.ki as f64 + 0.5 * nf) + y.ln() * (s.kj as f64 + 0.5 * nf);
+    let omega_z = if s.n == 0 { rho * gz / rt } else { pow([rho], s.n - 1)[0] * gz / rt };
+    (l, rho_n * g, rho_n * gx / x, rho_n * gy / y, omega_z)
+}
+
+/// `gvr::cm_kinetic` in f64.
+#[inline(always)]
+fn cm_kinetic(ci: f64, cj: f64, ui: f64, uj: f64, m: f64, w: (f64, f64, f64, f64)) -> f64 {
+    let (om, ox, oy, oz) = w;
+    let s = ci + cj;
+    om * (3.0 * ci * cj / (m * s)) - (ui * ui * cj * ox + uj * uj * ci * oy) / (m * s)
+        + (ui * ui * ox + ui * uj * oz + uj * uj * oy) * (ci * cj) / (m * s * s)
+}
+
+/// `Σ_P c_P <bra| O |P ket>` over the images of one ket.
+#[inline(always)]
+pub fn symmetrised<const D: usize, const W: usize>(
+    bra: &Prepared<D>,
+    images: &[Prepared<D>],
+    coef: &[f64],
+    table: &Table,
+    pairs: &Pairs<D>,
+    cm_mass: Option<f64>,
+) -> Element {
+    let mut e = Element::zero();
+    for (ket, c) in images.iter().zip(coef) {
+        e += (*c, element::<D, W>(bra, ket, table, pairs, cm_mass));
+    }
+    e
+}
+
+/// `∫_0^1 P dτ` with its partial derivatives with respect to `[x, y, z, γ_I, γ_J]`
+/// (`gvr::quadrature_partials`: the same chain rule through `a`, `b`, `ζ`) in lanes of `W`
+/// nodes of the padded rule (`tau2`, `weight`), summed node by node. The series of `P_a`,
+/// `P_b`, `P_ζ` come from G and G' alone: `Σ ĉ_k(K_I−k) r^k = K_I G − r G'`, likewise K_J,
+/// and `Σ ĉ_k(N+2k) r^k = N G + 2 r G'` (for N = 0 over r: `2 G'`).
+#[inline(always)]
+pub fn integral_partials<const W: usize>(
+    c: &[f64],
+    (ki, kj, n): (u32, u32, u32),
+    tau2: &[f64],
+    weight: &[f64],
+    inputs: [f64; 5],
+) -> (f64, [f64; 5]) {
+    let [x, y, z, gam_i, gam_j] = inputs;
+    let rt = (x * y).sqrt();
+    let (kif, kjf, nf) = (ki as f64, kj as f64, n as f64);
+    let (mut f, mut d) = (0.0, [0.0; 5]);
+    for (t2, wt) in tau2.chunks_exact(W).zip(weight.chunks_exact(W)) {
+        let a: [f64; W] = std::array::from_fn(|l| (1.0 - gam_i * gam_i * t2[l] / x).max(0.0));
+        let b: [f64; W] = std::array::from_fn(|l| (1.0 - gam_j * gam_j * t2[l] / y).max(0.0));
+        let zeta: [f64; W] = std::array::from_fn(|l| (z - gam_i * gam_j * t2[l]) / rt);
+        let r: [f64; W] = std::array::from_fn(|l| {
+            let ab = a[l] * b[l];
+            if ab > 0.0 { (zeta[l] * zeta[l] / ab).min(1.0) } else { 1.0 }
+        });
+        // G and G' by one Horner pass
+        let (mut g, mut gp) = ([0.0f64; W], [0.0f64; W]);
+        for ck in c.iter().rev() {
+            for l in 0..W {
+                gp[l] = gp[l] * r[l] + g[l];
+                g[l] = g[l] * r[l] + ck;
+            }
+        }
+        let one = [1.0f64; W];
+        let (pa1, pb1) = (if ki > 0 { pow(a, ki - 1) } else { one }, if kj > 0 { pow(b, kj - 1) } else { one });
+        let pz1 = if n > 0 { pow(zeta, n - 1) } else { one };
+        for l in 0..W {
+            let pa = if ki > 0 { pa1[l] * a[l] } else { 1.0 };
+            let pb = if kj > 0 { pb1[l] * b[l] } else { 1.0 };
+            let pz = if n > 0 { pz1[l] * zeta[l] } else { 1.0 };
+            let w = wt[l];
+            f += w * pa * pb * pz * g[l];
+            let p_a = if ki > 0 { w * pa1[l] * pb * pz * (kif * g[l] - r[l] * gp[l]) } else { 0.0 };
+            let p_b = if kj > 0 { w * pa * pb1[l] * pz * (kjf * g[l] - r[l] * gp[l]) } else { 0.0 };
+            let p_z = match n {
+                0 if ki > 0 && kj > 0 => w * pa1[l] * pb1[l] * zeta[l] * (2.0 * gp[l]),
+                0 => 0.0,
+                _ => w * pa * pb * pz1[l] * (nf * g[l] + 2.0 * r[l] * gp[l]),
+            };
+            let t = t2[l];
+            d[0] += p_a * gam_i * gam_i * t / (x * x) - p_z * zeta[l] / (2.0 * x);
+            d[1] += p_b * gam_j * gam_j * t / (y * y) - p_z * zeta[l] / (2.0 * y);
+            d[2] += p_z / rt;
+            d[3] += -p_a * 2.0 * gam_i * t / x - p_z * gam_j * t / rt;
+            d[4] += -p_b * 2.0 * gam_j * t / y - p_z * gam_i * t / rt;
+        }
+    }
+    (f, d)
+}
