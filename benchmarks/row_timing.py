@@ -62,7 +62,7 @@ def main():
     for name, g, b in cases:
         t_row = seconds(lambda: rep.rows(g, b), args.repeat)
         t_grad = seconds(lambda: rep.row_gradient(g, dA, dv, b), args.repeat)
-        print(f"| {name} | {1e3 * t_row:.1f} | {1e3 * t_grad:.1f} |")
+        print(f"| {name} | {1e3 * t_row:.3f} | {1e3 * t_grad:.3f} |")
 
 
 if __name__ == "__main__":
