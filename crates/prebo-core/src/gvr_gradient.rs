@@ -221,7 +221,6 @@ fn image<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, ser: &Serie
 
 /// The explicit and `g`-adjoints of the kinetic scalars `p` (shared by `T` and `T_TI`) for
 /// `sw = s [ω, ω_x, ω_y, ω_z]`; `xyz` left zero (module docs).
-#[allow(clippy::too_many_arguments)]
 fn kinetic<const D: usize>(
     ket: &Gvr<D>,
     lam: &Mat<D>,
@@ -301,7 +300,6 @@ fn coulomb<const D: usize>(
 }
 
 /// `(G_O, g_O)` of one output of value `o` from its adjoints (module docs).
-#[allow(clippy::too_many_arguments)]
 fn fold<const D: usize>(
     adj: &Adjoint<D>,
     o: f64,
