@@ -1,7 +1,7 @@
 """TOML input files; each table mirrors a Python object:
 
     [system]     particles = ["p", "e", {name = "x", mass = 3.0, charge = 1, spin = 0.5}]   -> System
-    [state]      N = 0, parity = 1, spin = {e = 0}                                          -> State
+    [state]      N = 0, parity = 1, spin = {e = 0}, threshold = -7.28                       -> State
     [basis]      type = "pecg", size = 100, c_A = 1.0, K_max = 20     -> Optimiser.kind (a prebo.basis.family), .size, .c_A, .K_max
     [optimiser]  trials = 20, sweeps = 1, seed = 1, channels = "pairs", length_range = [0.01, 15]
 
@@ -56,7 +56,7 @@ def from_dict(d: dict) -> Job:
     if unknown:
         raise InputError(f"unknown tables {sorted(unknown)}")
     system_t = _table(d, "system", {"particles"})
-    state_t = _table(d, "state", {"N", "parity", "spin"})
+    state_t = _table(d, "state", {"N", "parity", "spin", "threshold"})
     basis_t = _table(d, "basis", set(BASIS_KEYS))
     opt_t = _table(d, "optimiser", OPTIMISER_KEYS)
     if "particles" not in system_t:

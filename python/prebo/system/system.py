@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..validation import MAX_PARTICLES, half_integer, strict_keywords
+from ..validation import MAX_PARTICLES, half_integer, number, strict_keywords
 from .particles import Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
 
@@ -23,12 +23,15 @@ class State:
     Parameters: `N`, the total orbital angular momentum quantum number (≥ 0, units of ħ);
     `parity`, +1 or -1; `spin`, {particle name: total spin S} of each group of identical
     particles (0, 1/2, 1, ...); a group not named gets its lowest total spin (singlet,
-    doublet, para). InputError for anything else (unknown keywords included).
+    doublet, para); `threshold`, a dissociation threshold (Eh) the user knows to lie below the
+    hydrogen-like ones `prebo.thresholds` finds (e.g. Li⁺ + e for Li), or None. InputError for
+    anything else (unknown keywords included).
     """
 
     N: int = 0
     parity: int = 1
     spin: dict = field(default_factory=dict)
+    threshold: float | None = None
 
     def __post_init__(self):
         if isinstance(self.N, bool) or not isinstance(self.N, int) or self.N < 0:
@@ -39,6 +42,8 @@ class State:
             raise InputError(f"state: spin = {self.spin!r}: must map particle names to total spins, e.g. {{e = 0}}")
         for name, S in self.spin.items():
             half_integer(S, f"state: spin of {name!r}")
+        if self.threshold is not None:
+            object.__setattr__(self, "threshold", number(self.threshold, "state: threshold"))
 
 
 class System:
@@ -169,12 +174,13 @@ class System:
 
     # --- I/O -----------------------------------------------------------------
     def to_dict(self) -> dict:
-        """basis.json's "system" block: the particles and the state with every group's total spin."""
-        return {
-            "particles": [p.to_dict() for p in self.particles],
-            "state": {"N": self.state.N, "parity": self.state.parity,
-                      "spin": {g.name: float(g.total_spin) for g in self.groups}},
-        }
+        """basis.json's "system" block: the particles and the state with every group's total spin
+        (and its threshold, only when one is given)."""
+        state = {"N": self.state.N, "parity": self.state.parity,
+                 "spin": {g.name: float(g.total_spin) for g in self.groups}}
+        if self.state.threshold is not None:
+            state["threshold"] = self.state.threshold
+        return {"particles": [p.to_dict() for p in self.particles], "state": state}
 
     @classmethod
     def from_dict(cls, d: dict, symmetry: dict | None = None) -> "System":
@@ -183,9 +189,9 @@ class System:
         if not isinstance(d, dict) or "particles" not in d:
             raise InputError("system: missing 'particles'")
         if not isinstance(d.get("state", {}), dict):
-            raise InputError(f"state = {d['state']!r}: must be a table of N, parity and spin")
+            raise InputError(f"state = {d['state']!r}: must be a table of N, parity, spin and threshold")
         st = dict(d.get("state", {}))
-        unknown = set(st) - {"N", "parity", "spin"}
+        unknown = set(st) - {"N", "parity", "spin", "threshold"}
         if unknown:
             raise InputError(f"state: unknown keys {sorted(unknown)}")
         return cls(d["particles"], State(**st),
