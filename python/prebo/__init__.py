@@ -8,6 +8,7 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.integrals`, `prebo.eigen`: matrices and the generalised eigenproblem;
 - `prebo.optimise`: `Optimiser` settings and `optimise`, the stochastic variational driver;
 - `prebo.results`: `evaluate`, the energies of a basis;
+- `prebo.thresholds`: the lowest dissociation threshold, below which a state is bound;
 - `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
 - `prebo.cli`, `prebo.plot`: the command line and convergence plots.
 
