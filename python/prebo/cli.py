@@ -41,6 +41,10 @@ def _print_result(r: dict) -> None:
     if r.get("energy_lab") is not None:
         t.add_row("energy (laboratory frame)", f"{r['energy_lab']:.12f} Eh")
     t.add_row("virial η_TI", f"{r['virial']:.2e}")
+    for fragments, energy in r["thresholds"].items():
+        t.add_row("given threshold" if fragments == "given" else "dissociation threshold",
+                  f"{energy:.12f} Eh" + ("" if fragments == "given" else f" ({fragments})"))
+    t.add_row("binding energy", f"{r['binding_energy']:.3e} Eh ({'bound' if r['bound'] else 'not bound'})")
     t.add_row("basis", f"{r['n_basis']} {r['basis_type']} functions")
     t.add_row("particles", " ".join(p["name"] for p in r["particles"]))
     t.add_row("overlap condition", f"{r['overlap_condition']:.2e} ({r['kept']} kept)")
@@ -51,9 +55,20 @@ def _print_result(r: dict) -> None:
     Console().print(t)
 
 
+def _warn_if_unbound(r: dict) -> None:
+    """One line on stderr when the energy is not below the lowest dissociation threshold (`results`),
+    after the result (a closed output pipe shows before it)."""
+    sys.stdout.flush()
+    if not r["bound"]:
+        print(f"prebo: warning: E = {r['energy']:.12g} Eh is not below the dissociation threshold "
+              f"{r['threshold']:.12g} Eh ({r['threshold_fragments']}): the state is not bound in this basis "
+              "(a small virial coefficient is no evidence of binding)", file=sys.stderr)
+
+
 def cmd_run(args) -> int:
     """`prebo run INPUT [--out DIR]` or `prebo run --resume DIR`: optimise, then write DIR/result.json
-    (`_result`, energies in Eh) beside the checkpoint DIR/basis.json. Returns the exit status 0."""
+    (`_result`, energies in Eh) beside the checkpoint DIR/basis.json; warn when the state is not
+    bound in the basis. Returns the exit status 0."""
     from .io.basis_json import write_json_atomic
     from .errors import InputError, StalledError
     from .io import toml
@@ -87,6 +102,7 @@ def cmd_run(args) -> int:
     if not args.quiet:
         _print_result(r)
         print(f"wrote {out / 'result.json'} and {out / 'basis.json'}")
+    _warn_if_unbound(r)
     return 0
 
 
@@ -138,13 +154,15 @@ def load_basis(path):
 
 def cmd_energy(args) -> int:
     """`prebo energy BASIS [--coordinates lab|ti] [--operator NAME ...] [--json]`: re-evaluate a
-    stored basis (Eh), with the expectation values of registered operators."""
+    stored basis (Eh), with the expectation values of registered operators; a warning on stderr
+    (exit status 0) when the state is not bound in the basis."""
     basis = load_basis(args.basis)
     r = _result(basis, args.basis, args.coordinates, args.operator)
     if args.json:
         print(json.dumps(r, allow_nan=False))
     else:
         _print_result(r)
+    _warn_if_unbound(r)
     return 0
 
 

@@ -6,6 +6,9 @@ module because it uses every earlier stage and none of them uses it.
 
 result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_uncertainty
 (Eh, below), energy_lab (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential,
+threshold (the lowest dissociation threshold, Eh: `thresholds.lowest`), threshold_fragments (its
+fragments, "p-e + e", or "given"), thresholds ({fragments or "given": Eh} of both candidates),
+bound (energy < threshold − energy_uncertainty), binding_energy (threshold − energy, Eh),
 n_basis, basis_type, particles, state, symmetry, coordinates, overlap_condition, kept; with
 `operators`, expectation ({operator: {pair class: value}} of operators registered in
 `expectation.OPERATORS`, e.g. ⟨r_ij²⟩ in bohr²); for floating ECGs also n2 = <N²>_TI (their
@@ -17,6 +20,10 @@ deviation that element errors of a few ulp (4 u each, independent) of S, T_TI an
 ε (2 Σ_ij w_ij − Σ_i w_ii)^½ with w_ij = c_i² c_j² (T_ij² + V_ij² + E² S_ij²) (`eigen.energy_uncertainty`;
 docs/conventions.md compares it with Monte-Carlo perturbations): an ill-conditioned basis resolves
 its energy no better than this. A non-finite element of H or S is an error (`eigen.solve`), never a number.
+
+`bound` is False when the energy is not below the threshold: the basis describes fragments and free
+particles, not a bound state. The virial coefficient cannot tell: a basis scaled to its variational
+optimum satisfies the virial theorem, 2<T> + <V> = 0, whatever it describes (tests/test_thresholds.py).
 """
 from __future__ import annotations
 
@@ -27,6 +34,7 @@ from .basis import Basis
 from .errors import InputError
 from .expectation import expectation, operator
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
+from .thresholds import candidates, lowest
 
 
 def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13, operators=()) -> dict:
@@ -40,9 +48,9 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13, o
     "r2") whose expectation values to add.
 
     Returns a dict with the keys of the module docstring — energy, energy_uncertainty,
-    energy_lab, kinetic and potential in Eh; virial, overlap_condition dimensionless; n2
-    in ħ²; expectation in each operator's unit — and `coefficients`, the S-normalised
-    ground-state vector. InputError for a basis that is not a non-empty `Basis`, an unknown
+    energy_lab, kinetic, potential, threshold and binding_energy in Eh; bound a bool; virial,
+    overlap_condition dimensionless; n2 in ħ²; expectation in each operator's unit — and
+    `coefficients`, the S-normalised ground-state vector. InputError for a basis that is not a non-empty `Basis`, an unknown
     `coordinates` or operator; NonFiniteError and the eigen errors as `eigen.solve` raises them."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"evaluate: basis = {basis!r}: must be a prebo.Basis with at least one function")
@@ -75,6 +83,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13, o
         extra["n2"] = float(c @ n2 @ c)
     if operators:
         extra["expectation"] = {name: expectation(rep, basis, c, name) for name in operators}
+    low = lowest(system)
     return extra | {
         "energy": energy,
         "energy_uncertainty": uncertainty,
@@ -82,6 +91,11 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13, o
         "virial": abs(1.0 + potential / (2.0 * kinetic)),
         "kinetic": kinetic,
         "potential": potential,
+        "threshold": low.energy,
+        "threshold_fragments": low.fragments,
+        "thresholds": {t.fragments: t.energy for t in candidates(system)},
+        "bound": energy < low.energy - uncertainty,
+        "binding_energy": low.energy - energy,
         "n_basis": len(basis),
         "basis_type": basis.family.name,
         "particles": [p.to_dict() for p in system.particles],
