@@ -45,6 +45,7 @@ TOML = EDGES | EDGES | st.recursive(SCALARS.filter(lambda v: v is not None),
 
 #: positions a corruption most often matters at (the state, the particles, the functions, the symmetry)
 SENSITIVE = [("system", "state", "N"), ("system", "state", "parity"), ("system", "state", "spin"),
+             ("system", "state", "threshold"),
              ("system", "particles"), ("system", "particles", 0, "charge"), ("system", "particles", 1, "mass"),
              ("system", "particles", 0, "spin"), ("functions",), ("functions", 0), ("functions", 0, "A"),
              ("functions", 0, "c_A"), ("functions", 0, "K"), ("functions", 0, "u"), ("basis_type",),
@@ -82,7 +83,7 @@ def assert_clean(rc, out, err):
     with one `prebo: error:` line."""
     if rc == 0:
         r = json.loads(out, parse_constant=lambda c: pytest.fail(f"{c} in the JSON output"))
-        assert np.isfinite(r["energy"])
+        assert np.isfinite(r["energy"]) and np.isfinite(r["threshold"]) and isinstance(r["bound"], bool)
         N, parity = r["state"]["N"], r["state"]["parity"]
         assert {"pecg": (N, parity) == (0, 1), "ecg-gvr": parity == (-1) ** N}.get(r["basis_type"], True), r["state"]
     else:
@@ -95,7 +96,8 @@ def checkpoints(tmp_path_factory):
     """Run checkpoints (basis.json with optimiser state) of three basis types."""
     d = tmp_path_factory.mktemp("checkpoints")
     runs = {
-        "pecg": (prebo.System(["p", "e", "e"], spin={"e": 0}), prebo.Optimiser(size=3, trials=3, seed=2, sweeps=1)),
+        "pecg": (prebo.System(["p", "e", "e"], spin={"e": 0}, threshold=-0.6),
+                 prebo.Optimiser(size=3, trials=3, seed=2, sweeps=1)),
         "gvr": (prebo.System(["p", "e"], N=1, parity=-1),
                 prebo.Optimiser(size=3, trials=3, seed=2, kind="ecg-gvr", K_max=2, channels=["jacobi:0-1"])),
         "fecg": (prebo.System(["p", "e"]), prebo.Optimiser(size=2, trials=3, seed=2, kind="fecg")),
@@ -183,7 +185,8 @@ def test_corrupted_checkpoints_on_resume(checkpoints, tmp_path, capsys, data):
     assert_clean(rc, out, err)
 
 
-TOML_KEYS = {"system": ["particles"], "state": ["N", "parity", "spin"], "basis": ["type", "size", "c_A", "K_max"],
+TOML_KEYS = {"system": ["particles"], "state": ["N", "parity", "spin", "threshold"],
+             "basis": ["type", "size", "c_A", "K_max"],
              "optimiser": sorted(s.key.partition(" ")[2] for s in SETTINGS.values() if s.key.startswith("[optimiser]"))}
 
 
@@ -227,13 +230,14 @@ def test_optimiser_arguments(name, value):
 @FUZZ
 @given(particles=st.lists(st.sampled_from(["p", "e", "e+", "alpha", "mu"]) | st.dictionaries(
     st.sampled_from(["name", "mass", "charge", "spin", "x"]), SCALARS, max_size=4), max_size=4),
-    state=st.dictionaries(st.sampled_from(["N", "parity", "spin", "L"]), JSON, max_size=3))
+    state=st.dictionaries(st.sampled_from(["N", "parity", "spin", "threshold", "L"]), JSON, max_size=3))
 def test_system_arguments(particles, state):
     try:
         system = prebo.System(particles, **state)
     except PreboError:
         return
     assert all(np.isfinite([p.mass, p.charge]).all() and p.mass > 0 for p in system.particles)
+    assert system.state.threshold is None or np.isfinite(system.state.threshold)
 
 
 # --- real processes ---------------------------------------------------------------------
