@@ -17,7 +17,7 @@ def prebo(*args, cwd=None):
 def run_dir(tmp_path_factory):
     d = tmp_path_factory.mktemp("run")
     (d / "h.toml").write_text(
-        '[system]\nparticles = ["p", "e"]\n[basis]\nsize = 6\n[optimiser]\ntrials = 8\nseed = 3\n'
+        '[system]\nparticles = ["p", "e"]\n[basis]\nsize = 6\n[optimiser]\ntrials = 8\nseed = 3\nrefine = 1\n'
     )
     r = prebo("run", d / "h.toml", "--out", d / "out", "--quiet")
     assert r.returncode == 0, r.stderr
@@ -48,6 +48,7 @@ def test_energy_json_reproduces_the_run(run_dir, coordinates):
 
 
 def test_same_seed_same_basis(run_dir, tmp_path):
+    """A fixed schedule repeats bit for bit (the adaptive one follows measured seconds)."""
     r = prebo("run", run_dir.parent / "h.toml", "--out", tmp_path, "--quiet")
     assert r.returncode == 0
     a = json.loads((run_dir / "basis.json").read_text())["functions"]
@@ -69,7 +70,7 @@ def assert_clean_error(r, *words):
     ('[{name = "p", mass = 0}, "e"]', "", ["mass = 0: must be a finite positive number"]),
     ('["alpha", "e", "e", "e"]', "[state]\nspin = { e = 1 }\n", ["cannot couple to total spin 1"]),
     ('["p", "e", "e"]', "[state]\nspin = { e = 0.3 }\n", ["spin of 'e' = 0.3: must be a spin 0, 1/2, 1"]),
-    ('["p", "e"]', "[state]\nN = 1\n", ["N = 0"]),
+    ('["p", "e"]', "[state]\nN = 1\n", ["natural parity", "not parity +1 with N = 1"]),  # ECG-GVR chosen for N = 1
     ('["p", "e"]', "[optimiser]\ncycle = 2\n", ["unknown keys ['cycle']", "'cycles'"]),
     ('["p", "e"]', "[optimiser]\ncycles = 0\n", ["[optimiser] cycles = 0: must be an integer ≥ 1"]),
 ])

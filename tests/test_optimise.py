@@ -10,6 +10,7 @@ import pytest
 
 import prebo
 from prebo.optimise import Cursor, Optimiser
+from prebo.optimise.defaults import resolved
 from conftest import ROOT
 
 INPUT = """
@@ -77,7 +78,7 @@ def test_resume_without_checkpoint_is_a_clear_error(tmp_path):
 
 
 def test_cursor_schedule():
-    opts = Optimiser(size=2, sweeps=1, refine=2, polish=2)
+    opts = resolved(Optimiser(size=2, sweeps=1, refine=2, polish=2), prebo.System(["p", "e"]))
     c, seen = Cursor().advance(0, opts), []
     nb = 0
     while c.phase != "done":
@@ -90,7 +91,7 @@ def test_cursor_schedule():
 
 
 def test_cursor_repeats_the_block_after_growth_in_cycles():
-    opts = Optimiser(size=1, sweeps=1, refine=0, polish=1, cycles=3)
+    opts = resolved(Optimiser(size=1, sweeps=1, refine=0, polish=1, cycles=3), prebo.System(["p", "e"]))
     c, seen = Cursor().advance(1, opts), []
     while c.phase != "done":
         seen.append((c.phase, c.sweep, c.index, c.cycle))
@@ -102,17 +103,20 @@ def test_cursor_repeats_the_block_after_growth_in_cycles():
 def test_each_phase_has_its_method_configured_by_the_settings():
     from prebo.optimise import Grow, Polish, Refine, Refinement, Sweep
     from prebo.optimise.methods import methods
-    plain = methods(Optimiser(trials=7, polish_iterations=9))
+    he = prebo.System(["alpha", "e", "e"])
+    plain = methods(resolved(Optimiser(trials=7, polish_iterations=9, sweeps=0), he))
     assert plain == {"grow": Grow(7), "sweep": Sweep(7), "refine": Refine(Refinement(200, "gradient")),
                      "polish": Polish(9)}
     refined = methods(Optimiser(trials=3, refine=1, refine_evaluations=40, refine_method="powell"))
     assert refined["grow"] == Grow(3, Refinement(40, "powell")) and refined["sweep"].refine == Refinement(40, "powell")
+    adaptive = methods(resolved(Optimiser(trials=5), he))  # the adaptive schedule refines every new function
+    assert adaptive["grow"] == Grow(5, Refinement(30, "gradient")) and adaptive["sweep"] == Sweep(5, Refinement(30, "gradient"))
 
 
 def test_refinement_and_learning_lower_the_energy():
     """Same seed and size: refinement and learned sampling must beat plain selection."""
     system = prebo.System(["p", "e", "e"], spin={"e": 0})
-    plain = prebo.optimise(system, Optimiser(size=8, trials=5, seed=2, learned=0.0), progress=False)
+    plain = prebo.optimise(system, Optimiser(size=8, trials=5, seed=2, learned=0.0, sweeps=0), progress=False)
     better = prebo.optimise(system, Optimiser(size=8, trials=5, seed=2, refine=1, refine_evaluations=40),
                             progress=False)
     e_plain, e_better = prebo.evaluate(plain)["energy"], prebo.evaluate(better)["energy"]

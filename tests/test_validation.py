@@ -105,7 +105,7 @@ def test_gvr_basis_file_with_unnatural_parity_is_refused(bases, tmp_path, capsys
 def test_plain_ecgs_for_a_p_state_are_refused_by_the_api():
     p2 = prebo.System(["p", "e"], N=1, parity=-1)
     with pytest.raises(InputError, match="plain ECGs .* not N = 1, parity -1"):
-        prebo.optimise(p2, prebo.Optimiser(size=4), progress=False)
+        prebo.optimise(p2, prebo.Optimiser(size=4, kind="pecg"), progress=False)
     with pytest.raises(InputError, match="N = 0, parity \\+1"):
         prebo.Basis(p2, np.eye(2)[None], [1.0])
     with pytest.raises(InputError, match="natural parity"):
@@ -114,7 +114,8 @@ def test_plain_ecgs_for_a_p_state_are_refused_by_the_api():
 
 
 def test_toml_with_plain_ecgs_or_unnatural_parity_is_refused(tmp_path, capsys):
-    toml_error(capsys, tmp_path, H_TOML + "[state]\nN = 1\nparity = -1\n", "not N = 1, parity -1")
+    toml_error(capsys, tmp_path, H_TOML.replace("size = 3", 'size = 3\ntype = "pecg"') + "[state]\nN = 1\nparity = -1\n",
+               "not N = 1, parity -1")
     toml_error(capsys, tmp_path, H_TOML.replace("size = 3", 'size = 3\ntype = "ecg-gvr"') + "[state]\nN = 2\nparity = -1\n",
                "natural parity (-1)^N = +1")
 

@@ -31,6 +31,11 @@ def _result(basis, where, coordinates: str = "lab", operators=()) -> dict:
     return r
 
 
+#: why a run stopped (optimise.convergence), as the result table says it
+STOPPED = {"exhausted": "basis exhausted (a larger basis would gain faster)", "budget": "wall-time budget used",
+           "schedule": "schedule completed", None: "interrupted"}
+
+
 def _print_result(r: dict) -> None:
     from rich.console import Console
     from rich.table import Table
@@ -48,6 +53,16 @@ def _print_result(r: dict) -> None:
     t.add_row("basis", f"{r['n_basis']} {r['basis_type']} functions")
     t.add_row("particles", " ".join(p["name"] for p in r["particles"]))
     t.add_row("overlap condition", f"{r['overlap_condition']:.2e} ({r['kept']} kept)")
+    if r.get("convergence"):
+        c = r["convergence"]
+        t.add_row("stopped", f"{STOPPED[c['stopped']]} after {c['seconds']:.1f} s")
+        if c["recent"]:
+            rate = c["recent"]["rate"]
+            t.add_row(f"last {c['recent']['steps']} steps", f"ΔE = {-c['recent']['gain']:.2e} Eh in "
+                      f"{c['recent']['seconds']:.1f} s" + (f" ({rate:.1e} Eh/s)" if rate else ""))
+        if c["extrapolation"]:
+            t.add_row("still to gain at this size", f"~{c['extrapolation']['remaining']:.1e} Eh (extrapolated: "
+                      "a power law in time; not the error against the exact energy)")
     for name, values in r.get("expectation", {}).items():
         op = OPERATORS[name]
         for pair, value in values.items():
@@ -97,7 +112,8 @@ def cmd_run(args) -> int:
         raise StalledError(f"{source}: {exc}") from exc
     title = title or basis.system.label()
     r = _result(basis, out / "basis.json")
-    r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source}
+    r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
+          "convergence": basis.convergence}
     write_json_atomic(out / "result.json", r)
     if not args.quiet:
         _print_result(r)

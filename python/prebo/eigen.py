@@ -22,6 +22,12 @@ LAPACK eigenbasis (Dongarra, Moler & Wilkinson, SIAM J. Numer. Anal. 20, 23 (198
 is the eigenvalue of the stored matrices to about an ulp, the same on every machine; a root that
 does not converge is refused (LinearDependenceError), never returned.
 
+Threads: below SERIAL_BELOW functions LAPACK and BLAS run on one thread (`lapack_threads`, in
+`solve` and around a whole optimisation);
+prebo's own parallelism is the Rust core's (rayon), and on the project's 2-core machine
+OpenBLAS's threads cost more than they give at these sizes (benchmarks/README, "LAPACK
+threads"). The refined energies do not depend on the thread count.
+
 Uncertainty: to first order an element error changes the energy by δE = cᵀ(δH − E δS)c
 (cᵀSc = 1). With independent relative errors ε of the elements of S and of each term of H
 (symmetric, i ≤ j), its standard deviation is σ = ε (2 Σ_ij w_ij − Σ_i w_ii)^½,
@@ -30,15 +36,27 @@ w_ij = c_i² c_j² (Σ_terms t_ij² + E² S_ij²); `energy_uncertainty` uses ε 
 """
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from . import _core
 from .errors import LinearDependenceError, NonFiniteError, NotPositiveDefiniteError
 
 #: relative error assumed for every stored matrix element: 4 unit roundoffs (a few ulp)
 ELEMENT_ERROR = 4 * 2.0**-53
+#: bases below this many functions are solved with LAPACK on one thread (module docstring)
+SERIAL_BELOW = 2000
+
+
+_POOLS = ThreadpoolController()  # the loaded BLAS libraries, found once (a limit then costs ~10 µs)
+
+
+def lapack_threads(nb: int):
+    """A context in which LAPACK and BLAS use one thread if `nb` < SERIAL_BELOW, their own count otherwise."""
+    return _POOLS.limit(limits=1, user_api="blas") if nb < SERIAL_BELOW else contextlib.nullcontext()
 
 
 @dataclass
@@ -70,7 +88,8 @@ def solve(H: np.ndarray, S: np.ndarray, threshold: float = 1e-13, roots: int = 1
         raise NotPositiveDefiniteError(f"overlap matrix: diagonal element {bad} is {diag[bad]:.3g}, not positive")
     d = 1.0 / np.sqrt(diag)
     Ss = S * np.outer(d, d)
-    s, V = np.linalg.eigh(Ss)
+    with lapack_threads(len(S)):
+        s, V = np.linalg.eigh(Ss)
     if s[0] < -1e3 * threshold * s[-1] - 1e-10:
         raise NotPositiveDefiniteError(f"overlap matrix is not positive definite (lowest eigenvalue {s[0]:.3g})")
     keep = s > threshold * s[-1]
@@ -78,7 +97,8 @@ def solve(H: np.ndarray, S: np.ndarray, threshold: float = 1e-13, roots: int = 1
         raise LinearDependenceError("overlap matrix has no eigenvalue above the threshold")
     X = V[:, keep] / np.sqrt(s[keep])
     Hs = H * np.outer(d, d)
-    E, Y = np.linalg.eigh(X.T @ Hs @ X)
+    with lapack_threads(len(S)):
+        E, Y = np.linalg.eigh(X.T @ Hs @ X)
     return refine(H, S, Eigen(E, d[:, None] * (X @ Y), int(keep.sum()), float(s[-1] / max(s[0], 1e-300))), roots)
 
 

@@ -4,8 +4,8 @@
   basis whose matrices fit in this machine's memory: 16 dense nb x nb float64 matrices (S, T,
   T_ti, V, their copies while a function is appended or replaced, and the eigensolver's
   working matrices), i.e. nb <= sqrt(memory / 128 bytes);
-- the rules of one value (`Integer`, `Real`, `Choice`, `Lengths`, `Channels`), with the text of
-  what they allow; the optimiser's table of settings is prebo.optimise.settings.SETTINGS;
+- the rules of one value (`Integer`, `Real`, `Choice`, `Lengths`, `Channels`, and `Automatic`
+  for a setting prebo chooses itself when it is absent), with the text of what they allow; the optimiser's table of settings is prebo.optimise.settings.SETTINGS;
 - `number`, `half_integer`: the checks of one real parameter (masses, charges; spins);
 - `strict_keywords`: unknown keyword arguments of a settings dataclass as InputError.
 The states a basis family can describe are checked by the family (prebo.basis.Family.check_state).
@@ -148,6 +148,21 @@ class Channels:
         if isinstance(v, (list, tuple)) and v and all(isinstance(c, str) for c in v):
             return list(v)
         raise Refused
+
+
+@dataclass(frozen=True)
+class Automatic:
+    """A value of `rule`, or None: absent, chosen by prebo for the system (prebo.optimise.defaults)."""
+
+    rule: object
+
+    @property
+    def allowed(self) -> str:
+        """What the rule allows, for error messages."""
+        return f"{self.rule.allowed}, or absent (chosen for the system)"
+
+    def __call__(self, v):
+        return None if v is None else self.rule(v)
 
 
 def strict_keywords(cls):

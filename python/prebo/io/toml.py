@@ -5,8 +5,9 @@
     [basis]      type = "pecg", size = 100, c_A = 1.0, K_max = 20     -> Optimiser.kind (a prebo.basis.family), .size, .c_A, .K_max
     [optimiser]  trials = 20, sweeps = 1, seed = 1, channels = "pairs", length_range = [0.01, 15]
 
-Every value is checked against optimise.settings.SETTINGS, the basis family against the state and the
-coordinate sets against the particles before anything runs; errors name the file and the key.
+Every value is checked against optimise.settings.SETTINGS, the settings left out are chosen for the
+system (optimise.defaults), the basis family is checked against the state and the coordinate
+sets against the particles before anything runs; errors name the file and the key.
 """
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from ..basis import family
 from ..errors import InputError
 from ..optimise import Optimiser, coordinate_sets
 from ..system import State, System
+from ..optimise.defaults import resolved
 from ..optimise.settings import SETTINGS, check
 from .basis_json import read_text
 
@@ -66,7 +68,7 @@ def from_dict(d: dict) -> Job:
         raise InputError(f"title = {title!r}: must be a string")
     system = System(system_t["particles"], State(**state_t))
     settings = {BASIS_KEYS[k]: v for k, v in basis_t.items()} | opt_t
-    opts = Optimiser(**{name: check(name, v, SETTINGS[name].key) for name, v in settings.items()})
+    opts = resolved(Optimiser(**{name: check(name, v, SETTINGS[name].key) for name, v in settings.items()}), system)
     family(opts.kind).check_state(system.state)
     coordinate_sets(system, opts.channels)
     return Job(title or system.label(), system, opts)

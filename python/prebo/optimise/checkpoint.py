@@ -1,6 +1,6 @@
 """Where a run stands, and its checkpoint: out/basis.json holds the basis, the settings, the
-`Cursor` (the next unit of work), the random-number state, the history and the seconds spent,
-written atomically after every step; `load_checkpoint` reads it back for `prebo run --resume`,
+`Cursor` (the next unit of work), the random-number state, the history, the seconds spent, the
+adaptive schedule's passes and why the run stopped, written atomically after every step; `load_checkpoint` reads it back for `prebo run --resume`,
 which continues the run bit for bit.
 """
 from __future__ import annotations
@@ -40,9 +40,9 @@ class Cursor:
                              "sweep, index and cycle non-negative integers")
 
     def advance(self, nb: int, opts: Optimiser) -> "Cursor":
-        """The unit of work after this one, for a basis of `nb` functions and the schedule of `opts`
-        (grow to `size`; per cycle `sweeps` replacement sweeps, `refine` refinement sweeps, `polish`
-        joint steps; `cycles` cycles)."""
+        """The unit of work after this one, for a basis of `nb` functions and the fixed schedule of
+        `opts` (settings resolved by defaults.resolved: grow to `size`; per cycle `sweeps`
+        replacement sweeps, `refine` refinement sweeps, `polish` joint steps; `cycles` cycles)."""
         if self.phase == "grow":
             if nb < opts.size:
                 return self
@@ -66,9 +66,15 @@ class Cursor:
 
 
 
+STOPPED = (None, "schedule", "exhausted", "budget")  # why a run stopped (None: it has not)
+
+
 def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> tuple:
-    """The basis, cursor, history and elapsed seconds of checkpoint content `d` (`rng` takes its
-    state); BasisFileError naming `where` for anything that does not fit."""
+    """The basis, cursor, history, elapsed seconds, adaptive schedule (schedule.Adaptive) and
+    stop reason of checkpoint content `d` (`rng` takes its state); BasisFileError naming `where`
+    for anything that does not fit."""
+    from .schedule import Adaptive
+
     basis = Basis.from_dict(d, where, empty=True)
     if basis.kind != opts.kind:
         raise BasisFileError(f"{where}: a {basis.kind} basis, but the optimiser's kind is {opts.kind}")
@@ -76,6 +82,9 @@ def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> t
         cursor = Cursor(**d["progress"])
         rng.bit_generator.state = d["rng"]
         history, elapsed = d["history"], number(d.get("elapsed", 0.0), "elapsed")
+        schedule, stopped = Adaptive.check(opts, d.get("schedule")), d.get("stopped")
+        if stopped not in STOPPED:
+            raise ValueError(f"stopped = {stopped!r}: must be one of {STOPPED}")
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise BasisFileError(f"{where}: malformed run state ({exc})") from exc
     if not (isinstance(history, list) and all(isinstance(h, list) and len(h) >= 3 for h in history)):
@@ -83,7 +92,7 @@ def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> t
     nb = len(basis)
     if (cursor.phase != "grow" and nb == 0) or (cursor.phase in ("sweep", "refine") and cursor.index >= nb):
         raise BasisFileError(f"{where}: progress {vars(cursor)} does not fit a basis of {nb} functions")
-    return basis, cursor, history, elapsed
+    return basis, cursor, history, elapsed, schedule, stopped
 
 
 def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:

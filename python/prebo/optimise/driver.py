@@ -1,5 +1,8 @@
 """The one driver: `optimise` runs the methods of the schedule (methods.py) one unit of work at a
-time, keeps the history and writes the checkpoint; `resume_from` continues a run.
+time — the fixed schedule of the settings (checkpoint.Cursor.advance) or the adaptive one
+(schedule.py) — keeps the history, stops at the wall-time budget, writes the checkpoint and
+leaves the convergence report (convergence.py) on the basis it returns; `resume_from`
+continues a run.
 
 With an output folder, the basis, the random-number state and the position in the schedule are
 written atomically after every step: a killed run loses at most the step in flight, and
@@ -13,42 +16,52 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import eigen
 from ..basis import Basis
 from ..errors import InputError
 from ..integrals import laboratory
 from ..io.basis_json import remove_stale_temporaries
 from ..system import System
 from .checkpoint import CHECKPOINT, Cursor, load_checkpoint, resumed
+from .convergence import convergence
+from .defaults import resolved
 from .expansion import Expansion
 from .methods import Run, methods
 from .report import Reporter
 from .sampler import Sampler
+from .schedule import Adaptive
 from .settings import Optimiser
 
 
 def optimise(system: System, opts: Optimiser, out: Path | None = None, progress: bool = True,
              resume: dict | None = None) -> Basis:
-    """Optimise a basis of `opts.kind` for the state of `system`: grow it to `opts.size` by
-    competitive selection, then run `opts.cycles` times `opts.sweeps` random replacement sweeps,
-    `opts.refine` refinement sweeps and `opts.polish` joint steps (methods.py).
+    """Optimise a basis of `opts.kind` for the state of `system`: with the adaptive schedule
+    (schedule.py), growth to `opts.size` and refinement, replacement and joint passes chosen by
+    the energy each gains per second until the basis is exhausted; with a fixed one, growth to
+    `opts.size` by competitive selection, then `opts.cycles` times `opts.sweeps` random
+    replacement sweeps, `opts.refine` refinement sweeps and `opts.polish` joint steps
+    (methods.py). Either stops after `opts.budget` seconds. Settings left at None are chosen
+    for the system first (defaults.resolved).
 
     out: folder of the checkpoint out/basis.json, written atomically after every step (None: no
     checkpoint); progress: show a live line; resume: a checkpoint's content
     (checkpoint.load_checkpoint) to continue exactly where it stopped.
-    Returns the basis with the ground state's coefficients; its energy (hartree) is
-    prebo.evaluate(basis)["energy"]. InputError for arguments of the wrong type, StalledError when
+    Returns the basis with the ground state's coefficients and `convergence`, the report of
+    convergence.py; its energy (hartree) is prebo.evaluate(basis)["energy"]. InputError for arguments of the wrong type, StalledError when
     growth rejects every trial for STALL_STEPS steps, BasisFileError for a `resume` that does not fit."""
     if not isinstance(system, System):
         raise InputError(f"optimise: system = {system!r}: must be a prebo.System")
     if not isinstance(opts, Optimiser):
         raise InputError(f"optimise: opts = {opts!r}: must be a prebo.Optimiser")
+    opts = resolved(opts, system)
     rng = np.random.default_rng(opts.seed)
     sampler = Sampler(system, opts, rng)
     rep = laboratory(system)
     if resume is None:
-        basis, cursor, history, elapsed = Basis.empty(system, opts.kind), Cursor().advance(0, opts), [], 0.0
+        basis, history, elapsed, schedule, stopped = Basis.empty(system, opts.kind), [], 0.0, Adaptive(opts), None
+        cursor = schedule.first() if opts.adaptive else Cursor().advance(0, opts)
     else:
-        basis, cursor, history, elapsed = resumed(resume, opts, rng, "checkpoint")
+        basis, cursor, history, elapsed, schedule, stopped = resumed(resume, opts, rng, "checkpoint")
     if out is not None:
         remove_stale_temporaries(Path(out) / CHECKPOINT)
     t_start = time.perf_counter()
@@ -68,9 +81,10 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
             energy = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
             ex.basis.save(Path(out) / CHECKPOINT, {
                 "energy": energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
-                "rng": rng.bit_generator.state, "history": history, "elapsed": wall()})
+                "rng": rng.bit_generator.state, "history": history, "elapsed": wall(),
+                "schedule": schedule.to_dict(), "stopped": stopped})
 
-    with run.report:
+    with run.report, eigen.lapack_threads(opts.size):
         while cursor.phase != "done":
             old = ex.energy
             steps[cursor.phase].step(run, cursor)
@@ -78,9 +92,18 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 history.append([len(ex.basis), ex.energy, cursor.phase, wall()])
                 run.report.step(ex, old, cursor)
                 sampler.learn(ex.basis)  # a function of the basis alone, so a resumed run learns the same
-            cursor = cursor.advance(len(ex.basis), opts)
+            now = wall()
+            if opts.adaptive:
+                cursor = schedule.advance(cursor, len(ex.basis), ex.energy, now)
+            else:
+                cursor = cursor.advance(len(ex.basis), opts)
+            if cursor.phase == "done":
+                stopped = "exhausted" if opts.adaptive else "schedule"
+            elif opts.budget is not None and now >= opts.budget:
+                cursor, stopped = Cursor("done"), "budget"
             checkpoint()
     ex.basis.coefficients = ex.eig.vectors[:, 0]
+    ex.basis.convergence = convergence(history, opts, stopped, wall())
     return ex.basis
 
 

@@ -12,7 +12,8 @@
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed (refine.py).
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
 Replacements reach new basins, joint refinement converges within one; the sweep-refine-polish
-block is repeated `cycles` times (Optimiser).
+block is repeated `cycles` times (Optimiser), or the adaptive schedule chooses among them
+(schedule.py).
 """
 from __future__ import annotations
 
@@ -128,8 +129,10 @@ class Polish:
 
 
 def methods(opts: Optimiser) -> dict:
-    """The method of each phase of the schedule, configured by `opts`."""
+    """The method of each phase of the schedule, configured by `opts` (defaults.resolved): in an
+    adaptive schedule, and in a fixed one with `refine`, every grown and replacing function is
+    refined."""
     refinement = Refinement(opts.refine_evaluations, opts.refine_method)
-    on_change = refinement if opts.refine else None  # refine grown and replacing functions too
+    on_change = refinement if opts.adaptive or opts.refine else None  # refine grown and replacing functions too
     return {"grow": Grow(opts.trials, on_change), "sweep": Sweep(opts.trials, on_change),
             "refine": Refine(refinement), "polish": Polish(opts.polish_iterations)}

@@ -7,6 +7,7 @@ import numpy as np
 
 from .checkpoint import Cursor
 from .expansion import Expansion
+from .schedule import CHUNK
 from .settings import Optimiser
 
 
@@ -43,7 +44,12 @@ class Reporter:
         gain = old - st.energy if np.isfinite(old) else float("nan")
         info = f"E = {st.energy:.12f}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.1f} trials/s"
         if cursor.phase == "grow":
-            self.progress.update(self.task, completed=len(st.basis), info=info)
+            self.progress.update(self.task, description="growing", completed=len(st.basis), total=self.opts.size,
+                                 info=info)
+        elif self.opts.adaptive:
+            done, total = (cursor.sweep + 1, min(CHUNK, len(st.basis))) if cursor.phase != "polish" else (1, 1)
+            self.progress.update(self.task, description=f"{cursor.phase} (pass {cursor.cycle + 1})", completed=done,
+                                 total=total, info=info)
         elif cursor.phase == "polish":
             self.progress.update(self.task, description=f"polish (cycle {cursor.cycle + 1})", completed=cursor.sweep + 1, total=self.opts.polish,
                                  info=info)

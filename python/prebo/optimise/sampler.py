@@ -2,10 +2,10 @@
 distributions learned from the functions selected so far.
 
 - "pairs": A = Σ_{i<j} α_ij w_ij w_ij^T + c_A (m/m_tot)(m/m_tot)^T, α_ij = 1/b_ij^2,
-  b_ij log-uniform in [lo, hi] × a_ij with a_ij = 1/(min(μ_ij, 1) max(|q_i q_j|, 1));
-- a coordinate set x (coordinates.all_sets): 𝒜 = diag(1/b_k^2) in x, b_k log-uniform
-  over the same range with the lengths of the particles the coordinate joins, then
-  A^(r) = U_x^T blockdiag(𝒜, c_A) U_x.
+  b_ij log-uniform in [lo a_ij, hi ã_ij] (`length_range` = [lo, hi]; `pair_lengths`: the pair's
+  Bohr radius, bare and in the screened charge, from its reduced mass and charges);
+- a coordinate set x (coordinates.all_sets): 𝒜 = diag(1/b_k^2) in x, b_k drawn in the same way
+  for the two particles the coordinate joins, then A^(r) = U_x^T blockdiag(𝒜, c_A) U_x.
 The family adds its own parameters (Family.draw_power, Family.drawn): ECG-GVR a power K and the
 global vector along the pair or coordinate drawn, floating ECGs centres displaced along it.
 After `learn_after` functions of a channel, a share `learned` of the trials is drawn from the
@@ -41,6 +41,37 @@ def coordinate_sets(system: System, channels) -> list[coords.CoordinateSet]:
     return sets
 
 
+def pair_lengths(system: System) -> tuple[np.ndarray, np.ndarray]:
+    """(a, ã), n x n, bohr: the length scales a pair of particles moves on.
+
+    An attractive pair (q_i q_j < 0) is a hydrogen-like system: a_ij = 1/(μ_ij |q_i q_j|) is its
+    Bohr radius (μ_ij = m_i m_j/(m_i + m_j)), the innermost length, for electrons, positrons,
+    muons and nuclei alike. Its outermost length ã_ij ≥ a_ij is the largest Bohr radius of either
+    particle k of the pair in Z_k, the charge the rest of the system shows it from afar
+    (Σ_{l≠k} q_l where that attracts k; at least 1/2, for a particle held by polarisation, as in
+    H⁻): the outer electron of Li sees Z = 1, not 3. A repulsive or neutral pair moves on the lengths of its particles'
+    attractive pairs: the smallest a and the largest ã of either; a pair with no attractive
+    partner at all takes 1/(μ_ij max(|q_i q_j|, 1)) for both.
+    """
+    m, q, n = system.masses, system.charges, system.n
+    mu = np.outer(m, m) / np.add.outer(m, m)
+    a, outer = np.full((n, n), np.inf), np.zeros((n, n))
+    for i, j, _ in system.pairs():
+        if q[i] * q[j] < 0:
+            a[i, j] = a[j, i] = 1.0 / (mu[i, j] * abs(q[i] * q[j]))
+            Z = [max(-np.sign(q[k]) * (q.sum() - q[k]), 0.5) for k in (i, j)]  # the rest, seen from k
+            outer[i, j] = outer[j, i] = max(a[i, j], *(1.0 / (mu[i, j] * abs(q[k]) * z) for k, z in zip((i, j), Z)))
+    inner, outermost = a.min(axis=1), outer.max(axis=1)  # per particle, over its attractive pairs
+    for i, j, _ in system.pairs():
+        if not q[i] * q[j] < 0:
+            lo, hi = min(inner[i], inner[j]), max(outermost[i], outermost[j])
+            if not np.isfinite(lo):
+                lo = hi = 1.0 / (mu[i, j] * max(abs(q[i] * q[j]), 1.0))
+            a[i, j] = a[j, i] = lo
+            outer[i, j] = outer[j, i] = hi
+    return a, outer
+
+
 @dataclass
 class Sampler:
     """Random functions of `system` with the settings `opts`, drawn with `rng` (module docstring)."""
@@ -53,20 +84,15 @@ class Sampler:
     _thetas: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
-        s, m, q = self.system, self.system.masses, self.system.charges
-        n = s.n
-        self.length = np.ones((n, n))
-        for i in range(n):
-            for j in range(n):
-                if i != j:
-                    mu = m[i] * m[j] / (m[i] + m[j])
-                    self.length[i, j] = 1.0 / (min(mu, 1.0) * max(abs(q[i] * q[j]), 1.0))
-        self.sets = coordinate_sets(s, self.opts.channels)
+        n = self.system.n
+        self.a, self.a_outer = pair_lengths(self.system)
+        self.sets = coordinate_sets(self.system, self.opts.channels)
         self.pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
 
-    def _b(self, a, size=None):
+    def _b(self, i: int, j: int) -> float:
+        """A length of pair (i, j), log-uniform in [lo a_ij, hi ã_ij] (bohr)."""
         lo, hi = self.opts.length_range
-        return a * np.exp(self.rng.uniform(np.log(lo), np.log(hi), size))
+        return float(np.exp(self.rng.uniform(np.log(lo * self.a[i, j]), np.log(hi * self.a_outer[i, j]))))
 
     def _pair_vector(self, i, j):
         w = np.zeros(self.system.n)
@@ -132,21 +158,18 @@ class Sampler:
             A = c_A * np.outer(cm, cm)
             for i, j in self.pairs:
                 w = self._pair_vector(i, j)
-                b = self._b(self.length[i, j])
+                b = self._b(i, j)
                 A += np.outer(w, w) * (max(power, 1.0) if (i, j) == (i0, j0) else 1.0) / b**2
             u = self._pair_vector(i0, j0)
             # centres: particle j displaced from particle i by a random vector of its pair length
             centres = np.zeros((n, 3))
-            centres[j0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(self.length[i0, j0])
+            centres[j0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(i0, j0)
             channel = "pairs"
         else:
             x = self.sets[self.rng.integers(len(self.sets))]
             # the length of coordinate k: that of the two particles its row weighs most
-            lengths = []
-            for k in range(n - 1):
-                i, j = np.argsort(-np.abs(x.U[k]))[:2]
-                lengths.append(self.length[i, j])
-            b = self._b(np.array(lengths))
+            joined = [np.argsort(-np.abs(x.U[k]))[:2] for k in range(n - 1)]
+            b = np.array([self._b(i, j) for i, j in joined])
             alpha = 1.0 / b**2
             k0 = int(self.rng.integers(n - 1))
             alpha[k0] *= max(power, 1.0)
@@ -156,7 +179,7 @@ class Sampler:
             u = x.U.T @ ux
             # centres in x: coordinate k0 displaced by a random vector of its drawn length, CM at rest
             sx = np.zeros((n, 3))
-            sx[k0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(lengths[k0])
+            sx[k0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(*joined[k0])
             centres = x.U_inv @ sx
             channel = x.name
         return Basis.single(s, A, c_A, channel, fam.name, fam.drawn(s, u, centres, K))

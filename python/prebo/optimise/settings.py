@@ -10,9 +10,10 @@ from dataclasses import dataclass, fields
 from ..basis import FAMILIES
 from ..basis.gvr import K_LIMIT
 from ..errors import InputError
-from ..validation import MATRICES, MAX_SIZE, Channels, Choice, Integer, Lengths, Real, Refused, strict_keywords
+from ..validation import MATRICES, MAX_SIZE, Automatic, Channels, Choice, Integer, Lengths, Real, Refused, strict_keywords
 
 REFINE_METHODS = ("powell", "gradient")
+SCHEDULE = ("sweeps", "refine", "polish", "cycles")  # the fixed schedule's settings
 
 
 @dataclass(frozen=True)
@@ -27,22 +28,25 @@ class Setting:
 SETTINGS = {
     "size": Setting(Integer(1, MAX_SIZE), f"basis functions; at most {MAX_SIZE}, what {MATRICES} nb x nb "
                     "matrices in this machine's memory allow", "[basis] size"),
-    "trials": Setting(Integer(1, MAX_SIZE), "competitive trials per step", "[optimiser] trials"),
-    "sweeps": Setting(Integer(0), "random replacement sweeps per cycle", "[optimiser] sweeps"),
+    "trials": Setting(Automatic(Integer(1, MAX_SIZE)), "competitive trials per step", "[optimiser] trials"),
+    "sweeps": Setting(Automatic(Integer(0)), "random replacement sweeps per cycle", "[optimiser] sweeps"),
     "seed": Setting(Integer(0), "seed of the random numbers", "[optimiser] seed"),
-    "channels": Setting(Channels(), "coordinate sets the functions are drawn in", "[optimiser] channels"),
-    "length_range": Setting(Lengths(), "range of the drawn lengths in bohr, scaled per pair",
+    "channels": Setting(Automatic(Channels()), "coordinate sets the functions are drawn in", "[optimiser] channels"),
+    "length_range": Setting(Lengths(), "range of the drawn lengths in units of each pair's Bohr radius",
                             "[optimiser] length_range"),
     "c_A": Setting(Real(0.0), "exponent of the centre-of-mass coordinate", "[basis] c_A"),
-    "kind": Setting(Choice(tuple(FAMILIES)), "basis type", "[basis] type"),
-    "K_max": Setting(Integer(0, K_LIMIT), "largest power K of an ECG-GVR function", "[basis] K_max"),
-    "refine": Setting(Integer(0), "refinement sweeps per cycle", "[optimiser] refine"),
-    "refine_evaluations": Setting(Integer(1), "energies per refinement of one function",
+    "kind": Setting(Automatic(Choice(tuple(FAMILIES))), "basis type", "[basis] type"),
+    "K_max": Setting(Automatic(Integer(0, K_LIMIT)), "largest power K of an ECG-GVR function", "[basis] K_max"),
+    "refine": Setting(Automatic(Integer(0)), "refinement sweeps per cycle", "[optimiser] refine"),
+    "refine_evaluations": Setting(Automatic(Integer(1)), "energies per refinement of one function",
                                   "[optimiser] refine_evaluations"),
     "refine_method": Setting(Choice(REFINE_METHODS), "refinement minimiser", "[optimiser] refine_method"),
-    "polish": Setting(Integer(0), "joint refinement steps per cycle", "[optimiser] polish"),
+    "polish": Setting(Automatic(Integer(0)), "joint refinement steps per cycle", "[optimiser] polish"),
     "polish_iterations": Setting(Integer(1), "L-BFGS iterations per joint step", "[optimiser] polish_iterations"),
-    "cycles": Setting(Integer(1), "repetitions of the sweep-refine-polish block", "[optimiser] cycles"),
+    "cycles": Setting(Automatic(Integer(1)), "repetitions of the sweep-refine-polish block", "[optimiser] cycles"),
+    "budget": Setting(Automatic(Real(0.0)), "wall-time budget of the run in seconds", "[optimiser] budget"),
+    "tolerance": Setting(Automatic(Real(0.0)), "energy gain (Eh) below which a pass over the basis counts as "
+                         "exhausted (adaptive schedule)", "[optimiser] tolerance"),
     "learned": Setting(Real(0.0, 1.0, True, True), "share of trials from the learned distributions",
                        "[optimiser] learned"),
     "learn_after": Setting(Integer(1), "functions of a channel before its distribution is learned",
@@ -70,46 +74,58 @@ def check(name: str, value, label: str | None = None):
 @dataclass
 class Optimiser:
     """Settings of `optimise` (TOML table [optimiser]; `size`, `c_A`, `kind`, `K_max` from [basis]).
-    Checked on construction (InputError naming the setting, the value and what is allowed).
+    Checked on construction (InputError naming the setting, the value and what is allowed). A
+    setting left at None is chosen for the system by `defaults.resolved` when the run starts.
 
     Basis: size — functions to grow to (≤ MAX_SIZE, what memory allows); kind — the basis
     family ("pecg", "ecg-gvr", "fecg"); c_A — exponent of the CM coordinate in bohr⁻², shared by
     every function (> 0); K_max — largest power K of an ECG-GVR function (0..60).
     Sampling: trials — competitive trials per step; seed — of the random numbers; channels —
     "pairs", "all" or a list of coordinate-set names the functions are drawn in; length_range —
-    [lo, hi] of the drawn lengths in bohr, scaled per pair; learned — share of trials from the
-    learned per-channel distributions (0..1); learn_after — functions of a channel before its
-    distribution is learned.
-    Schedule (methods.py): sweeps — replacement sweeps per cycle; refine — refinement sweeps per
-    cycle (and refinement of every grown or replacing function when > 0); refine_evaluations —
-    energies per refinement of one function; refine_method — "gradient" (L-BFGS, exact
-    gradients) or "powell"; polish — joint L-BFGS steps per cycle; polish_iterations — iterations
-    per joint step; cycles — repetitions of the sweep-refine-polish block.
+    [lo, hi] of the drawn lengths in units of each pair's Bohr radius (sampler.pair_lengths);
+    learned — share of trials from the learned per-channel distributions (0..1); learn_after —
+    functions of a channel before its distribution is learned.
+    Schedule: with none of sweeps, refine, polish and cycles given, the schedule chooses itself
+    (schedule.py: growth, refinement, replacement and joint passes by the energy each gains per
+    second), stopping at `budget` seconds, or when every kind of pass gains less than
+    `tolerance` Eh. Given any of them, the fixed schedule of methods.py: sweeps — replacement
+    sweeps per cycle; refine — refinement sweeps per cycle (and refinement of every grown or
+    replacing function when > 0); polish — joint L-BFGS steps per cycle; cycles — repetitions of
+    the sweep-refine-polish block; `budget` still stops it. refine_evaluations — energies per
+    refinement of one function; refine_method — "gradient" (L-BFGS, exact gradients) or
+    "powell"; polish_iterations — iterations per joint step.
     Linear dependence: min_norm — smallest part of a trial orthogonal to the basis, relative to
     its norm; max_overlap — largest normalised overlap of a trial with a function; threshold —
     relative overlap eigenvalue below which eigen.solve drops directions.
     """
 
     size: int = 50
-    trials: int = 20
-    sweeps: int = 0
+    trials: int | None = None
+    sweeps: int | None = None
     seed: int = 1
-    channels: str | list = "pairs"
+    channels: str | list | None = None
     length_range: tuple = (0.01, 15.0)
     c_A: float = 1.0
-    kind: str = "pecg"
-    K_max: int = 0
-    refine: int = 0
-    refine_evaluations: int = 200
+    kind: str | None = None
+    K_max: int | None = None
+    refine: int | None = None
+    refine_evaluations: int | None = None
     refine_method: str = "gradient"
-    polish: int = 0
+    polish: int | None = None
     polish_iterations: int = 20
-    cycles: int = 1
+    cycles: int | None = None
+    budget: float | None = None
+    tolerance: float | None = None
     learned: float = 0.5
     learn_after: int = 5
     min_norm: float = 1e-8
     max_overlap: float = 0.99
     threshold: float = 1e-13
+
+    @property
+    def adaptive(self) -> bool:
+        """Whether the schedule chooses itself (none of sweeps, refine, polish, cycles given)."""
+        return all(getattr(self, k) is None for k in SCHEDULE)
 
     def to_dict(self) -> dict:
         """The settings as a JSON-ready mapping (a checkpoint's "optimiser")."""

@@ -1,0 +1,50 @@
+"""The convergence report of a run (result.json's "convergence"), from its history of accepted
+steps [n_b, E, phase, seconds]:
+
+- `stopped`: why the run ended — "exhausted" (the adaptive schedule: every kind of pass gains
+  less than a tenth of what growth gained per second, or than `tolerance`), "budget" (the wall-time budget) or "schedule" (a fixed schedule ran
+  out) — and `seconds` of optimisation over every segment of the run;
+- `recent`: the energy gained by the last RECENT accepted steps, the seconds they span and the
+  gain rate in Eh/s;
+- `extrapolation`: from the energies E₁, E₂, E₃ at three equally spaced times between the end of
+  growth and the last step, gains g₁ = E₁ − E₂ and g₂ = E₂ − E₃, the gain still to be had at
+  this basis size, g₂²/(g₁ − g₂), were the gains to keep falling geometrically (Aitken's Δ²
+  process), and the energy E₃ less that; none while the gains are not yet falling; with the
+  caveat that says what the figure is and is not.
+"""
+from __future__ import annotations
+
+from .settings import Optimiser
+
+RECENT = 10
+CAVEAT = ("the gain still to be had at this basis size were the gains to keep falling geometrically (Aitken's "
+          "delta-squared over three equal spans of time since growth ended); not the error against the exact "
+          "energy, which also holds the error of the basis size; too small where the gains fall more slowly "
+          "(as a power of the time), or where the run would still find a deeper basin")
+
+
+def energy_at(steps: list, t: float) -> float:
+    """The energy of the last step taken by time `t` (seconds)."""
+    return [h[1] for h in steps if h[3] <= t][-1]
+
+
+def convergence(history: list, opts: Optimiser, stopped: str | None, seconds: float) -> dict:
+    """The report of a run with `history` (module docstring)."""
+    steps = [h for h in history if len(h) >= 4]
+    report = {"stopped": stopped, "seconds": seconds, "adaptive": opts.adaptive, "recent": None,
+              "extrapolation": None}
+    if len(steps) >= 2:
+        last = steps[-min(RECENT + 1, len(steps)):]
+        gain, span = last[0][1] - last[-1][1], last[-1][3] - last[0][3]
+        report["recent"] = {"steps": len(last) - 1, "gain": gain, "seconds": span,
+                            "rate": gain / span if span > 0 else None}
+    final = [h for h in steps if h[0] == steps[-1][0]] if steps else []
+    if len(final) >= 3 and final[-1][3] > final[0][3]:
+        t0, T = final[0][3], final[-1][3]
+        E1, E2, E3 = (energy_at(final, t0 + k * (T - t0) / 3) for k in (1, 2, 3))
+        g1, g2 = E1 - E2, E2 - E3
+        if g1 > g2:
+            remaining = g2 * g2 / (g1 - g2)
+            report["extrapolation"] = {"energy": E3 - remaining, "remaining": remaining, "gains": [g1, g2],
+                                       "caveat": CAVEAT}
+    return report

@@ -1,0 +1,150 @@
+"""The adaptive schedule: which unit of work comes next, chosen by the energy each kind of pass has
+been gaining per second.
+
+A pass is the unit the schedule measures: growth by a quarter of the basis (at least GROWTH
+functions, at most to `size`; every new function refined), refinement or replacement of the
+next CHUNK functions (a sweep continues where the last pass of its kind stopped), or one joint
+L-BFGS step (methods.py). After each pass the next one is of the kind whose last pass gained
+the most energy per second of wall time; kinds not yet tried come first. A kind's rate is
+measured again only when it runs again, so the rate it keeps is that of an earlier, richer
+state: as the running kind's rate falls below it, the other kinds are tried again, and each
+stays in use as long as it pays best. Growth is a kind while the basis is smaller than `size`.
+
+At full size the basis is exhausted, and the schedule ends, when the last pass of every kind
+gains less than RATIO of what the last growth pass gained per second (a larger basis would
+gain faster; where growth took one pass, there is no such rate), or, over a whole sweep, less
+than `tolerance` Eh (default TOLERANCE |E|). The
+wall-time budget stops any schedule (driver.py).
+
+The choices follow measured seconds, so two runs of one input may part in their last digits; a
+fixed schedule (any of sweeps, refine, polish, cycles given) repeats bit for bit.
+
+The passes, [kind, n_b, E before, E after, seconds before, seconds after, functions] (E
+before is None for the first; functions: those the pass visited, 1 for a joint step), the
+start of the pass in flight, [E, seconds], and where each sweep goes on are kept in the
+checkpoint, so a resumed run goes on with what it had learned (`check` reads them back).
+"""
+from __future__ import annotations
+
+import math
+
+from .checkpoint import Cursor
+from .settings import Optimiser
+
+#: the fewest functions a growth pass adds
+GROWTH = 8
+#: the most functions a refinement or replacement pass visits
+CHUNK = 50
+#: exhausted below this share of the last growth pass's gain per second
+RATIO = 0.1
+#: the default tolerance relative to |E|: a sweep that gains less has exhausted the basis
+TOLERANCE = 1e-10
+#: the kinds of pass that improve a basis of fixed size, in the order they are first tried
+IMPROVE = ("refine", "sweep", "polish")
+
+
+class Adaptive:
+    """The adaptive schedule of `opts` (module docstring); `passes`, `start` and `next` (the
+    function each sweep goes on with) from a checkpoint."""
+
+    def __init__(self, opts: Optimiser, passes: list | None = None, start: list | None = None,
+                 next: dict | None = None):
+        self.opts = opts
+        self.passes = [list(p) for p in passes or []]
+        self.start = list(start) if start is not None else [None, 0.0]  # no energy before the first function
+        self.next = dict(next or {"refine": 0, "sweep": 0})
+
+    def first(self) -> Cursor:
+        """The cursor of a new run: growth from no function."""
+        return self.begin("grow", 0, 0)
+
+    def begin(self, kind: str, nb: int, number: int) -> Cursor:
+        """The cursor at the start of pass `number` of `kind` on a basis of `nb` functions: a growth
+        pass keeps its target size in `sweep`, a sweep pass its count of functions visited."""
+        if kind == "grow":
+            return Cursor("grow", sweep=min(self.opts.size, nb + max(GROWTH, nb // 4)), cycle=number)
+        return Cursor(kind, index=self.next.get(kind, 0) % max(nb, 1), cycle=number)
+
+    def tolerance(self, energy: float) -> float:
+        """The gain (Eh) of a whole sweep below which the basis counts as exhausted."""
+        return self.opts.tolerance if self.opts.tolerance is not None else TOLERANCE * abs(energy)
+
+    def advance(self, cursor: Cursor, nb: int, energy: float, now: float) -> Cursor:
+        """The unit of work after the one at `cursor`, which left `nb` functions at `energy` after
+        `now` seconds of the run; at the end of a pass it is recorded and the next one chosen."""
+        phase, visited = cursor.phase, cursor.sweep + 1
+        if phase == "grow" and nb < cursor.sweep:
+            return cursor
+        if phase in ("sweep", "refine"):
+            self.next[phase] = (cursor.index + 1) % nb
+            if visited < min(CHUNK, nb):
+                return Cursor(phase, visited, self.next[phase], cursor.cycle)
+        functions = visited if phase in ("sweep", "refine") else 1
+        self.passes.append([phase, nb, self.start[0], energy, self.start[1], now, functions])
+        self.start = [energy, now]
+        kind = self.choose(nb, energy)
+        return Cursor("done") if kind is None else self.begin(kind, nb, cursor.cycle + 1)
+
+    @staticmethod
+    def gain(p: list) -> float:
+        """Energy gained by pass `p` (inf for the first growth pass: no energy before it)."""
+        return math.inf if p[2] is None else p[2] - p[3]
+
+    def rate(self, p: list) -> float:
+        """Energy gained per second by pass `p`."""
+        return self.gain(p) / max(p[5] - p[4], 1e-3)
+
+    def exhausted(self, last: dict, nb: int, energy: float) -> bool:
+        """Whether every kind's last pass gained less than RATIO of the last growth pass's rate, or
+        less than the tolerance over a whole sweep (module docstring)."""
+        grown = RATIO * self.rate(last["grow"]) if math.isfinite(self.gain(last.get("grow", [0, 0, None]))) else 0.0
+        return all(self.rate(last[k]) < grown for k in IMPROVE) or all(
+            self.gain(last[k]) * nb / last[k][6] < self.tolerance(energy) if k != "polish"
+            else self.gain(last[k]) < self.tolerance(energy) for k in IMPROVE)
+
+    def choose(self, nb: int, energy: float) -> str | None:
+        """The kind of the next pass, or None when the basis is exhausted (module docstring)."""
+        last = {p[0]: p for p in self.passes}
+        growing = nb < self.opts.size
+        if growing and "grow" not in last:
+            return "grow"
+        untried = [k for k in IMPROVE if k not in last]
+        if untried:
+            return untried[0]
+        if not growing and self.exhausted(last, nb, energy):
+            return None
+        return max((("grow",) if growing else ()) + IMPROVE, key=lambda k: self.rate(last[k]))
+
+    def to_dict(self) -> dict:
+        """The checkpoint's "schedule" block."""
+        return {"passes": self.passes, "start": self.start, "next": self.next}
+
+    @classmethod
+    def check(cls, opts: Optimiser, block) -> "Adaptive":
+        """The schedule of a checkpoint's "schedule" block (`to_dict`; absent in the checkpoints of
+        fixed schedules written before it); ValueError for one that is malformed."""
+        if block is None:
+            return cls(opts)
+
+        def count(k):
+            return type(k) is int and k >= 0
+
+        def energy(e):
+            return e is None or (isinstance(e, (int, float)) and not isinstance(e, bool) and math.isfinite(e))
+
+        def seconds(t):
+            return isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t) and t >= 0
+
+        def one(p):
+            return (isinstance(p, list) and len(p) == 7 and p[0] in ("grow",) + IMPROVE and count(p[1])
+                    and energy(p[2]) and p[3] is not None and energy(p[3]) and seconds(p[4]) and seconds(p[5])
+                    and count(p[6]) and p[6] > 0)
+
+        passes, start, nxt = ((block.get("passes"), block.get("start"), block.get("next"))
+                              if isinstance(block, dict) else (None, None, None))
+        if not (isinstance(passes, list) and all(map(one, passes)) and isinstance(start, list) and len(start) == 2
+                and energy(start[0]) and seconds(start[1]) and isinstance(nxt, dict)
+                and set(nxt) == {"refine", "sweep"} and all(map(count, nxt.values()))):
+            raise ValueError("schedule must be {passes: [[kind, n_b, E before, E after, t before, t after, "
+                             "functions], ...], start: [E, t], next: {refine: i, sweep: j}}")
+        return cls(opts, passes, start, nxt)

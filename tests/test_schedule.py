@@ -1,0 +1,206 @@
+"""The schedule that chooses itself (issue 17): settings chosen from the physics (optimise.defaults),
+sampling lengths from each pair's Bohr radius (sampler.pair_lengths), the adaptive schedule
+(optimise.schedule), the wall-time budget and the convergence report (optimise.convergence)."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import prebo
+from prebo.optimise import Cursor, Optimiser, resume_from
+from prebo.optimise.convergence import convergence
+from prebo.optimise.defaults import resolved
+from prebo.optimise.sampler import pair_lengths
+from prebo.optimise.schedule import CHUNK, RATIO, Adaptive
+
+LI7 = {"name": "li7", "mass": 12786.39227775, "charge": 3, "spin": 1.5}
+
+
+# --- settings chosen for the system ---------------------------------------------------------
+def test_a_molecule_gets_ecg_gvr_functions_with_powers_from_its_nuclear_mass():
+    for particles in (["p", "p", "e"], ["p", "p", "e", "e"], ["d", "d", "e"]):
+        opts = resolved(Optimiser(), prebo.System(particles))
+        m = prebo.System(particles).masses
+        mu = m[0] * m[1] / (m[0] + m[1])
+        assert (opts.kind, opts.channels, opts.trials) == ("ecg-gvr", "all", 30)
+        assert opts.K_max == int(np.ceil(np.sqrt(mu)))  # 31 for H2, as the paper's 30; 43 for D2+
+    assert resolved(Optimiser(), prebo.System(["p", "p", "e"])).K_max == 31
+
+
+def test_an_atom_gets_plain_ecgs_and_a_p_state_ecg_gvr_functions_without_powers():
+    for particles in (["alpha", "e", "e"], [LI7, "e", "e", "e"], ["e+", "e", "e"], ["p", "mu", "e"]):
+        opts = resolved(Optimiser(), prebo.System(particles))
+        assert (opts.kind, opts.K_max, opts.channels, opts.trials) == ("pecg", 0, "pairs", 20), particles
+    opts = resolved(Optimiser(), prebo.System(["p", "e"], N=1, parity=-1))
+    assert (opts.kind, opts.K_max) == ("ecg-gvr", 0)
+
+
+def test_explicit_settings_override_and_any_schedule_setting_fixes_the_schedule():
+    h2 = prebo.System(["p", "p", "e", "e"])
+    opts = resolved(Optimiser(kind="pecg", channels="pairs", trials=7, K_max=2), h2)
+    assert (opts.kind, opts.channels, opts.trials, opts.K_max) == ("pecg", "pairs", 7, 2)
+    assert opts.adaptive and opts.refine_evaluations == 30 and opts.sweeps is None
+    fixed = resolved(Optimiser(refine=2), h2)
+    assert not fixed.adaptive and (fixed.sweeps, fixed.refine, fixed.polish, fixed.cycles) == (0, 2, 0, 1)
+    assert fixed.refine_evaluations == 200
+    assert resolved(fixed, h2) == fixed and resolved(opts, h2) == opts  # a checkpoint's settings stay
+
+
+# --- lengths from the physics --------------------------------------------------------------
+def test_an_attractive_pair_is_drawn_from_its_bohr_radius():
+    for particles, Z in ((["p", "mu"], 1.0), (["alpha", "e"], 2.0), (["e+", "e"], 1.0), (["p", "pbar"], 1.0)):
+        s = prebo.System(particles)
+        m = s.masses
+        a, outer = pair_lengths(s)
+        assert a[0, 1] == pytest.approx((m[0] + m[1]) / (m[0] * m[1] * Z))
+        assert outer[0, 1] == pytest.approx(a[0, 1])  # two particles: nothing screens
+    a, _ = pair_lengths(prebo.System(["p", "p", "mu"]))
+    assert a[0, 1] == a[0, 2] < 0.006  # muonic: 186 times smaller than the electron's, not capped at it
+
+
+def test_screening_sets_the_outer_length_and_like_charges_move_on_their_partners_lengths():
+    a, outer = pair_lengths(prebo.System([LI7, "e", "e", "e"]))
+    assert a[0, 1] == pytest.approx(1 / 3, rel=1e-3) and outer[0, 1] == pytest.approx(1.0, rel=1e-3)  # Z = 3 − 2
+    assert (a[1, 2], outer[1, 2]) == (a[0, 1], outer[0, 1])  # electrons move on their nucleus's lengths
+    a, outer = pair_lengths(prebo.System(["p", "e", "e"]))
+    assert outer[0, 1] == pytest.approx(2 * a[0, 1])  # H⁻: the outer electron held by polarisation, Z = 1/2
+    a, outer = pair_lengths(prebo.System(["p", "p", "e", "e"]))
+    assert a[0, 1] == pytest.approx(a[0, 2]) and outer[0, 1] == pytest.approx(outer[0, 2])  # the bond: ~1 bohr
+
+
+def test_the_sampler_draws_every_pair_within_its_range():
+    s = prebo.System(["p", "mu", "e"])
+    opts = resolved(Optimiser(length_range=(0.5, 2.0)), s)
+    from prebo.optimise.sampler import Sampler
+    sampler = Sampler(s, opts, np.random.default_rng(1))
+    for i, j in sampler.pairs:
+        b = [sampler._b(i, j) for _ in range(200)]
+        assert 0.5 * sampler.a[i, j] <= min(b) and max(b) <= 2.0 * sampler.a_outer[i, j]
+
+
+# --- the adaptive schedule -------------------------------------------------------------------
+def passes(schedule, *rows):
+    """Record passes (kind, nb, gain, seconds) one after another, as the driver would (the first
+    from no function: no energy before it)."""
+    E, t = (schedule.passes[-1][3], schedule.passes[-1][5]) if schedule.passes else (None, 0.0)
+    for kind, nb, gain, seconds in rows:
+        after = -1.0 if E is None else E - gain
+        schedule.passes.append([kind, nb, E, after, t, t + seconds, 1 if kind in ("grow", "polish") else
+                                min(CHUNK, nb)])
+        E, t = after, t + seconds
+    return E
+
+
+def test_growth_first_then_every_kind_once_then_the_best_rate():
+    s = Adaptive(resolved(Optimiser(size=100), prebo.System(["alpha", "e", "e"])))
+    assert s.first() == Cursor("grow", sweep=8)
+    assert s.choose(0, np.inf) == "grow"
+    E = passes(s, ("grow", 8, None, 1.0))
+    assert [s.choose(8, E), s.begin("refine", 8, 1)] == ["refine", Cursor("refine", cycle=1)]
+    E = passes(s, ("refine", 8, 1e-3, 1.0), ("sweep", 8, 1e-3, 2.0), ("polish", 8, 1e-4, 1.0))
+    assert s.choose(8, E) == "grow"  # the first growth pass: no energy before it, an unbounded rate
+    E = passes(s, ("grow", 16, 1e-4, 1.0))  # growth slows: refinement (1e-3 Eh/s) pays best now
+    assert s.choose(16, E) == "refine"
+    assert s.begin("grow", 80, 9) == Cursor("grow", sweep=100, cycle=9)  # a quarter, capped at size
+
+
+def test_a_pass_ends_after_a_chunk_and_the_next_sweep_goes_on_where_it_stopped():
+    opts = resolved(Optimiser(size=120), prebo.System(["alpha", "e", "e"]))
+    s = Adaptive(opts)
+    passes(s, ("grow", 120, None, 1.0), ("refine", 120, 1e-3, 1.0), ("sweep", 120, 1e-3, 1.0), ("polish", 120, 1, 1))
+    c = Cursor("refine", index=100, cycle=4)
+    for k in range(CHUNK - 1):
+        c = s.advance(c, 120, -3.0, 20.0)
+        assert (c.phase, c.sweep, c.index) == ("refine", k + 1, (101 + k) % 120)
+    c = s.advance(c, 120, -3.0, 20.0)
+    assert s.passes[-1][0] == "refine" and s.passes[-1][6] == CHUNK and c.cycle == 5
+    assert s.next["refine"] == (100 + CHUNK) % 120 and s.begin("refine", 120, 6).index == 30
+    grow = Cursor("grow", sweep=10, cycle=7)
+    assert s.advance(grow, 9, -3.0, 21.0) == grow  # growth goes on to its target size
+
+
+def test_the_basis_is_exhausted_when_every_kind_gains_less_than_a_tenth_of_growth_or_the_tolerance():
+    opts = resolved(Optimiser(size=100), prebo.System(["alpha", "e", "e"]))
+    s = Adaptive(opts)
+    E = passes(s, ("grow", 80, None, 1.0), ("grow", 100, 1e-3, 1.0), ("refine", 100, 2e-4, 1.0),
+               ("sweep", 100, 1e-4, 1.0), ("polish", 100, 1e-4, 1.0))
+    assert s.choose(100, E) == "refine"
+    E = passes(s, ("refine", 100, 0.5 * RATIO * 1e-3, 1.0), ("sweep", 100, 0.5 * RATIO * 1e-3, 1.0),
+               ("polish", 100, 0.9 * RATIO * 1e-3, 1.0))
+    assert s.choose(100, E) is None
+    assert s.choose(99, E) == "grow"  # below full size the basis grows instead
+
+    t = Adaptive(resolved(Optimiser(size=8, tolerance=1e-6), prebo.System(["alpha", "e", "e"])))
+    E = passes(t, ("grow", 8, None, 1.0), ("refine", 8, 2e-6, 1.0), ("sweep", 8, 1e-7, 1.0), ("polish", 8, 1e-7, 1.0))
+    assert t.choose(8, E) == "refine"  # one pass in one growth step: no growth rate, the tolerance decides
+    E = passes(t, ("refine", 8, 5e-7, 1.0))
+    assert t.choose(8, E) is None
+
+
+@pytest.mark.parametrize("block", [
+    {"passes": [], "start": [None, 0.0]},  # no "next"
+    {"passes": [["grow", 1, None, -1.0, 0.0, 1.0]], "start": [None, 0.0], "next": {"refine": 0, "sweep": 0}},
+    {"passes": [["jump", 1, None, -1.0, 0.0, 1.0, 1]], "start": [None, 0.0], "next": {"refine": 0, "sweep": 0}},
+    {"passes": [["grow", 1, None, None, 0.0, 1.0, 1]], "start": [None, 0.0], "next": {"refine": 0, "sweep": 0}},
+    {"passes": [], "start": [None, -1.0], "next": {"refine": 0, "sweep": 0}},
+    {"passes": [], "start": [None, 0.0], "next": {"refine": -1, "sweep": 0}},
+    [], "x",
+])
+def test_a_malformed_schedule_block_is_refused(block):
+    with pytest.raises(ValueError, match="schedule must be"):
+        Adaptive.check(Optimiser(), block)
+    good = {"passes": [["grow", 1, None, -1.0, 0.0, 1.0, 1]], "start": [-1.0, 1.0], "next": {"refine": 0, "sweep": 0}}
+    assert Adaptive.check(Optimiser(), good).passes == good["passes"]
+
+
+# --- the convergence report ------------------------------------------------------------------
+def test_the_extrapolation_is_exact_for_geometrically_falling_gains():
+    """Gains falling by q per equal span of time: Aitken's Δ² gives the remaining g q/(1 − q) exactly."""
+    E_inf, q = -2.0, 0.5
+    history = [[5, -1.0, "grow", 1.0]] + [[10, E_inf + q ** (k / 10), "refine", 10.0 + k] for k in range(31)]
+    r = convergence(history, Optimiser(), "exhausted", 40.0)
+    assert r["extrapolation"]["remaining"] == pytest.approx(history[-1][1] - E_inf, rel=1e-12)
+    assert r["extrapolation"]["energy"] == pytest.approx(E_inf, rel=1e-12)
+    assert "not the error against the exact energy" in r["extrapolation"]["caveat"]
+    assert r["recent"]["steps"] == 10 and r["recent"]["gain"] == pytest.approx(history[-11][1] - history[-1][1])
+    assert r["recent"]["rate"] == pytest.approx(r["recent"]["gain"] / 10.0)
+    rising = [[10, -1.0 - 0.01 * k * k, "refine", float(k)] for k in range(30)]  # gains not yet falling
+    assert convergence(rising, Optimiser(), "budget", 30.0)["extrapolation"] is None
+
+
+# --- end to end ------------------------------------------------------------------------------
+def test_an_input_without_optimiser_table_runs_to_an_exhausted_basis_with_a_report(tmp_path):
+    (tmp_path / "he.toml").write_text('[system]\nparticles = ["alpha", "e", "e"]\n[state]\nspin = { e = 0 }\n'
+                                      "[basis]\nsize = 24\n")
+    r = subprocess.run([sys.executable, "-m", "prebo", "run", tmp_path / "he.toml", "--out", tmp_path / "he"],
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert "stopped" in r.stdout and "basis exhausted" in r.stdout
+    result = json.loads((tmp_path / "he" / "result.json").read_text())
+    c = result["convergence"]
+    assert c["stopped"] == "exhausted" and c["adaptive"] and 0 < c["seconds"] <= result["wall_seconds"] + 0.05  # 0.1 s
+    assert c["recent"]["steps"] >= 1 and c["recent"]["gain"] >= 0 and c["recent"]["seconds"] >= 0
+    assert c["extrapolation"] is None or (c["extrapolation"]["remaining"] > 0 and c["extrapolation"]["caveat"])
+    assert result["n_basis"] == 24 and result["basis_type"] == "pecg"
+    assert -2.90330455773 < result["energy"] < -2.9030  # the literature energy (Drake), variational
+    d = json.loads((tmp_path / "he" / "basis.json").read_text())
+    kinds = [p[0] for p in d["schedule"]["passes"]]
+    assert kinds[0] == "grow" and {"refine", "sweep", "polish"} <= set(kinds) and d["stopped"] == "exhausted"
+
+
+def test_the_budget_stops_a_run_and_a_resumed_adaptive_run_goes_on(tmp_path):
+    he = prebo.System(["alpha", "e", "e"], spin={"e": 0})
+    basis = prebo.optimise(he, Optimiser(size=400, budget=2.0), out=tmp_path, progress=False)
+    assert basis.convergence["stopped"] == "budget" and 2.0 <= basis.convergence["seconds"] < 30
+    assert 0 < len(basis) < 400
+    d = json.loads((tmp_path / "basis.json").read_text())
+    d["progress"] = vars(Adaptive(Optimiser(size=400)).begin("grow", len(basis), 3))
+    d["optimiser"]["budget"] = d["elapsed"] + 1.0  # one more second
+    d["stopped"] = None
+    (tmp_path / "basis.json").write_text(json.dumps(d))
+    more, _ = resume_from(tmp_path, progress=False)
+    assert more.convergence["stopped"] == "budget" and len(more) > len(basis)
+    assert json.loads((tmp_path / "basis.json").read_text())["schedule"]["passes"][:len(d["schedule"]["passes"])] \
+        == d["schedule"]["passes"]
