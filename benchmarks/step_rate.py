@@ -1,11 +1,12 @@
 """Optimiser steps per minute on a run's checkpoint: `--steps` consecutive steps of one phase
 ("sweep": replacement with `trials` random functions, the winner refined; "refine": L-BFGS
 refinement of one function) from function `--first` on, with the checkpoint's settings, random
-state and basis — the quantity the optimiser feels. The matrices of the basis are built before
+state and basis, LAPACK threads as the driver sets them — the quantity the optimiser feels. The matrices of the basis are built before
 the clock starts. The energy after the steps shows that two builds took the same path.
 
     python benchmarks/step_rate.py benchmarks/checkpoints/h2-cycles --phase refine --first 100 --steps 10
     python benchmarks/step_rate.py benchmarks/checkpoints/h2-cycles --phase sweep --first 100 --steps 5
+    python benchmarks/step_rate.py examples/bases/auto-he-400 --phase refine --steps 20 --blas-threads 2
 """
 from __future__ import annotations
 
@@ -13,7 +14,14 @@ import argparse
 import time
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
+try:
+    from prebo.eigen import lapack_threads as threads
+except ImportError:  # code before the LAPACK thread limit
+    from contextlib import nullcontext as threads
+
+from prebo import eigen
 from prebo.integrals import laboratory
 from prebo.optimise.checkpoint import Cursor, load_checkpoint, resumed
 from prebo.optimise.expansion import Expansion
@@ -28,6 +36,7 @@ def main():
     ap.add_argument("--phase", choices=("sweep", "refine"), default="refine")
     ap.add_argument("--first", type=int, default=100, help="the function of the first step")
     ap.add_argument("--steps", type=int, default=10)
+    ap.add_argument("--blas-threads", type=int, help="LAPACK/BLAS threads instead of the driver's choice")
     args = ap.parse_args()
     d, system, opts = load_checkpoint(args.checkpoint)
     rng = np.random.default_rng(opts.seed)
@@ -38,10 +47,14 @@ def main():
     run = Run(ex, sampler, Reporter(opts, False))
     step = methods(opts)[args.phase]
     e0, times = ex.energy, []
-    for i in range(args.first, args.first + args.steps):
-        t0 = time.perf_counter()
-        step.step(run, Cursor(args.phase, index=i))
-        times.append(time.perf_counter() - t0)
+    if args.blas_threads is not None and hasattr(eigen, "SERIAL_BELOW"):
+        eigen.SERIAL_BELOW = 0  # no one-thread limit in eigen.solve either
+    with (threads(len(ex.basis)) if args.blas_threads is None  # as the driver runs its steps
+          else threadpool_limits(args.blas_threads, user_api="blas")):
+        for i in range(args.first, args.first + args.steps):
+            t0 = time.perf_counter()
+            step.step(run, Cursor(args.phase, index=i))
+            times.append(time.perf_counter() - t0)
     t = np.array(times)
     print(f"{args.checkpoint}: {args.steps} {args.phase} steps from function {args.first} "
           f"({opts.kind}, {len(ex.basis)} functions, trials {opts.trials}, "

@@ -204,3 +204,18 @@ def test_the_budget_stops_a_run_and_a_resumed_adaptive_run_goes_on(tmp_path):
     assert more.convergence["stopped"] == "budget" and len(more) > len(basis)
     assert json.loads((tmp_path / "basis.json").read_text())["schedule"]["passes"][:len(d["schedule"]["passes"])] \
         == d["schedule"]["passes"]
+
+
+def test_growth_that_stalls_ends_at_the_size_reached_in_an_adaptive_schedule(tmp_path, monkeypatch):
+    """Every trial rejected (here: max_overlap 1e-9, no trial is that far from every function) — a
+    fixed schedule stops with StalledError, the adaptive one keeps the size reached and goes on."""
+    from prebo.errors import StalledError
+    from prebo.optimise import methods
+    monkeypatch.setattr(methods, "STALL_STEPS", 5)
+    h = prebo.System(["p", "e"])
+    with pytest.raises(StalledError):
+        prebo.optimise(h, Optimiser(size=10, max_overlap=1e-9, sweeps=0), progress=False)
+    basis = prebo.optimise(h, Optimiser(size=10, max_overlap=1e-9), out=tmp_path, progress=False)
+    d = json.loads((tmp_path / "basis.json").read_text())
+    assert len(basis) == d["schedule"]["stalled"] == 1 and basis.convergence["stopped"] == "exhausted"
+    assert {p[0] for p in d["schedule"]["passes"]} == {"grow", "refine", "sweep", "polish"}

@@ -138,12 +138,20 @@ def test_max_overlap_zero_is_refused(tmp_path, capsys):
 
 
 def test_growth_whose_every_trial_is_rejected_stops_naming_the_setting(tmp_path, capsys):
-    """max_overlap = 1e-9 is allowed but rejects every trial after the first function: the run
-    stops (after optimise.STALL_STEPS steps) instead of looping forever."""
-    err = toml_error(capsys, tmp_path, H_TOML + "max_overlap = 1e-9\n", "every trial of the last",
+    """max_overlap = 1e-9 is allowed but rejects every trial after the first function: a fixed
+    schedule stops (after optimise.STALL_STEPS steps) instead of looping forever; the adaptive one
+    keeps the size reached and warns, naming the same settings."""
+    err = toml_error(capsys, tmp_path, H_TOML + "max_overlap = 1e-9\nsweeps = 0\n", "every trial of the last",
                      "raise max_overlap (now 1e-09)")
     assert "growth steps was rejected at 1 functions" in err
     assert json.loads((tmp_path / "out" / "basis.json").read_text())["functions"]  # the state is kept
+    f = tmp_path / "adaptive.toml"
+    f.write_text(H_TOML + "max_overlap = 1e-9\n")
+    assert main(["run", str(f), "--out", str(tmp_path / "adaptive"), "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith("prebo: warning: growth stalled") and "raise max_overlap (now 1e-09)" in err
+    result = json.loads((tmp_path / "adaptive" / "result.json").read_text())
+    assert result["n_basis"] == result["convergence"]["stalled"]["size"] == 1
 
 
 def test_size_beyond_memory_is_refused(tmp_path, capsys):

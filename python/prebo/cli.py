@@ -119,6 +119,9 @@ def cmd_run(args) -> int:
         _print_result(r)
         print(f"wrote {out / 'result.json'} and {out / 'basis.json'}")
     _warn_if_unbound(r)
+    if basis.convergence["stalled"]:
+        print(f"prebo: warning: growth stalled short of the basis size: {basis.convergence['stalled']['why']}",
+              file=sys.stderr)
     return 0
 
 

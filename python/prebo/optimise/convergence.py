@@ -2,8 +2,10 @@
 steps [n_b, E, phase, seconds]:
 
 - `stopped`: why the run ended — "exhausted" (the adaptive schedule: every kind of pass gains
-  less than a tenth of what growth gained per second, or than `tolerance`), "budget" (the wall-time budget) or "schedule" (a fixed schedule ran
+  less than a fiftieth of what growth gained per second, or than `tolerance`), "budget" (the wall-time budget) or "schedule" (a fixed schedule ran
   out) — and `seconds` of optimisation over every segment of the run;
+- `stalled`: where growth of an adaptive schedule stopped short of `size` (every trial refused;
+  the basis kept the size it reached), with the settings to change, or None;
 - `recent`: the energy gained by the last RECENT accepted steps, the seconds they span and the
   gain rate in Eh/s;
 - `extrapolation`: from the energies E₁, E₂, E₃ at three equally spaced times between the end of
@@ -14,6 +16,7 @@ steps [n_b, E, phase, seconds]:
 """
 from __future__ import annotations
 
+from .methods import stalled
 from .settings import Optimiser
 
 RECENT = 10
@@ -28,11 +31,14 @@ def energy_at(steps: list, t: float) -> float:
     return [h[1] for h in steps if h[3] <= t][-1]
 
 
-def convergence(history: list, opts: Optimiser, stopped: str | None, seconds: float) -> dict:
-    """The report of a run with `history` (module docstring)."""
+def convergence(history: list, opts: Optimiser, stopped: str | None, seconds: float,
+                stalled_at: int | None = None) -> dict:
+    """The report of a run with `history` (module docstring); `stalled_at`: the size at which growth
+    stalled."""
     steps = [h for h in history if len(h) >= 4]
     report = {"stopped": stopped, "seconds": seconds, "adaptive": opts.adaptive, "recent": None,
-              "extrapolation": None}
+              "extrapolation": None,
+              "stalled": None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts)}}
     if len(steps) >= 2:
         last = steps[-min(RECENT + 1, len(steps)):]
         gain, span = last[0][1] - last[-1][1], last[-1][3] - last[0][3]

@@ -18,7 +18,7 @@ import numpy as np
 
 from .. import eigen
 from ..basis import Basis
-from ..errors import InputError
+from ..errors import InputError, StalledError
 from ..integrals import laboratory
 from ..io.basis_json import remove_stale_temporaries
 from ..system import System
@@ -87,7 +87,13 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     with run.report, eigen.lapack_threads(opts.size):
         while cursor.phase != "done":
             old = ex.energy
-            steps[cursor.phase].step(run, cursor)
+            try:
+                steps[cursor.phase].step(run, cursor)
+            except StalledError:
+                if not opts.adaptive:
+                    raise
+                run.stalled = 0
+                schedule.stall(len(ex.basis))
             if ex.energy < old:
                 history.append([len(ex.basis), ex.energy, cursor.phase, wall()])
                 run.report.step(ex, old, cursor)
@@ -103,7 +109,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 cursor, stopped = Cursor("done"), "budget"
             checkpoint()
     ex.basis.coefficients = ex.eig.vectors[:, 0]
-    ex.basis.convergence = convergence(history, opts, stopped, wall())
+    ex.basis.convergence = convergence(history, opts, stopped, wall(), schedule.stalled)
     return ex.basis
 
 

@@ -76,11 +76,14 @@ class Grow:
             return
         run.stalled += 1
         if run.stalled == STALL_STEPS:
-            raise StalledError(
-                f"optimiser: every trial of the last {run.stalled} growth steps was rejected at "
-                f"{len(ex.basis)} functions (linearly dependent on the basis or implausible); raise "
-                f"max_overlap (now {ex.max_overlap:g}), lower min_norm (now {ex.min_norm:g}) "
-                f"or change length_range (now {list(run.sampler.opts.length_range)})")
+            raise StalledError(f"optimiser: {stalled(len(ex.basis), run.sampler.opts)}")
+
+
+def stalled(nb: int, opts: Optimiser) -> str:
+    """Why growth stopped at `nb` functions, and the settings to change."""
+    return (f"every trial of the last {STALL_STEPS} growth steps was rejected at {nb} functions (linearly "
+            f"dependent on the basis or implausible); raise max_overlap (now {opts.max_overlap:g}), lower "
+            f"min_norm (now {opts.min_norm:g}) or change length_range (now {list(opts.length_range)})")
 
 
 @dataclass(frozen=True)

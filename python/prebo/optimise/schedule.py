@@ -8,7 +8,9 @@ L-BFGS step (methods.py). After each pass the next one is of the kind whose last
 the most energy per second of wall time; kinds not yet tried come first. A kind's rate is
 measured again only when it runs again, so the rate it keeps is that of an earlier, richer
 state: as the running kind's rate falls below it, the other kinds are tried again, and each
-stays in use as long as it pays best. Growth is a kind while the basis is smaller than `size`.
+stays in use as long as it pays best. Growth is a kind while the basis is smaller than `size`
+and growth has not stalled (`stall`: every trial of STALL_STEPS steps linearly dependent on the
+basis; the basis then keeps the size it reached).
 
 At full size the basis is exhausted, and the schedule ends, when the last pass of every kind
 gains less than RATIO of what the last growth pass gained per second (a larger basis would
@@ -21,8 +23,8 @@ fixed schedule (any of sweeps, refine, polish, cycles given) repeats bit for bit
 
 The passes, [kind, n_b, E before, E after, seconds before, seconds after, functions] (E
 before is None for the first; functions: those the pass visited, 1 for a joint step), the
-start of the pass in flight, [E, seconds], and where each sweep goes on are kept in the
-checkpoint, so a resumed run goes on with what it had learned (`check` reads them back).
+start of the pass in flight, [E, seconds], where each sweep goes on and the size at which growth
+stalled (None) are kept in the checkpoint, so a resumed run goes on with what it had learned (`check` reads them back).
 """
 from __future__ import annotations
 
@@ -36,7 +38,7 @@ GROWTH = 8
 #: the most functions a refinement or replacement pass visits
 CHUNK = 50
 #: exhausted below this share of the last growth pass's gain per second
-RATIO = 0.1
+RATIO = 0.02
 #: the default tolerance relative to |E|: a sweep that gains less has exhausted the basis
 TOLERANCE = 1e-10
 #: the kinds of pass that improve a basis of fixed size, in the order they are first tried
@@ -48,11 +50,20 @@ class Adaptive:
     function each sweep goes on with) from a checkpoint."""
 
     def __init__(self, opts: Optimiser, passes: list | None = None, start: list | None = None,
-                 next: dict | None = None):
-        self.opts = opts
+                 next: dict | None = None, stalled: int | None = None):
+        self.opts, self.stalled = opts, stalled
         self.passes = [list(p) for p in passes or []]
         self.start = list(start) if start is not None else [None, 0.0]  # no energy before the first function
         self.next = dict(next or {"refine": 0, "sweep": 0})
+
+    @property
+    def size(self) -> int:
+        """The size the basis grows to: `size`, or where growth stalled."""
+        return self.opts.size if self.stalled is None else min(self.opts.size, self.stalled)
+
+    def stall(self, nb: int) -> None:
+        """Growth stalled at `nb` functions (methods.Grow): the basis keeps that size."""
+        self.stalled = nb
 
     def first(self) -> Cursor:
         """The cursor of a new run: growth from no function."""
@@ -62,7 +73,7 @@ class Adaptive:
         """The cursor at the start of pass `number` of `kind` on a basis of `nb` functions: a growth
         pass keeps its target size in `sweep`, a sweep pass its count of functions visited."""
         if kind == "grow":
-            return Cursor("grow", sweep=min(self.opts.size, nb + max(GROWTH, nb // 4)), cycle=number)
+            return Cursor("grow", sweep=min(self.size, nb + max(GROWTH, nb // 4)), cycle=number)
         return Cursor(kind, index=self.next.get(kind, 0) % max(nb, 1), cycle=number)
 
     def tolerance(self, energy: float) -> float:
@@ -73,7 +84,7 @@ class Adaptive:
         """The unit of work after the one at `cursor`, which left `nb` functions at `energy` after
         `now` seconds of the run; at the end of a pass it is recorded and the next one chosen."""
         phase, visited = cursor.phase, cursor.sweep + 1
-        if phase == "grow" and nb < cursor.sweep:
+        if phase == "grow" and nb < min(cursor.sweep, self.size):
             return cursor
         if phase in ("sweep", "refine"):
             self.next[phase] = (cursor.index + 1) % nb
@@ -105,7 +116,7 @@ class Adaptive:
     def choose(self, nb: int, energy: float) -> str | None:
         """The kind of the next pass, or None when the basis is exhausted (module docstring)."""
         last = {p[0]: p for p in self.passes}
-        growing = nb < self.opts.size
+        growing = nb < self.size
         if growing and "grow" not in last:
             return "grow"
         untried = [k for k in IMPROVE if k not in last]
@@ -117,7 +128,7 @@ class Adaptive:
 
     def to_dict(self) -> dict:
         """The checkpoint's "schedule" block."""
-        return {"passes": self.passes, "start": self.start, "next": self.next}
+        return {"passes": self.passes, "start": self.start, "next": self.next, "stalled": self.stalled}
 
     @classmethod
     def check(cls, opts: Optimiser, block) -> "Adaptive":
@@ -140,11 +151,12 @@ class Adaptive:
                     and energy(p[2]) and p[3] is not None and energy(p[3]) and seconds(p[4]) and seconds(p[5])
                     and count(p[6]) and p[6] > 0)
 
-        passes, start, nxt = ((block.get("passes"), block.get("start"), block.get("next"))
-                              if isinstance(block, dict) else (None, None, None))
+        passes, start, nxt, stalled = ((block.get("passes"), block.get("start"), block.get("next"),
+                                        block.get("stalled")) if isinstance(block, dict) else (None,) * 4)
         if not (isinstance(passes, list) and all(map(one, passes)) and isinstance(start, list) and len(start) == 2
                 and energy(start[0]) and seconds(start[1]) and isinstance(nxt, dict)
-                and set(nxt) == {"refine", "sweep"} and all(map(count, nxt.values()))):
+                and set(nxt) == {"refine", "sweep"} and all(map(count, nxt.values()))
+                and (stalled is None or count(stalled))):
             raise ValueError("schedule must be {passes: [[kind, n_b, E before, E after, t before, t after, "
-                             "functions], ...], start: [E, t], next: {refine: i, sweep: j}}")
-        return cls(opts, passes, start, nxt)
+                             "functions], ...], start: [E, t], next: {refine: i, sweep: j}, stalled: n_b or null}")
+        return cls(opts, passes, start, nxt, stalled)
