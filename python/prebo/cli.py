@@ -61,8 +61,8 @@ def _print_result(r: dict) -> None:
             t.add_row(f"last {c['recent']['steps']} steps", f"ΔE = {-c['recent']['gain']:.2e} Eh in "
                       f"{c['recent']['seconds']:.1f} s" + (f" ({rate:.1e} Eh/s)" if rate else ""))
         if c["extrapolation"]:
-            t.add_row("still to gain at this size", f"~{c['extrapolation']['remaining']:.1e} Eh (extrapolated: "
-                      "a power law in time; not the error against the exact energy)")
+            t.add_row("still to gain at this size", f"~{c['extrapolation']['remaining']:.1e} Eh (Aitken's Δ² of the "
+                      "gains since growth; not the error against the exact energy)")
     for name, values in r.get("expectation", {}).items():
         op = OPERATORS[name]
         for pair, value in values.items():

@@ -1,7 +1,8 @@
 """Where a run stands, and its checkpoint: out/basis.json holds the basis, the settings, the
 `Cursor` (the next unit of work), the random-number state, the history, the seconds spent, the
-adaptive schedule's passes and why the run stopped, written atomically after every step; `load_checkpoint` reads it back for `prebo run --resume`,
-which continues the run bit for bit.
+adaptive schedule's passes and why the run stopped, written atomically after every step;
+`load_checkpoint` reads it back for `prebo run --resume`, which continues the run (bit for bit
+in a fixed schedule).
 """
 from __future__ import annotations
 

@@ -2,8 +2,9 @@
 steps [n_b, E, phase, seconds]:
 
 - `stopped`: why the run ended — "exhausted" (the adaptive schedule: every kind of pass gains
-  less than a fiftieth of what growth gained per second, or than `tolerance`), "budget" (the wall-time budget) or "schedule" (a fixed schedule ran
-  out) — and `seconds` of optimisation over every segment of the run;
+  less than a fiftieth of what growth gained per second, or than `tolerance`), "budget" (the
+  wall-time budget) or "schedule" (a fixed schedule ran out) — and `seconds` of optimisation
+  over every segment of the run;
 - `stalled`: where growth of an adaptive schedule stopped short of `size` (every trial refused;
   the basis kept the size it reached), with the settings to change, or None;
 - `recent`: the energy gained by the last RECENT accepted steps, the seconds they span and the

@@ -47,8 +47,10 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     checkpoint); progress: show a live line; resume: a checkpoint's content
     (checkpoint.load_checkpoint) to continue exactly where it stopped.
     Returns the basis with the ground state's coefficients and `convergence`, the report of
-    convergence.py; its energy (hartree) is prebo.evaluate(basis)["energy"]. InputError for arguments of the wrong type, StalledError when
-    growth rejects every trial for STALL_STEPS steps, BasisFileError for a `resume` that does not fit."""
+    convergence.py; its energy (hartree) is prebo.evaluate(basis)["energy"]. InputError for
+    arguments of the wrong type, StalledError when growth rejects every trial for STALL_STEPS
+    steps in a fixed schedule (the adaptive one keeps the size reached), BasisFileError for a
+    `resume` that does not fit."""
     if not isinstance(system, System):
         raise InputError(f"optimise: system = {system!r}: must be a prebo.System")
     if not isinstance(opts, Optimiser):

@@ -10,7 +10,8 @@ from dataclasses import dataclass, fields
 from ..basis import FAMILIES
 from ..basis.gvr import K_LIMIT
 from ..errors import InputError
-from ..validation import MATRICES, MAX_SIZE, Automatic, Channels, Choice, Integer, Lengths, Real, Refused, strict_keywords
+from ..validation import (MATRICES, MAX_SIZE, Automatic, Channels, Choice, Integer, Lengths, Real, Refused,
+                          strict_keywords)
 
 REFINE_METHODS = ("powell", "gradient")
 SCHEDULE = ("sweeps", "refine", "polish", "cycles")  # the fixed schedule's settings
