@@ -87,7 +87,7 @@ def passes(schedule, *rows):
     E, t = (schedule.passes[-1][3], schedule.passes[-1][5]) if schedule.passes else (None, 0.0)
     for kind, nb, gain, seconds in rows:
         after = -1.0 if E is None else E - gain
-        schedule.passes.append([kind, nb, E, after, t, t + seconds, 1 if kind in ("grow", "polish") else
+        schedule.passes.append([kind, nb, E, after, t, t + seconds, nb if kind in ("grow", "polish") else
                                 min(CHUNK, nb)])
         E, t = after, t + seconds
     return E

@@ -15,16 +15,17 @@ basis; the basis then keeps the size it reached).
 At full size the basis is exhausted, and the schedule ends, when the last pass of every kind
 gains less than RATIO of what the last growth pass gained per second (a larger basis would
 gain faster; where growth took one pass, there is no such rate), or, over a whole sweep, less
-than `tolerance` Eh (default TOLERANCE |E|). The
-wall-time budget stops any schedule (driver.py).
+than `tolerance` Eh (default TOLERANCE |E|). The wall-time budget stops any schedule
+(driver.py).
 
 The choices follow measured seconds, so two runs of one input may part in their last digits; a
 fixed schedule (any of sweeps, refine, polish, cycles given) repeats bit for bit.
 
 The passes, [kind, n_b, E before, E after, seconds before, seconds after, functions] (E
-before is None for the first; functions: those the pass visited, 1 for a joint step), the
-start of the pass in flight, [E, seconds], where each sweep goes on and the size at which growth
-stalled (None) are kept in the checkpoint, so a resumed run goes on with what it had learned (`check` reads them back).
+before is None for the first; functions: those the pass visited, every one for growth and a
+joint step), the start of the pass in flight, [E, seconds], where each sweep goes on and the
+size at which growth stalled (None) are kept in the checkpoint, so a resumed run goes on with
+what it had learned (`check` reads them back).
 """
 from __future__ import annotations
 
@@ -90,7 +91,7 @@ class Adaptive:
             self.next[phase] = (cursor.index + 1) % nb
             if visited < min(CHUNK, nb):
                 return Cursor(phase, visited, self.next[phase], cursor.cycle)
-        functions = visited if phase in ("sweep", "refine") else 1
+        functions = visited if phase in ("sweep", "refine") else nb
         self.passes.append([phase, nb, self.start[0], energy, self.start[1], now, functions])
         self.start = [energy, now]
         kind = self.choose(nb, energy)
@@ -109,9 +110,8 @@ class Adaptive:
         """Whether every kind's last pass gained less than RATIO of the last growth pass's rate, or
         less than the tolerance over a whole sweep (module docstring)."""
         grown = RATIO * self.rate(last["grow"]) if math.isfinite(self.gain(last.get("grow", [0, 0, None]))) else 0.0
-        return all(self.rate(last[k]) < grown for k in IMPROVE) or all(
-            self.gain(last[k]) * nb / last[k][6] < self.tolerance(energy) if k != "polish"
-            else self.gain(last[k]) < self.tolerance(energy) for k in IMPROVE)
+        return (all(self.rate(last[k]) < grown for k in IMPROVE)
+                or all(self.gain(last[k]) * nb / last[k][6] < self.tolerance(energy) for k in IMPROVE))
 
     def choose(self, nb: int, energy: float) -> str | None:
         """The kind of the next pass, or None when the basis is exhausted (module docstring)."""
