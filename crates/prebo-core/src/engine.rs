@@ -1,6 +1,7 @@
 //! The engine: one basis family in one coordinate representation, with every build the
 //! binding offers. Flat row-major arrays in and out; the coordinate dimension `n` and the
 //! family are dispatched once per call to the const-generic, family-generic path (`path`).
+use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Vector};
 use crate::error::{CoreError, Result};
 use crate::family::{check, Directions, Family, Params};
@@ -104,12 +105,14 @@ impl Representation {
     }
 }
 
-/// One basis family in one representation, with the total angular momentum N (ECG-GVR; M = N).
-#[derive(Clone, Debug)]
+/// One basis family in one representation, with the total angular momentum N (ECG-GVR; M = N),
+/// and the basis side of its last rows and row gradients (`cache`).
+#[derive(Debug)]
 pub struct Engine {
     pub kind: Kind,
     pub rep: Representation,
     pub n_ang: u32,
+    cache: Cache,
 }
 
 /// Calls `$f::<D, F>($args)` for the engine's dimension and family (`$fam` limits the families).
@@ -154,6 +157,7 @@ fn rows_d<const D: usize, F: Family<D>>(
         trials,
         basis,
         position,
+        &e.cache,
     )
 }
 
@@ -164,7 +168,7 @@ fn row_gradient_d<const D: usize, F: Family<D>>(
     basis: &Params,
 ) -> Result<(Matrices, Vec<Element>)> {
     let (ops, sym) = e.rep.operators::<D>();
-    F::row_gradient(&F::context(ops, e.n_ang, &[trial, basis])?, &sym, trial, dir, basis)
+    F::row_gradient(&F::context(ops, e.n_ang, &[trial, basis])?, &sym, trial, dir, basis, &e.cache)
 }
 
 fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &Params, w: &[f64]) -> Result<Vec<f64>> {
@@ -194,7 +198,7 @@ impl Engine {
                 kind.name()
             )));
         }
-        Ok(Self { kind, rep, n_ang })
+        Ok(Self { kind, rep, n_ang, cache: Cache::default() })
     }
 
     /// Overlap, kinetic (full and translation-free) and Coulomb matrices of a basis.

@@ -10,6 +10,7 @@
 //! (`fecg::FloatingEcg`).
 use nalgebra::SMatrix;
 
+use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Real};
 use crate::error::{CoreError, Result};
 use crate::gradient::Dual;
@@ -138,26 +139,30 @@ pub trait Family<const D: usize>: Sized + 'static {
     }
 
     /// Rows of trials against a basis and the trials' diagonals (default: the generic path,
-    /// oriented for a trial that will sit at `position`, `None`: appended).
+    /// oriented for a trial that will sit at `position`, `None`: appended). The basis side's
+    /// preparations are kept in `cache` for the next call against the same basis.
     fn rows(
         ctx: &Self::Context,
         sym: &Symmetry<D>,
         trials: &Params,
         basis: &Params,
         position: Option<usize>,
+        cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
-        path::rows::<D, Self>(ctx, sym, trials, basis, position)
+        path::rows::<D, Self>(ctx, sym, trials, basis, position, cache)
     }
 
     /// The row of one function against a basis and its diagonal, with their derivatives along
-    /// the directions `dir` (default: dual numbers through `element`, `path::row_gradient`).
+    /// the directions `dir` (default: dual numbers through `element`, `path::row_gradient`);
+    /// `cache` as for `rows`.
     fn row_gradient(
         ctx: &Self::Context,
         sym: &Symmetry<D>,
         trial: &Params,
         dir: &Directions,
         basis: &Params,
+        cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
-        path::row_gradient::<D, Self>(ctx, sym, trial, dir, basis)
+        path::row_gradient::<D, Self>(ctx, sym, trial, dir, basis, cache)
     }
 }

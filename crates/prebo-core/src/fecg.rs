@@ -20,6 +20,7 @@ use std::f64::consts::PI;
 
 use nalgebra::SMatrix;
 
+use crate::cache::Cache;
 use crate::ecg::{dot_f, inverse_log_det, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
 use crate::family::{matrices_of, Directions, Family, Params, Symmetry};
@@ -118,8 +119,9 @@ impl<const D: usize> Family<D> for FloatingEcg {
         trial: &Params,
         dir: &Directions,
         basis: &Params,
+        cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
-        crate::fecg_gradient::row_gradient(ops, sym, trial, dir, basis)
+        crate::fecg_gradient::row_gradient(ops, sym, trial, dir, basis, cache)
     }
 
     /// `(r-s)^T A (r-s) + r^T M r = r^T (A+M) r - 2 r^T A s + s^T A s`: `A` grows, `A s`, `s^T A s`

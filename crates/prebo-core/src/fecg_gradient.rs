@@ -25,6 +25,7 @@ use std::f64::consts::PI;
 use nalgebra::Cholesky;
 use rayon::prelude::*;
 
+use crate::cache::Cache;
 use crate::ecg::{mul, Element, Mat, Operators};
 use crate::error::{CoreError, Result};
 use crate::family::{check, matrices_of, Directions, Family, Params, Symmetry};
@@ -162,17 +163,18 @@ fn add_element<const D: usize>(
 /// The row of one floating ECG against a basis and its diagonal, with their derivatives along
 /// the directions `dir`: the layout of `path::row_gradient` (`(1 + P) x nb` matrices, row 0 the
 /// values with the function as bra, the function un-transformed), the row by `add_element`,
-/// the diagonal by dual numbers.
+/// the diagonal by dual numbers; the basis images kept in `cache`.
 pub fn row_gradient<const D: usize>(
     ops: &Operators<D>,
     sym: &Symmetry<D>,
     trial: &Params,
     dir: &Directions,
     basis: &Params,
+    cache: &Cache,
 ) -> Result<(Matrices, Vec<Element>)> {
     check(trial.len(), 1, "trial functions")?;
     let f = <FloatingEcg as Family<D>>::functions(trial, ops)?.remove(0);
-    let b = path::images::<D, FloatingEcg>(ops, sym, basis)?;
+    let b = path::basis_images::<D, FloatingEcg>(ops, sym, basis, cache)?;
     let (da, _) = dir.exponents::<D>()?;
     let ds = matrices_of::<D, 3>(dir.v, da.len(), "centre directions")?;
     let a_inv = Cholesky::new(f.a).ok_or(CoreError::NotPositiveDefinite { function: 0 })?.inverse();
@@ -199,7 +201,7 @@ pub fn row_gradient<const D: usize>(
             m.set(k, j, x);
         }
     }
-    let (_, diag) = path::row_gradient::<D, FloatingEcg>(ops, sym, trial, dir, &Params::default())?;
+    let (_, diag) = path::row_gradient::<D, FloatingEcg>(ops, sym, trial, dir, &Params::default(), &Cache::default())?;
     Ok((m, diag))
 }
 

@@ -170,8 +170,8 @@ fn against_dual<const D: usize>(n_dir: usize) -> (f64, f64) {
                 let trial = Params { a: &p.a[..D * D], c_a: &p.c_a[..1], v: &p.v[..3 * D], k_pow: &[] };
                 let basis = Params { a: &p.a[D * D..], c_a: &p.c_a[1..], v: &p.v[3 * D..], k_pow: &[] };
                 let dir = Directions { a: &da, v: &ds };
-                let (hand, hand_diag) = <FloatingEcg as Family<D>>::row_gradient(&ops, &sym, &trial, &dir, &basis).unwrap();
-                let (dual, dual_diag) = path::row_gradient::<D, FloatingEcg>(&ops, &sym, &trial, &dir, &basis).unwrap();
+                let (hand, hand_diag) = <FloatingEcg as Family<D>>::row_gradient(&ops, &sym, &trial, &dir, &basis, &Cache::default()).unwrap();
+                let (dual, dual_diag) = path::row_gradient::<D, FloatingEcg>(&ops, &sym, &trial, &dir, &basis, &Cache::default()).unwrap();
                 assert_eq!((hand.rows, hand.cols), (1 + n_dir, 6));
                 assert_eq!(hand_diag, dual_diag);
                 let (values, derivatives) = deviation(&set, &ops, &sym, &hand, &dual);
@@ -179,7 +179,7 @@ fn against_dual<const D: usize>(n_dir: usize) -> (f64, f64) {
                 assert!(values <= 1e-13, "{case}: values {values:e}");
                 assert!(derivatives <= 1e-12, "{case}: derivatives {derivatives:e}");
                 // the values are those of `rows` with the trial as bra (at position 0), bit for bit
-                let (rows, _) = <FloatingEcg as Family<D>>::rows(&ops, &sym, &trial, &basis, Some(0)).unwrap();
+                let (rows, _) = <FloatingEcg as Family<D>>::rows(&ops, &sym, &trial, &basis, Some(0), &Cache::default()).unwrap();
                 assert_eq!(rows.s.iter().chain(&rows.v).chain(&rows.t_ti).map(|x| x.to_bits()).collect::<Vec<_>>(),
                     hand.s[..6].iter().chain(&hand.v[..6]).chain(&hand.t_ti[..6]).map(|x| x.to_bits()).collect::<Vec<_>>());
                 let r = coulomb_range(&set, &ops, &sym);
@@ -213,10 +213,10 @@ fn agrees_with_central_differences() {
         let a: Vec<f64> = (0..D * D).map(|i| p.a[i] + h * da[k * D * D + i]).collect();
         let s: Vec<f64> = (0..3 * D).map(|i| p.v[i] + h * ds[k * 3 * D + i]).collect();
         let t = Params { a: &a, c_a: &p.c_a[..1], v: &s, k_pow: &[] };
-        <FloatingEcg as Family<D>>::rows(&ops, &sym, &t, &basis, Some(0)).unwrap().0
+        <FloatingEcg as Family<D>>::rows(&ops, &sym, &t, &basis, Some(0), &Cache::default()).unwrap().0
     };
     let t0 = Params { a: &p.a[..D * D], c_a: &p.c_a[..1], v: &p.v[..3 * D], k_pow: &[] };
-    let (hand, _) = <FloatingEcg as Family<D>>::row_gradient(&ops, &sym, &t0, &Directions { a: &da, v: &ds }, &basis).unwrap();
+    let (hand, _) = <FloatingEcg as Family<D>>::row_gradient(&ops, &sym, &t0, &Directions { a: &da, v: &ds }, &basis, &Cache::default()).unwrap();
     let h = 1e-5;
     let fi = set.function::<D>(0);
     for k in 0..4 {

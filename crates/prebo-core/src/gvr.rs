@@ -51,12 +51,14 @@ use std::f64::consts::PI;
 
 use nalgebra::{Cholesky, SMatrix, SVector};
 
+use crate::cache::Cache;
 use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
 use crate::build::best_isa;
 use crate::family::{check, matrices_of, Family, Params, Symmetry};
 use crate::gvr_build;
-use crate::gvr_kernel::MAX_W;
+#[cfg(test)]
+use crate::gvr_kernel::padded_rule;
 use crate::matrices::Matrices;
 use crate::gradient::{seed_matrix, Dual};
 use crate::images::Transform;
@@ -270,6 +272,8 @@ pub(crate) fn series_coefficients<const D: usize>(go: &GvrOps<D>, ki: u32, kj: u
 /// (K_I, K_J) for each of `inputs` = `[x, y, z, γ_I, γ_J]` (`quadrature`), with its partial
 /// derivatives with respect to the five inputs (the maths of `quadrature_partials`), into
 /// `out`: nodes in lanes of the f64 kernel (`gvr_kernel::integral_partials`, `gvr_build::partials`).
+/// The tests' entry point; the row gradient keeps its rules per pair (`gvr_gradient`).
+#[cfg(test)]
 pub(crate) fn coulomb_partials<const D: usize>(
     go: &GvrOps<D>,
     ki: u32,
@@ -278,10 +282,7 @@ pub(crate) fn coulomb_partials<const D: usize>(
     out: &mut [(f64, [f64; 5])],
 ) {
     let c = Coefficients::new(ki, kj, go.n_ang).c;
-    let rule = go.legendre[(ki + kj + go.n_ang) as usize];
-    let padded = rule.len().div_ceil(MAX_W) * MAX_W;
-    let tau2: Vec<f64> = (0..padded).map(|i| rule.get(i).map_or(0.0, |(t, _)| t * t)).collect();
-    let weight: Vec<f64> = (0..padded).map(|i| rule.get(i).map_or(0.0, |(_, w)| *w)).collect();
+    let (tau2, weight) = padded_rule(go.rule(ki + kj + go.n_ang));
     gvr_build::partials(&c, (ki, kj, go.n_ang), &tau2, &weight, inputs, out);
 }
 
@@ -403,8 +404,9 @@ impl<const D: usize> Family<D> for EcgGvr {
         trials: &Params,
         basis: &Params,
         position: Option<usize>,
+        cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
-        gvr_build::rows(go, sym, trials, basis, position, best_isa())
+        gvr_build::rows(go, sym, trials, basis, position, best_isa(), cache)
     }
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
@@ -447,8 +449,9 @@ impl<const D: usize> Family<D> for EcgGvr {
         trial: &Params,
         dir: &crate::family::Directions,
         basis: &Params,
+        cache: &Cache,
     ) -> Result<(crate::matrices::Matrices, Vec<Element>)> {
-        crate::gvr_gradient::row_gradient(go, sym, trial, dir, basis)
+        crate::gvr_gradient::row_gradient(go, sym, trial, dir, basis, cache)
     }
 }
 
@@ -570,9 +573,7 @@ mod tests {
                     }
                 }
                 // the same bits on every instruction set
-                let padded = rule.len().div_ceil(MAX_W) * MAX_W;
-                let tau2: Vec<f64> = (0..padded).map(|i| rule.get(i).map_or(0.0, |(t, _)| t * t)).collect();
-                let weight: Vec<f64> = (0..padded).map(|i| rule.get(i).map_or(0.0, |(_, w)| *w)).collect();
+                let (tau2, weight) = padded_rule(rule);
                 for isa in [crate::build::Isa::Plain, crate::build::Isa::Avx2, crate::build::Isa::Avx512] {
                     let mut o = vec![(0.0, [0.0; 5]); inputs.len()];
                     gvr_build::partials_with(isa, &series.c, (ki, kj, n), &tau2, &weight, &inputs, &mut o);

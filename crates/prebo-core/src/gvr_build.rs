@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use crate::assemble;
 use crate::build::Isa;
+use crate::cache::Cache;
 use crate::ecg::Element;
 use crate::error::Result;
 use crate::family::{Params, Symmetry};
@@ -53,9 +54,7 @@ macro_rules! isa_kernels {
                 inputs: &[[f64; 5]],
                 out: &mut [(f64, [f64; 5])],
             ) {
-                for (x, o) in inputs.iter().zip(out.iter_mut()) {
-                    *o = integral_partials::<$w>(c, k, tau2, weight, *x);
-                }
+                integral_partials::<$w>(c, k, tau2, weight, inputs, out)
             }
         }
     };
@@ -175,7 +174,7 @@ pub fn matrices<const D: usize>(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &Param
 }
 
 /// Rows of trials against a basis for a trial that will sit at `position` (`None`: appended),
-/// oriented as `path::rows`, and the trials' diagonals.
+/// oriented as `path::rows`, and the trials' diagonals; the prepared basis kept in `cache`.
 pub fn rows<const D: usize>(
     go: &GvrOps<D>,
     sym: &Symmetry<D>,
@@ -183,9 +182,10 @@ pub fn rows<const D: usize>(
     basis: &Params,
     position: Option<usize>,
     isa: Isa,
+    cache: &Cache,
 ) -> Result<(Matrices, Vec<Element>)> {
     let t = Side::new(go, sym, trials)?;
-    let b = Side::new(go, sym, basis)?;
+    let b = cache.get(basis, || Side::new(go, sym, basis))?;
     let (kt, mut kb) = (t.powers(), b.powers());
     kb.extend(&kt);
     let table = Table::new(go, kt.iter().flat_map(|&ki| kb.iter().flat_map(move |&kj| [(ki, kj), (kj, ki)])));

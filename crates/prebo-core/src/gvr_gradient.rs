@@ -35,10 +35,13 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
+use crate::cache::Cache;
 use crate::ecg::{inverse_log_det, mul, Element, Mat, Vector};
 use crate::error::Result;
 use crate::family::{check, matrices_of, Directions, Family, Params, Symmetry};
-use crate::gvr::{coulomb_partials, omega, series_coefficients, Coefficients, EcgGvr, Gvr, GvrOps};
+use crate::gvr::{omega, series_coefficients, Coefficients, EcgGvr, Gvr, GvrOps};
+use crate::gvr_build;
+use crate::gvr_kernel::{padded_rule, MAX_PAIRS};
 use crate::matrices::Matrices;
 use crate::path;
 
@@ -84,18 +87,23 @@ impl<const D: usize> Adjoint<D> {
     }
 }
 
-/// The pair's series: `ĉ_k` for the Hessian and `Coefficients` for `gvr::omega`.
+/// The pair's series: `ĉ_k` for the Hessian and the Coulomb quadrature, `Coefficients` for
+/// `gvr::omega`, and the quadrature's padded rule (`gvr_kernel::padded_rule`).
 pub(crate) struct Series {
     coef: Coefficients,
     c: Vec<f64>,
     ki: u32,
     kj: u32,
     n: u32,
+    tau2: Vec<f64>,
+    weight: Vec<f64>,
 }
 
 impl Series {
     fn new<const D: usize>(go: &GvrOps<D>, ki: u32, kj: u32) -> Self {
-        Self { coef: Coefficients::new(ki, kj, go.n_ang), c: series_coefficients(go, ki, kj), ki, kj, n: go.n_ang }
+        let (tau2, weight) = padded_rule(go.rule(ki + kj + go.n_ang));
+        let (coef, c) = (Coefficients::new(ki, kj, go.n_ang), series_coefficients(go, ki, kj));
+        Self { coef, c, ki, kj, n: go.n_ang, tau2, weight }
     }
 
     /// `e^{-L}` times Ω's second derivatives, `[ω_xx, ω_xy, ω_yy, ω_xz, ω_yz, ω_zz]`: from
@@ -211,7 +219,7 @@ fn image<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, ser: &Serie
         None => (t, adj_t),
     };
 
-    let (v, adj_v) = coulomb(bra, ket, go, &m, &gi, &gj, [x, y, z], scale);
+    let (v, adj_v) = coulomb(go, ser, &m, &gi, &gj, [x, y, z], scale);
     let adj_s = Adjoint::of_xyz(xyz_bar([1.0, 0.0, 0.0, 0.0], first, &hess, scale));
     let values = [s, t, t_ti, v];
     let adjs = [adj_s, adj_t, adj_ti, adj_v];
@@ -250,12 +258,12 @@ fn kinetic<const D: usize>(
     Adjoint { xyz: [0.0; 3], a, u, gi: g_i, gj: g_j }
 }
 
-/// `V` of one image and its adjoints (module docs): all pairs through `gvr::coulomb_partials`.
+/// `V` of one image and its adjoints (module docs): all pairs in one call of the quadrature
+/// with partials (`gvr_build::partials`, the maths of `gvr::coulomb_partials`).
 #[allow(clippy::too_many_arguments)]
 fn coulomb<const D: usize>(
-    bra: &Gvr<D>,
-    ket: &Gvr<D>,
     go: &GvrOps<D>,
+    ser: &Series,
     m: &Mat<D>,
     gi: &Vector<D>,
     gj: &Vector<D>,
@@ -263,21 +271,22 @@ fn coulomb<const D: usize>(
     scale: f64,
 ) -> (f64, Adjoint<D>) {
     let pairs = &go.ops.pairs;
-    let mw: Vec<Vector<D>> = pairs.iter().map(|(w, _)| mul(m, w)).collect();
-    let c: Vec<f64> = mw.iter().zip(pairs).map(|(mw, (w, _))| mw.dot(w)).collect();
-    let inputs: Vec<[f64; 5]> = pairs
-        .iter()
-        .zip(&c)
-        .map(|((w, _), c)| {
-            let sq = (c * 2.0).sqrt();
-            [x, y, z, gi.dot(w) / sq, gj.dot(w) / sq]
-        })
-        .collect();
-    let mut out = vec![(0.0, [0.0; 5]); pairs.len()];
-    coulomb_partials(go, bra.k, ket.k, &inputs, &mut out);
+    let np = pairs.len();
+    assert!(np <= MAX_PAIRS, "at most {MAX_PAIRS} Coulomb pairs");
+    let mut mw = [Vector::<D>::zeros(); MAX_PAIRS];
+    let mut c = [0.0; MAX_PAIRS];
+    let mut inputs = [[0.0; 5]; MAX_PAIRS];
+    for (k, (w, _)) in pairs.iter().enumerate() {
+        mw[k] = mul(m, w);
+        c[k] = mw[k].dot(w);
+        let sq = (c[k] * 2.0).sqrt();
+        inputs[k] = [x, y, z, gi.dot(w) / sq, gj.dot(w) / sq];
+    }
+    let mut out = [(0.0, [0.0; 5]); MAX_PAIRS];
+    gvr_build::partials(&ser.c, (ser.ki, ser.kj, ser.n), &ser.tau2, &ser.weight, &inputs[..np], &mut out[..np]);
     let mut v = 0.0;
     let mut adj = Adjoint::of_xyz([0.0; 3]);
-    for k in 0..pairs.len() {
+    for k in 0..np {
         let ((w, q), (f, d), c) = (&pairs[k], &out[k], c[k]);
         let pref = q * 2.0 / (c * PI).sqrt();
         v += pref * f;
@@ -294,8 +303,8 @@ fn coulomb<const D: usize>(
     }
     let v = scale * v;
     let half_n = 0.5 * go.n_ang as f64;
-    adj.xyz[0] += v * (bra.k as f64 + half_n) / x;
-    adj.xyz[1] += v * (ket.k as f64 + half_n) / y;
+    adj.xyz[0] += v * (ser.ki as f64 + half_n) / x;
+    adj.xyz[1] += v * (ser.kj as f64 + half_n) / y;
     (v, adj)
 }
 
@@ -329,20 +338,22 @@ fn log_norm_gradient<const D: usize>(bra: &Gvr<D>, n_ang: u32) -> Grad<D> {
 }
 
 /// `EcgGvr::row_gradient` (module docs): the `(1 + P) x nb` row and its derivatives, and the
-/// `1 + P` diagonal (dual numbers, `path::row_gradient` against no basis).
+/// `1 + P` diagonal (dual numbers, `path::row_gradient` against no basis); the basis images kept
+/// in `cache`.
 pub fn row_gradient<const D: usize>(
     go: &GvrOps<D>,
     sym: &Symmetry<D>,
     trial: &Params,
     dir: &Directions,
     basis: &Params,
+    cache: &Cache,
 ) -> Result<(Matrices, Vec<Element>)> {
     check(trial.len(), 1, "trial functions")?;
     let bra = <EcgGvr as Family<D>>::functions(trial, go)?.remove(0);
-    let b = path::images::<D, EcgGvr>(go, sym, basis)?;
+    let b = path::basis_images::<D, EcgGvr>(go, sym, basis, cache)?;
     let (da, _) = dir.exponents::<D>()?;
     let du = matrices_of::<D, 1>(dir.v, da.len(), "global-vector directions")?;
-    let (_, diag) = path::row_gradient::<D, EcgGvr>(go, sym, trial, dir, &Params::default())?;
+    let (_, diag) = path::row_gradient::<D, EcgGvr>(go, sym, trial, dir, &Params::default(), &Cache::default())?;
     let k_max = b.functions.iter().map(|f| f.k).max().unwrap_or(0) as usize;
     let mut series: Vec<Option<Series>> = (0..=k_max).map(|_| None).collect();
     for f in &b.functions {

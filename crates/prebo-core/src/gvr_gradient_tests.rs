@@ -152,8 +152,8 @@ fn against_dual_path<const D: usize>() {
             let basis = Flat::random::<D>(&mut rng, &ks);
             let dir = directions::<D>(&mut rng);
             let d = Directions { a: &dir.0, v: &dir.1 };
-            let (got, got_diag) = <EcgGvr as Family<D>>::row_gradient(&go, &sym, &trial.params(), &d, &basis.params()).unwrap();
-            let (want, want_diag) = path::row_gradient::<D, EcgGvr>(&go, &sym, &trial.params(), &d, &basis.params()).unwrap();
+            let (got, got_diag) = <EcgGvr as Family<D>>::row_gradient(&go, &sym, &trial.params(), &d, &basis.params(), &Cache::default()).unwrap();
+            let (want, want_diag) = path::row_gradient::<D, EcgGvr>(&go, &sym, &trial.params(), &d, &basis.params(), &Cache::default()).unwrap();
             assert_eq!(got_diag, want_diag);
             assert_eq!((got.rows, got.cols), (want.rows, want.cols));
             let (scale, size) = scales(&go, &sym, &trial, &basis, &dir);
@@ -201,13 +201,13 @@ fn matches_central_differences() {
     let basis = Flat::random::<D>(&mut rng, &[0, 3, 12]);
     let dir = directions::<D>(&mut rng);
     let d = Directions { a: &dir.0, v: &dir.1 };
-    let (got, _) = <EcgGvr as Family<D>>::row_gradient(&go, &sym, &trial.params(), &d, &basis.params()).unwrap();
+    let (got, _) = <EcgGvr as Family<D>>::row_gradient(&go, &sym, &trial.params(), &d, &basis.params(), &Cache::default()).unwrap();
     let (scale, size) = scales(&go, &sym, &trial, &basis, &dir);
     let h = 1e-5;
     for p in 0..size.len() {
         let da = Mat::<D>::from_row_slice(&dir.0[p * D * D..(p + 1) * D * D]);
         let du = Vector::<D>::from_row_slice(&dir.1[p * D..(p + 1) * D]);
-        let row = |s: f64| <EcgGvr as Family<D>>::rows(&go, &sym, &trial.moved(s * h, &da, &du).params(), &basis.params(), Some(0)).unwrap().0;
+        let row = |s: f64| <EcgGvr as Family<D>>::rows(&go, &sym, &trial.moved(s * h, &da, &du).params(), &basis.params(), Some(0), &Cache::default()).unwrap().0;
         let (plus, minus) = (row(1.0), row(-1.0));
         for j in 0..3 {
             let (fp, fm, g) = (get(&plus, 0, j), get(&minus, 0, j), get(&got, 1 + p, j));

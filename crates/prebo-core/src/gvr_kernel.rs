@@ -70,6 +70,12 @@ struct Entry {
     weight: Span,
 }
 
+/// A rule as `(τ², weight)`, padded with zero weights to a multiple of [`MAX_W`] nodes.
+pub fn padded_rule(rule: &[(f64, f64)]) -> (Vec<f64>, Vec<f64>) {
+    let padded = rule.len().div_ceil(MAX_W) * MAX_W;
+    (0..padded).map(|i| rule.get(i).map_or((0.0, 0.0), |&(t, w)| (t * t, w))).unzip()
+}
+
 /// Series and rules of the pairs (K_I, K_J) met in one call, in one flat storage.
 pub struct Table {
     n: u32,
@@ -108,8 +114,7 @@ impl Table {
 
     fn push<const D: usize>(&mut self, go: &GvrOps<D>, ki: u32, kj: u32) -> Entry {
         let s = Coefficients::new(ki, kj, go.n_ang);
-        let rule = go.rule(ki + kj + go.n_ang);
-        let padded = rule.len().div_ceil(MAX_W) * MAX_W;
+        let (tau2, weight) = padded_rule(go.rule(ki + kj + go.n_ang));
         let span = |data: &mut Vec<f64>, values: &mut dyn Iterator<Item = f64>| {
             let start = data.len();
             data.extend(values);
@@ -121,8 +126,8 @@ impl Table {
             cx: span(d, &mut s.cx.iter().copied()),
             cy: span(d, &mut s.cy.iter().copied()),
             cz: span(d, &mut s.cz.iter().copied()),
-            tau2: span(d, &mut (0..padded).map(|i| rule.get(i).map_or(0.0, |(t, _)| t * t))),
-            weight: span(d, &mut (0..padded).map(|i| rule.get(i).map_or(0.0, |(_, w)| *w))),
+            tau2: span(d, &mut tau2.into_iter()),
+            weight: span(d, &mut weight.into_iter()),
         }
     }
 
@@ -187,8 +192,8 @@ pub fn pow<const W: usize>(x: [f64; W], k: u32) -> [f64; W] {
     }
 }
 
-/// Most Coulomb pairs of a call (`integrals`' stack storage).
-pub const MAX_PAIRS: usize = 64;
+/// Most Coulomb pairs of a call (stack storage): the pairs of `engine::MAX_DIM` particles.
+pub const MAX_PAIRS: usize = crate::engine::MAX_DIM * (crate::engine::MAX_DIM - 1) / 2;
 
 /// Lane blocks evaluated together: independent Horner chains that hide the latency.
 const SLOTS: usize = 8;
@@ -415,61 +420,103 @@ pub fn symmetrised<const D: usize, const W: usize>(
 }
 
 /// `∫_0^1 P dτ` with its partial derivatives with respect to `[x, y, z, γ_I, γ_J]`
-/// (`gvr::quadrature_partials`: the same chain rule through `a`, `b`, `ζ`) in lanes of `W`
-/// nodes of the padded rule (`tau2`, `weight`), summed node by node. The series of `P_a`,
-/// `P_b`, `P_ζ` come from G and G' alone: `Σ ĉ_k(K_I−k) r^k = K_I G − r G'`, likewise K_J,
-/// and `Σ ĉ_k(N+2k) r^k = N G + 2 r G'` (for N = 0 over r: `2 G'`).
+/// (`gvr::quadrature_partials`: the same chain rule through `a`, `b`, `ζ`) for each of `inputs`,
+/// into `out`, in lanes of `W` nodes of the padded rule (`tau2`, `weight`). The series of
+/// `P_a`, `P_b`, `P_ζ` come from G and G' alone: `Σ ĉ_k(K_I−k) r^k = K_I G − r G'`, likewise
+/// K_J, and `Σ ĉ_k(N+2k) r^k = N G + 2 r G'` (for N = 0 over r: `2 G'`). The derivatives' node sums carry no division:
+/// with `α_I = γ_I²/x`, `α_J = γ_J²/y`,
+///
+/// ```text
+///     ∂_x = (α_I/x) Σ P_a τ² − Σ P_ζ ζ/(2x),       ∂_γI = −(2γ_I/x) Σ P_a τ² − (γ_J/√(xy)) Σ P_ζ τ²,
+///     ∂_y = (α_J/y) Σ P_b τ² − Σ P_ζ ζ/(2y),       ∂_γJ = −(2γ_J/y) Σ P_b τ² − (γ_I/√(xy)) Σ P_ζ τ²,
+///     ∂_z = Σ P_ζ/√(xy),
+/// ```
+///
+/// the sums taken node by node in order, so `out` has the same bits for every `W`.
 #[inline(always)]
 pub fn integral_partials<const W: usize>(
+    c: &[f64],
+    k: (u32, u32, u32),
+    tau2: &[f64],
+    weight: &[f64],
+    inputs: &[[f64; 5]],
+    out: &mut [(f64, [f64; 5])],
+) {
+    for (inputs, out) in inputs.chunks(MAX_PAIRS).zip(out.chunks_mut(MAX_PAIRS)) {
+        let mut sums = [[0.0f64; 6]; MAX_PAIRS];
+        partial_sums::<W>(c, k, tau2, weight, inputs, &mut sums);
+        for ((o, s), &[x, y, _, gam_i, gam_j]) in out.iter_mut().zip(&sums).zip(inputs) {
+            let rt = (x * y).sqrt();
+            let [f, pa_t, pb_t, pz, pz_zeta, pz_t] = *s;
+            let [al_i, al_j] = [gam_i * gam_i / x, gam_j * gam_j / y];
+            *o = (
+                f,
+                [
+                    al_i / x * pa_t - pz_zeta / (2.0 * x),
+                    al_j / y * pb_t - pz_zeta / (2.0 * y),
+                    pz / rt,
+                    -(2.0 * gam_i / x) * pa_t - gam_j / rt * pz_t,
+                    -(2.0 * gam_j / y) * pb_t - gam_i / rt * pz_t,
+                ],
+            );
+        }
+    }
+}
+
+/// The node sums of `integral_partials` for each of `inputs`: `[Σ P, Σ P_a τ², Σ P_b τ², Σ P_ζ,
+/// Σ P_ζ ζ, Σ P_ζ τ²]` (weights included), into `sums`; `a`, `b`, `ζ` rounded as in
+/// `gvr::quadrature_partials` (`Σ P` keeps its bits: the closed form's oracle).
+#[inline(always)]
+fn partial_sums<const W: usize>(
     c: &[f64],
     (ki, kj, n): (u32, u32, u32),
     tau2: &[f64],
     weight: &[f64],
-    inputs: [f64; 5],
-) -> (f64, [f64; 5]) {
-    let [x, y, z, gam_i, gam_j] = inputs;
-    let rt = (x * y).sqrt();
+    inputs: &[[f64; 5]],
+    sums: &mut [[f64; 6]],
+) {
     let (kif, kjf, nf) = (ki as f64, kj as f64, n as f64);
-    let (mut f, mut d) = (0.0, [0.0; 5]);
-    for (t2, wt) in tau2.chunks_exact(W).zip(weight.chunks_exact(W)) {
-        let a: [f64; W] = std::array::from_fn(|l| (1.0 - gam_i * gam_i * t2[l] / x).max(0.0));
-        let b: [f64; W] = std::array::from_fn(|l| (1.0 - gam_j * gam_j * t2[l] / y).max(0.0));
-        let zeta: [f64; W] = std::array::from_fn(|l| (z - gam_i * gam_j * t2[l]) / rt);
-        let r: [f64; W] = std::array::from_fn(|l| {
-            let ab = a[l] * b[l];
-            if ab > 0.0 { (zeta[l] * zeta[l] / ab).min(1.0) } else { 1.0 }
-        });
-        // G and G' by one Horner pass
-        let (mut g, mut gp) = ([0.0f64; W], [0.0f64; W]);
-        for ck in c.iter().rev() {
+    let one = [1.0f64; W];
+    for (s, &[x, y, z, gam_i, gam_j]) in sums.iter_mut().zip(inputs) {
+        let rt = (x * y).sqrt();
+        for (t2, wt) in tau2.chunks_exact(W).zip(weight.chunks_exact(W)) {
+            let a: [f64; W] = std::array::from_fn(|l| (1.0 - gam_i * gam_i * t2[l] / x).max(0.0));
+            let b: [f64; W] = std::array::from_fn(|l| (1.0 - gam_j * gam_j * t2[l] / y).max(0.0));
+            let zeta: [f64; W] = std::array::from_fn(|l| (z - gam_i * gam_j * t2[l]) / rt);
+            let r: [f64; W] = std::array::from_fn(|l| {
+                let ab = a[l] * b[l];
+                if ab > 0.0 { (zeta[l] * zeta[l] / ab).min(1.0) } else { 1.0 }
+            });
+            // G and G' by one Horner pass
+            let (mut g, mut gp) = ([0.0f64; W], [0.0f64; W]);
+            for ck in c.iter().rev() {
+                for l in 0..W {
+                    gp[l] = gp[l] * r[l] + g[l];
+                    g[l] = g[l] * r[l] + ck;
+                }
+            }
+            let pa1 = if ki > 0 { pow(a, ki - 1) } else { one };
+            let pb1 = if kj > 0 { pow(b, kj - 1) } else { one };
+            let pz1 = if n > 0 { pow(zeta, n - 1) } else { one };
             for l in 0..W {
-                gp[l] = gp[l] * r[l] + g[l];
-                g[l] = g[l] * r[l] + ck;
+                let pa = if ki > 0 { pa1[l] * a[l] } else { 1.0 };
+                let pb = if kj > 0 { pb1[l] * b[l] } else { 1.0 };
+                let pz = if n > 0 { pz1[l] * zeta[l] } else { 1.0 };
+                let (w, rgp) = (wt[l], r[l] * gp[l]);
+                let p_a = if ki > 0 { w * pa1[l] * pb * pz * (kif * g[l] - rgp) } else { 0.0 };
+                let p_b = if kj > 0 { w * pa * pb1[l] * pz * (kjf * g[l] - rgp) } else { 0.0 };
+                let p_z = match n {
+                    0 if ki > 0 && kj > 0 => w * pa1[l] * pb1[l] * zeta[l] * (2.0 * gp[l]),
+                    0 => 0.0,
+                    _ => w * pa * pb * pz1[l] * (nf * g[l] + 2.0 * rgp),
+                };
+                s[0] += w * pa * pb * pz * g[l];
+                s[1] += p_a * t2[l];
+                s[2] += p_b * t2[l];
+                s[3] += p_z;
+                s[4] += p_z * zeta[l];
+                s[5] += p_z * t2[l];
             }
         }
-        let one = [1.0f64; W];
-        let (pa1, pb1) = (if ki > 0 { pow(a, ki - 1) } else { one }, if kj > 0 { pow(b, kj - 1) } else { one });
-        let pz1 = if n > 0 { pow(zeta, n - 1) } else { one };
-        for l in 0..W {
-            let pa = if ki > 0 { pa1[l] * a[l] } else { 1.0 };
-            let pb = if kj > 0 { pb1[l] * b[l] } else { 1.0 };
-            let pz = if n > 0 { pz1[l] * zeta[l] } else { 1.0 };
-            let w = wt[l];
-            f += w * pa * pb * pz * g[l];
-            let p_a = if ki > 0 { w * pa1[l] * pb * pz * (kif * g[l] - r[l] * gp[l]) } else { 0.0 };
-            let p_b = if kj > 0 { w * pa * pb1[l] * pz * (kjf * g[l] - r[l] * gp[l]) } else { 0.0 };
-            let p_z = match n {
-                0 if ki > 0 && kj > 0 => w * pa1[l] * pb1[l] * zeta[l] * (2.0 * gp[l]),
-                0 => 0.0,
-                _ => w * pa * pb * pz1[l] * (nf * g[l] + 2.0 * r[l] * gp[l]),
-            };
-            let t = t2[l];
-            d[0] += p_a * gam_i * gam_i * t / (x * x) - p_z * zeta[l] / (2.0 * x);
-            d[1] += p_b * gam_j * gam_j * t / (y * y) - p_z * zeta[l] / (2.0 * y);
-            d[2] += p_z / rt;
-            d[3] += -p_a * 2.0 * gam_i * t / x - p_z * gam_j * t / rt;
-            d[4] += -p_b * 2.0 * gam_j * t / y - p_z * gam_i * t / rt;
-        }
     }
-    (f, d)
 }

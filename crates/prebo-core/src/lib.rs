@@ -9,6 +9,7 @@
 //! entry point of the `prebo._core` binding.
 pub mod assemble;
 pub mod build;
+pub mod cache;
 pub mod ecg;
 pub mod eigenpair;
 pub mod engine;

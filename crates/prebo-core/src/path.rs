@@ -3,7 +3,10 @@
 //!
 //! A symmetrised element is `Σ_P c_P <phi_I| O |P phi_J>` over the images `P phi_J`
 //! (`images::Images`); the matrices are evaluated with the lower index as bra and mirrored.
+use std::sync::Arc;
+
 use crate::assemble;
+use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Vector};
 use crate::error::Result;
 use crate::family::{check, Directions, Family, Params, Symmetry};
@@ -21,6 +24,16 @@ pub fn images<const D: usize, F: Family<D>>(
     Images::new(F::functions(p, ctx)?, sym, ctx)
 }
 
+/// `images` of a basis, kept in `cache` between calls against it.
+pub fn basis_images<const D: usize, F: Family<D>>(
+    ctx: &F::Context,
+    sym: &Symmetry<D>,
+    p: &Params,
+    cache: &Cache,
+) -> Result<Arc<Images<F::Function<f64>>>> {
+    cache.get(p, || images::<D, F>(ctx, sym, p))
+}
+
 /// The symmetrised `nb x nb` matrices of a basis.
 pub fn matrices<const D: usize, F: Family<D>>(ctx: &F::Context, sym: &Symmetry<D>, basis: &Params) -> Result<Matrices> {
     let b = images::<D, F>(ctx, sym, basis)?;
@@ -29,7 +42,8 @@ pub fn matrices<const D: usize, F: Family<D>>(ctx: &F::Context, sym: &Symmetry<D
     }))
 }
 
-/// Rows of trials `t` against basis `b` for a trial that will sit at `position` (`None`: appended).
+/// Rows of trials `t` against basis `b` (its images kept in `cache`) for a trial that will sit at
+/// `position` (`None`: appended).
 /// Element `j` is evaluated with the lower index as bra — `(b_j, t)` for `j < position`,
 /// `(t, b_j)` after — exactly as `matrices` evaluates the full matrix, so a basis grown from such
 /// rows has bit-for-bit the matrices of a fresh build.
@@ -39,9 +53,10 @@ pub fn rows<const D: usize, F: Family<D>>(
     trials: &Params,
     basis: &Params,
     position: Option<usize>,
+    cache: &Cache,
 ) -> Result<(Matrices, Vec<Element>)> {
     let t = images::<D, F>(ctx, sym, trials)?;
-    let b = images::<D, F>(ctx, sym, basis)?;
+    let b = basis_images::<D, F>(ctx, sym, basis, cache)?;
     let el = |x: &F::Function<f64>, y: &F::Function<f64>| F::element(x, y, ctx);
     let pos = position.unwrap_or(b.len());
     Ok(assemble::rows(
@@ -92,17 +107,18 @@ fn gradient_chunk<const D: usize, F: Family<D>, const W: usize>(
 
 /// The row of one function against a basis and its diagonal, with their derivatives along the
 /// directions `dir`: `(1 + P) x nb` matrices (row 0 the values, the function as bra) and `1 + P`
-/// diagonal elements (module `gradient`).
+/// diagonal elements (module `gradient`); the basis images kept in `cache`.
 pub fn row_gradient<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     sym: &Symmetry<D>,
     trial: &Params,
     dir: &Directions,
     basis: &Params,
+    cache: &Cache,
 ) -> Result<(Matrices, Vec<Element>)> {
     check(trial.len(), 1, "trial functions")?;
     let f = F::functions(trial, ctx)?.remove(0);
-    let b = images::<D, F>(ctx, sym, basis)?;
+    let b = basis_images::<D, F>(ctx, sym, basis, cache)?;
     let (da, per) = dir.exponents::<D>()?;
     gradient::gather(b.len(), da.len(), |first, count| {
         let (da, dv) = (&da[first..first + count], &dir.v[first * per..(first + count) * per]);

@@ -1,6 +1,7 @@
 //! The hand-derived row gradient against the dual-number path (the oracle), finite differences,
 //! and the same bits on every instruction set.
 use super::*;
+use crate::cache::Cache;
 use crate::family::{Directions, Family, Params};
 use crate::path;
 use crate::pecg::tests::{gaussian, operators, Rng};
@@ -80,8 +81,8 @@ impl<const D: usize> Case<D> {
         let dir = Directions { a: &da, v: &[] };
         let ctx = <PlainEcg as Family<D>>::context(self.ops.clone(), 0, &[]).unwrap();
         (
-            <PlainEcg as Family<D>>::row_gradient(&ctx, &self.sym, &trial, &dir, &basis).unwrap(),
-            path::row_gradient::<D, PlainEcg>(&ctx, &self.sym, &trial, &dir, &basis).unwrap(),
+            <PlainEcg as Family<D>>::row_gradient(&ctx, &self.sym, &trial, &dir, &basis, &Cache::default()).unwrap(),
+            path::row_gradient::<D, PlainEcg>(&ctx, &self.sym, &trial, &dir, &basis, &Cache::default()).unwrap(),
         )
     }
 

@@ -6,6 +6,7 @@
 use nalgebra::SMatrix;
 
 use crate::build;
+use crate::cache::Cache;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
 use crate::error::Result;
 use crate::family::{check, Directions, Family, Params, Symmetry};
@@ -78,8 +79,10 @@ impl<const D: usize> Family<D> for PlainEcg {
         trials: &Params,
         basis: &Params,
         position: Option<usize>,
+        cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
-        Ok(build::rows(&gaussians(trials, sym)?, &gaussians(basis, sym)?, &go.ops, position))
+        let b = cache.get(basis, || gaussians(basis, sym))?;
+        Ok(build::rows(&gaussians(trials, sym)?, &b, &go.ops, position))
     }
 
     /// The row from `pecg_gradient` (directions of `A` only, as `seeded`); the diagonal, where
@@ -90,11 +93,13 @@ impl<const D: usize> Family<D> for PlainEcg {
         trial: &Params,
         dir: &Directions,
         basis: &Params,
+        cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
         check(trial.len(), 1, "trial functions")?;
-        let (_, diag) = path::row_gradient::<D, Self>(go, sym, trial, dir, &Params::default())?;
+        let (_, diag) = path::row_gradient::<D, Self>(go, sym, trial, dir, &Params::default(), &Cache::default())?;
         let f = Gaussian::new(trial.exponents::<D>()?[0], trial.c_a[0], 0)?;
         let (da, _) = dir.exponents::<D>()?;
-        Ok((pecg_gradient::row_gradient(&f, &da, &gaussians(basis, sym)?, &go.ops), diag))
+        let b = cache.get(basis, || gaussians(basis, sym))?;
+        Ok((pecg_gradient::row_gradient(&f, &da, &b, &go.ops), diag))
     }
 }
