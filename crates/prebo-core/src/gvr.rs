@@ -58,7 +58,7 @@ use crate::build::best_isa;
 use crate::family::{check, matrices_of, Family, Params, Symmetry};
 use crate::gvr_build;
 #[cfg(test)]
-use crate::gvr_kernel::padded_rule;
+use crate::gvr_kernel::{derivative_series, padded_rule};
 use crate::matrices::Matrices;
 use crate::gradient::{seed_matrix, Dual};
 use crate::images::Transform;
@@ -283,7 +283,7 @@ pub(crate) fn coulomb_partials<const D: usize>(
 ) {
     let c = Coefficients::new(ki, kj, go.n_ang).c;
     let (tau2, weight) = padded_rule(go.rule(ki + kj + go.n_ang));
-    gvr_build::partials(&c, (ki, kj, go.n_ang), &tau2, &weight, inputs, out);
+    gvr_build::partials((&c, &derivative_series(&c)), (ki, kj, go.n_ang), &tau2, &weight, inputs, out);
 }
 
 /// Ω and its derivatives divided by `e^L`, `L = (K_I+N/2) ln x + (K_J+N/2) ln y`:
@@ -576,7 +576,7 @@ mod tests {
                 let (tau2, weight) = padded_rule(rule);
                 for isa in [crate::build::Isa::Plain, crate::build::Isa::Avx2, crate::build::Isa::Avx512] {
                     let mut o = vec![(0.0, [0.0; 5]); inputs.len()];
-                    gvr_build::partials_with(isa, &series.c, (ki, kj, n), &tau2, &weight, &inputs, &mut o);
+                    gvr_build::partials_with(isa, (&series.c, &derivative_series(&series.c)), (ki, kj, n), &tau2, &weight, &inputs, &mut o);
                     assert_eq!(o, out, "{isa:?}");
                 }
             }

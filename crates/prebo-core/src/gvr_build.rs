@@ -47,7 +47,7 @@ macro_rules! isa_kernels {
             /// Safety: as `element`.
             $(#[target_feature(enable = $feature)])?
             pub(super) unsafe fn partials(
-                c: &[f64],
+                c: (&[f64], &[f64]),
                 k: (u32, u32, u32),
                 tau2: &[f64],
                 weight: &[f64],
@@ -84,7 +84,7 @@ fn kernel<const D: usize>(isa: Isa) -> ElementFn<D> {
 /// The Coulomb τ-integrals with their partial derivatives (`gvr_kernel::integral_partials`) for
 /// each of `inputs`, on the best instruction set (`build::best_isa`, read once per process).
 pub(crate) fn partials(
-    c: &[f64],
+    c: (&[f64], &[f64]),
     k: (u32, u32, u32),
     tau2: &[f64],
     weight: &[f64],
@@ -99,7 +99,7 @@ pub(crate) fn partials(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn partials_with(
     isa: Isa,
-    c: &[f64],
+    c: (&[f64], &[f64]),
     k: (u32, u32, u32),
     tau2: &[f64],
     weight: &[f64],

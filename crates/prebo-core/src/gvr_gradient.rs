@@ -41,7 +41,7 @@ use crate::error::Result;
 use crate::family::{check, matrices_of, Directions, Family, Params, Symmetry};
 use crate::gvr::{omega, series_coefficients, Coefficients, EcgGvr, Gvr, GvrOps};
 use crate::gvr_build;
-use crate::gvr_kernel::{padded_rule, MAX_PAIRS};
+use crate::gvr_kernel::{derivative_series, padded_rule, MAX_PAIRS};
 use crate::matrices::Matrices;
 use crate::path;
 
@@ -87,11 +87,13 @@ impl<const D: usize> Adjoint<D> {
     }
 }
 
-/// The pair's series: `ĉ_k` for the Hessian and the Coulomb quadrature, `Coefficients` for
-/// `gvr::omega`, and the quadrature's padded rule (`gvr_kernel::padded_rule`).
+/// The pair's series: `ĉ_k` for the Hessian and the Coulomb quadrature (with G''s),
+/// `Coefficients` for `gvr::omega`, and the quadrature's padded rule (`gvr_kernel::padded_rule`).
 pub(crate) struct Series {
     coef: Coefficients,
     c: Vec<f64>,
+    /// `(k+1) ĉ_{k+1}`, the series of G' (`gvr_kernel::derivative_series`)
+    dc: Vec<f64>,
     ki: u32,
     kj: u32,
     n: u32,
@@ -103,7 +105,8 @@ impl Series {
     fn new<const D: usize>(go: &GvrOps<D>, ki: u32, kj: u32) -> Self {
         let (tau2, weight) = padded_rule(go.rule(ki + kj + go.n_ang));
         let (coef, c) = (Coefficients::new(ki, kj, go.n_ang), series_coefficients(go, ki, kj));
-        Self { coef, c, ki, kj, n: go.n_ang, tau2, weight }
+        let dc = derivative_series(&c);
+        Self { coef, c, dc, ki, kj, n: go.n_ang, tau2, weight }
     }
 
     /// `e^{-L}` times Ω's second derivatives, `[ω_xx, ω_xy, ω_yy, ω_xz, ω_yz, ω_zz]`: from
@@ -283,7 +286,7 @@ fn coulomb<const D: usize>(
         inputs[k] = [x, y, z, gi.dot(w) / sq, gj.dot(w) / sq];
     }
     let mut out = [(0.0, [0.0; 5]); MAX_PAIRS];
-    gvr_build::partials(&ser.c, (ser.ki, ser.kj, ser.n), &ser.tau2, &ser.weight, &inputs[..np], &mut out[..np]);
+    gvr_build::partials((&ser.c, &ser.dc), (ser.ki, ser.kj, ser.n), &ser.tau2, &ser.weight, &inputs[..np], &mut out[..np]);
     let mut v = 0.0;
     let mut adj = Adjoint::of_xyz([0.0; 3]);
     for k in 0..np {

@@ -70,6 +70,11 @@ struct Entry {
     weight: Span,
 }
 
+/// The coefficients `(k+1) ĉ_{k+1}` of G' from those of G.
+pub fn derivative_series(c: &[f64]) -> Vec<f64> {
+    c.iter().enumerate().skip(1).map(|(k, ck)| k as f64 * ck).collect()
+}
+
 /// A rule as `(τ², weight)`, padded with zero weights to a multiple of [`MAX_W`] nodes.
 pub fn padded_rule(rule: &[(f64, f64)]) -> (Vec<f64>, Vec<f64>) {
     let padded = rule.len().div_ceil(MAX_W) * MAX_W;
@@ -192,6 +197,20 @@ pub fn pow<const W: usize>(x: [f64; W], k: u32) -> [f64; W] {
     }
 }
 
+/// `r = ζ²/(ab)`, at most 1, and 1 where `ab` vanishes (`gvr::quadrature`): the quotient is
+/// taken in every lane and selected (no `f64::min`, whose NaN rule keeps lanes scalar).
+#[inline(always)]
+fn ratio(a: f64, b: f64, zeta: f64) -> f64 {
+    let (ab, q) = (a * b, zeta * zeta / (a * b));
+    if ab > 0.0 && q < 1.0 { q } else { 1.0 }
+}
+
+/// `max(v, 0)` as a select (`ratio`); NaN gives 0 as `f64::max` does.
+#[inline(always)]
+fn positive(v: f64) -> f64 {
+    if v > 0.0 { v } else { 0.0 }
+}
+
 /// Most Coulomb pairs of a call (stack storage): the pairs of `engine::MAX_DIM` particles.
 pub const MAX_PAIRS: usize = crate::engine::MAX_DIM * (crate::engine::MAX_DIM - 1) / 2;
 
@@ -200,12 +219,13 @@ const SLOTS: usize = 8;
 
 /// `∫_0^1 a^{K_I} b^{K_J} ζ^N G(ζ²/(ab)) dτ` (module docs) for every pair `p` of `inputs` =
 /// `[α_I, α_J, β, δ]`, into `out[p]`. The jobs (pair, block of `W` nodes) run `SLOTS` at a time;
-/// each pair's lane values are summed node by node, so `out` has the same bits for every `W`.
+/// each pair's nodes are summed in `MAX_W` slots (node `i` in slot `i mod MAX_W`) and the slots
+/// in order at the end, so `out` has the same bits for every `W`.
 #[inline(always)]
 pub fn integrals<const W: usize>(s: &Series, inputs: &[[f64; 4]], out: &mut [f64]) {
     let blocks = s.tau2.len() / W;
     let jobs = inputs.len() * blocks;
-    out.iter_mut().for_each(|o| *o = 0.0);
+    let mut slots = [[0.0f64; MAX_W]; MAX_PAIRS];
     let mut first = 0;
     while first < jobs {
         let n = SLOTS.min(jobs - first);
@@ -218,11 +238,10 @@ pub fn integrals<const W: usize>(s: &Series, inputs: &[[f64; 4]], out: &mut [f64
             let [al_i, al_j, beta, delta] = inputs[p];
             let t2 = &s.tau2[c * W..(c + 1) * W];
             for l in 0..W {
-                a[j][l] = (1.0 - al_i * t2[l]).max(0.0);
-                b[j][l] = (1.0 - al_j * t2[l]).max(0.0);
+                a[j][l] = positive(1.0 - al_i * t2[l]);
+                b[j][l] = positive(1.0 - al_j * t2[l]);
                 zeta[j][l] = beta - delta * t2[l];
-                let ab = a[j][l] * b[j][l];
-                r[j][l] = if ab > 0.0 { (zeta[j][l] * zeta[j][l] / ab).min(1.0) } else { 1.0 };
+                r[j][l] = ratio(a[j][l], b[j][l], zeta[j][l]);
             }
         }
         // all SLOTS blocks (unused ones at r = 0): a fixed trip count keeps the blocks in registers
@@ -238,11 +257,15 @@ pub fn integrals<const W: usize>(s: &Series, inputs: &[[f64; 4]], out: &mut [f64
             let (p, c) = ((first + j) / blocks, (first + j) % blocks);
             let (pa, pb, pz) = (pow(a[j], s.ki), pow(b[j], s.kj), pow(zeta[j], s.n));
             let wt = &s.weight[c * W..(c + 1) * W];
+            let at = (c * W) % MAX_W;
             for l in 0..W {
-                out[p] += wt[l] * pa[l] * pb[l] * pz[l] * g[j][l];
+                slots[p][at + l] += wt[l] * pa[l] * pb[l] * pz[l] * g[j][l];
             }
         }
         first += n;
+    }
+    for (o, slot) in out.iter_mut().zip(&slots) {
+        *o = slot.iter().fold(0.0, |acc, v| acc + v);
     }
 }
 
@@ -421,10 +444,11 @@ pub fn symmetrised<const D: usize, const W: usize>(
 
 /// `∫_0^1 P dτ` with its partial derivatives with respect to `[x, y, z, γ_I, γ_J]`
 /// (`gvr::quadrature_partials`: the same chain rule through `a`, `b`, `ζ`) for each of `inputs`,
-/// into `out`, in lanes of `W` nodes of the padded rule (`tau2`, `weight`). The series of
-/// `P_a`, `P_b`, `P_ζ` come from G and G' alone: `Σ ĉ_k(K_I−k) r^k = K_I G − r G'`, likewise
-/// K_J, and `Σ ĉ_k(N+2k) r^k = N G + 2 r G'` (for N = 0 over r: `2 G'`). The derivatives' node sums carry no division:
-/// with `α_I = γ_I²/x`, `α_J = γ_J²/y`,
+/// into `out`, in lanes of `W` nodes of the padded rule (`tau2`, `weight`); `c` = the series
+/// `ĉ_k` and its derivative's (`derivative_series`). The series of `P_a`, `P_b`, `P_ζ` come from
+/// G and G' alone: `Σ ĉ_k(K_I−k) r^k = K_I G − r G'`, likewise K_J, and `Σ ĉ_k(N+2k) r^k =
+/// N G + 2 r G'` (for N = 0 over r: `2 G'`). The derivatives' node sums carry no division: with
+/// `α_I = γ_I²/x`, `α_J = γ_J²/y`,
 ///
 /// ```text
 ///     ∂_x = (α_I/x) Σ P_a τ² − Σ P_ζ ζ/(2x),       ∂_γI = −(2γ_I/x) Σ P_a τ² − (γ_J/√(xy)) Σ P_ζ τ²,
@@ -432,10 +456,11 @@ pub fn symmetrised<const D: usize, const W: usize>(
 ///     ∂_z = Σ P_ζ/√(xy),
 /// ```
 ///
-/// the sums taken node by node in order, so `out` has the same bits for every `W`.
+/// the sums taken in an order that does not depend on `W` (`partial_sums`), so `out` has the
+/// same bits for every `W`.
 #[inline(always)]
 pub fn integral_partials<const W: usize>(
-    c: &[f64],
+    c: (&[f64], &[f64]),
     k: (u32, u32, u32),
     tau2: &[f64],
     weight: &[f64],
@@ -463,12 +488,18 @@ pub fn integral_partials<const W: usize>(
     }
 }
 
+/// Node blocks of one input evaluated together in `partial_sums` (latency of the Horner chains).
+const BLOCKS: usize = 4;
+
 /// The node sums of `integral_partials` for each of `inputs`: `[Σ P, Σ P_a τ², Σ P_b τ², Σ P_ζ,
 /// Σ P_ζ ζ, Σ P_ζ τ²]` (weights included), into `sums`; `a`, `b`, `ζ` rounded as in
-/// `gvr::quadrature_partials` (`Σ P` keeps its bits: the closed form's oracle).
+/// `gvr::quadrature_partials` (`Σ P` keeps its bits, summed node by node: the closed form's
+/// oracle). G and G' are two independent Horner chains (`c` and `dc`, `dc_k = (k+1) ĉ_{k+1}`) over
+/// `BLOCKS` blocks at once. The other sums run in `MAX_W` slots, node `i` in slot `i mod MAX_W`,
+/// added in slot order at the end: vector adds, and the same bits for every `W`.
 #[inline(always)]
 fn partial_sums<const W: usize>(
-    c: &[f64],
+    (c, dc): (&[f64], &[f64]),
     (ki, kj, n): (u32, u32, u32),
     tau2: &[f64],
     weight: &[f64],
@@ -477,46 +508,77 @@ fn partial_sums<const W: usize>(
 ) {
     let (kif, kjf, nf) = (ki as f64, kj as f64, n as f64);
     let one = [1.0f64; W];
+    let blocks = tau2.len() / W;
     for (s, &[x, y, z, gam_i, gam_j]) in sums.iter_mut().zip(inputs) {
         let rt = (x * y).sqrt();
-        for (t2, wt) in tau2.chunks_exact(W).zip(weight.chunks_exact(W)) {
-            let a: [f64; W] = std::array::from_fn(|l| (1.0 - gam_i * gam_i * t2[l] / x).max(0.0));
-            let b: [f64; W] = std::array::from_fn(|l| (1.0 - gam_j * gam_j * t2[l] / y).max(0.0));
-            let zeta: [f64; W] = std::array::from_fn(|l| (z - gam_i * gam_j * t2[l]) / rt);
-            let r: [f64; W] = std::array::from_fn(|l| {
-                let ab = a[l] * b[l];
-                if ab > 0.0 { (zeta[l] * zeta[l] / ab).min(1.0) } else { 1.0 }
-            });
-            // G and G' by one Horner pass
-            let (mut g, mut gp) = ([0.0f64; W], [0.0f64; W]);
-            for ck in c.iter().rev() {
+        // the derivative sums by node slot (node i in slot i mod MAX_W), summed in slot order at the end
+        let mut slots = [[0.0f64; MAX_W]; 5];
+        let mut first = 0;
+        while first < blocks {
+            let count = BLOCKS.min(blocks - first);
+            let mut a = [[0.0f64; W]; BLOCKS];
+            let mut b = [[0.0f64; W]; BLOCKS];
+            let mut zeta = [[0.0f64; W]; BLOCKS];
+            let mut r = [[0.0f64; W]; BLOCKS];
+            for j in 0..count {
+                let t2 = &tau2[(first + j) * W..(first + j + 1) * W];
                 for l in 0..W {
-                    gp[l] = gp[l] * r[l] + g[l];
-                    g[l] = g[l] * r[l] + ck;
+                    a[j][l] = positive(1.0 - gam_i * gam_i * t2[l] / x);
+                    b[j][l] = positive(1.0 - gam_j * gam_j * t2[l] / y);
+                    zeta[j][l] = (z - gam_i * gam_j * t2[l]) / rt;
+                    r[j][l] = ratio(a[j][l], b[j][l], zeta[j][l]);
                 }
             }
-            let pa1 = if ki > 0 { pow(a, ki - 1) } else { one };
-            let pb1 = if kj > 0 { pow(b, kj - 1) } else { one };
-            let pz1 = if n > 0 { pow(zeta, n - 1) } else { one };
-            for l in 0..W {
-                let pa = if ki > 0 { pa1[l] * a[l] } else { 1.0 };
-                let pb = if kj > 0 { pb1[l] * b[l] } else { 1.0 };
-                let pz = if n > 0 { pz1[l] * zeta[l] } else { 1.0 };
-                let (w, rgp) = (wt[l], r[l] * gp[l]);
-                let p_a = if ki > 0 { w * pa1[l] * pb * pz * (kif * g[l] - rgp) } else { 0.0 };
-                let p_b = if kj > 0 { w * pa * pb1[l] * pz * (kjf * g[l] - rgp) } else { 0.0 };
-                let p_z = match n {
-                    0 if ki > 0 && kj > 0 => w * pa1[l] * pb1[l] * zeta[l] * (2.0 * gp[l]),
-                    0 => 0.0,
-                    _ => w * pa * pb * pz1[l] * (nf * g[l] + 2.0 * rgp),
-                };
-                s[0] += w * pa * pb * pz * g[l];
-                s[1] += p_a * t2[l];
-                s[2] += p_b * t2[l];
-                s[3] += p_z;
-                s[4] += p_z * zeta[l];
-                s[5] += p_z * t2[l];
+            // all BLOCKS blocks (unused ones at r = 0): a fixed trip count keeps them in registers
+            let (mut g, mut gp) = ([[0.0f64; W]; BLOCKS], [[0.0f64; W]; BLOCKS]);
+            for ck in c.iter().rev() {
+                for j in 0..BLOCKS {
+                    for l in 0..W {
+                        g[j][l] = g[j][l] * r[j][l] + ck;
+                    }
+                }
             }
+            for ck in dc.iter().rev() {
+                for j in 0..BLOCKS {
+                    for l in 0..W {
+                        gp[j][l] = gp[j][l] * r[j][l] + ck;
+                    }
+                }
+            }
+            for j in 0..count {
+                let blk = first + j;
+                let (t2, wt) = (&tau2[blk * W..(blk + 1) * W], &weight[blk * W..(blk + 1) * W]);
+                let (aj, bj, zj, rj, gj, gpj) = (a[j], b[j], zeta[j], r[j], g[j], gp[j]);
+                let pa1 = if ki > 0 { pow(aj, ki - 1) } else { one };
+                let pb1 = if kj > 0 { pow(bj, kj - 1) } else { one };
+                let pz1 = if n > 0 { pow(zj, n - 1) } else { one };
+                let pa: [f64; W] = std::array::from_fn(|l| if ki > 0 { pa1[l] * aj[l] } else { 1.0 });
+                let pb: [f64; W] = std::array::from_fn(|l| if kj > 0 { pb1[l] * bj[l] } else { 1.0 });
+                let pz: [f64; W] = std::array::from_fn(|l| if n > 0 { pz1[l] * zj[l] } else { 1.0 });
+                for l in 0..W {
+                    s[0] += wt[l] * pa[l] * pb[l] * pz[l] * gj[l];
+                }
+                let at = (blk * W) % MAX_W;
+                for l in 0..W {
+                    let (w, rgp) = (wt[l], rj[l] * gpj[l]);
+                    let p_a = if ki > 0 { w * pa1[l] * pb[l] * pz[l] * (kif * gj[l] - rgp) } else { 0.0 };
+                    let p_b = if kj > 0 { w * pa[l] * pb1[l] * pz[l] * (kjf * gj[l] - rgp) } else { 0.0 };
+                    let p_z = match n {
+                        0 if ki > 0 && kj > 0 => w * pa1[l] * pb1[l] * zj[l] * (2.0 * gpj[l]),
+                        0 => 0.0,
+                        _ => w * pa[l] * pb[l] * pz1[l] * (nf * gj[l] + 2.0 * rgp),
+                    };
+                    slots[0][at + l] += p_a * t2[l];
+                    slots[1][at + l] += p_b * t2[l];
+                    slots[2][at + l] += p_z;
+                    slots[3][at + l] += p_z * zj[l];
+                    slots[4][at + l] += p_z * t2[l];
+                }
+            }
+            first += count;
+        }
+        for (k, slot) in slots.iter().enumerate() {
+            s[k + 1] = slot.iter().fold(0.0, |acc, v| acc + v);
         }
     }
 }
