@@ -139,6 +139,19 @@ def test_the_basis_is_exhausted_when_every_kind_gains_less_than_a_tenth_of_growt
     assert t.choose(8, E) is None
 
 
+def test_without_a_growth_rate_the_best_rate_at_full_size_is_the_reference():
+    """A basis grown in one pass (no energy before it, no rate) is exhausted when every kind gains
+    less than RATIO of the best rate seen at full size, though each still gains above the tolerance."""
+    s = Adaptive(resolved(Optimiser(size=6), prebo.System(["p", "e", "e"])))
+    E = passes(s, ("grow", 6, None, 1.0), ("refine", 6, 1e-2, 1.0), ("sweep", 6, 1e-3, 1.0), ("polish", 6, 1e-3, 1.0))
+    assert s.choose(6, E) == "refine"
+    E = passes(s, ("refine", 6, 0.9 * RATIO * 1e-2, 1.0), ("sweep", 6, 0.5 * RATIO * 1e-2, 1.0))
+    assert s.choose(6, E) == "polish"  # polish's last rate, 1e-3, is above RATIO of the best
+    E = passes(s, ("polish", 6, 0.5 * RATIO * 1e-2, 1.0))
+    assert 0.5 * RATIO * 1e-2 > s.tolerance(E)
+    assert s.choose(6, E) is None
+
+
 @pytest.mark.parametrize("block", [
     {"passes": [], "start": [None, 0.0]},  # no "next"
     {"passes": [["grow", 1, None, -1.0, 0.0, 1.0]], "start": [None, 0.0], "next": {"refine": 0, "sweep": 0}},

@@ -14,8 +14,8 @@ basis; the basis then keeps the size it reached).
 
 At full size the basis is exhausted, and the schedule ends, when the last pass of every kind
 gains less than RATIO of what the last growth pass gained per second (a larger basis would
-gain faster; where growth took one pass, there is no such rate), or, over a whole sweep, less
-than `tolerance` Eh (default TOLERANCE |E|). The wall-time budget stops any schedule
+gain faster; where growth took one pass, which has no rate, RATIO of the best rate of a pass
+at full size), or, over a whole sweep, less than `tolerance` Eh (default TOLERANCE |E|). The wall-time budget stops any schedule
 (driver.py).
 
 The choices follow measured seconds, so two runs of one input may part in their last digits; a
@@ -107,10 +107,15 @@ class Adaptive:
         return self.gain(p) / max(p[5] - p[4], 1e-3)
 
     def exhausted(self, last: dict, nb: int, energy: float) -> bool:
-        """Whether every kind's last pass gained less than RATIO of the last growth pass's rate, or
-        less than the tolerance over a whole sweep (module docstring)."""
-        grown = RATIO * self.rate(last["grow"]) if math.isfinite(self.gain(last.get("grow", [0, 0, None]))) else 0.0
-        return (all(self.rate(last[k]) < grown for k in IMPROVE)
+        """Whether every kind's last pass gained less than RATIO of the last growth pass's rate (of
+        the best pass at full size where growth has none), or less than the tolerance over a whole
+        sweep (module docstring)."""
+        grow = last.get("grow", [0, 0, None])
+        if math.isfinite(self.gain(grow)):
+            reference = self.rate(grow)
+        else:
+            reference = max(self.rate(p) for p in self.passes if p[0] in IMPROVE and p[1] == nb)
+        return (all(self.rate(last[k]) < RATIO * reference for k in IMPROVE)
                 or all(self.gain(last[k]) * nb / last[k][6] < self.tolerance(energy) for k in IMPROVE))
 
     def choose(self, nb: int, energy: float) -> str | None:
