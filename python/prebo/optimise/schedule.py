@@ -15,8 +15,8 @@ basis; the basis then keeps the size it reached).
 At full size the basis is exhausted, and the schedule ends, when the last pass of every kind
 gains less than RATIO of what the last growth pass gained per second (a larger basis would
 gain faster; where growth took one pass, which has no rate, RATIO of the best rate of a pass
-at full size), or, over a whole sweep, less than `tolerance` Eh (default TOLERANCE |E|). The wall-time budget stops any schedule
-(driver.py).
+at full size), or, over a whole sweep, less than `tolerance` Eh (default TOLERANCE |E|). The
+wall-time budget stops any schedule (driver.py).
 
 The choices follow measured seconds, so two runs of one input may part in their last digits; a
 fixed schedule (any of sweeps, refine, polish, cycles given) repeats bit for bit.
