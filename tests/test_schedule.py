@@ -93,16 +93,21 @@ def passes(schedule, *rows):
     return E
 
 
+def now(schedule):
+    """The seconds of the run at the end of the last recorded pass."""
+    return schedule.passes[-1][5] if schedule.passes else 0.0
+
+
 def test_growth_first_then_every_kind_once_then_the_best_rate():
     s = Adaptive(resolved(Optimiser(size=100), prebo.System(["alpha", "e", "e"])))
     assert s.first() == Cursor("grow", sweep=8)
-    assert s.choose(0, np.inf) == "grow"
+    assert s.choose(0, np.inf, now(s)) == "grow"
     E = passes(s, ("grow", 8, None, 1.0))
-    assert [s.choose(8, E), s.begin("refine", 8, 1)] == ["refine", Cursor("refine", cycle=1)]
+    assert [s.choose(8, E, now(s)), s.begin("refine", 8, 1)] == ["refine", Cursor("refine", cycle=1)]
     E = passes(s, ("refine", 8, 1e-3, 1.0), ("sweep", 8, 1e-3, 2.0), ("polish", 8, 1e-4, 1.0))
-    assert s.choose(8, E) == "grow"  # the first growth pass: no energy before it, an unbounded rate
+    assert s.choose(8, E, now(s)) == "grow"  # the first growth pass: no energy before it, an unbounded rate
     E = passes(s, ("grow", 16, 1e-4, 1.0))  # growth slows: refinement (1e-3 Eh/s) pays best now
-    assert s.choose(16, E) == "refine"
+    assert s.choose(16, E, now(s)) == "refine"
     assert s.begin("grow", 80, 9) == Cursor("grow", sweep=100, cycle=9)  # a quarter, capped at size
 
 
@@ -126,17 +131,33 @@ def test_the_basis_is_exhausted_when_every_kind_gains_less_than_a_tenth_of_growt
     s = Adaptive(opts)
     E = passes(s, ("grow", 80, None, 1.0), ("grow", 100, 1e-3, 1.0), ("refine", 100, 2e-4, 1.0),
                ("sweep", 100, 1e-4, 1.0), ("polish", 100, 1e-4, 1.0))
-    assert s.choose(100, E) == "refine"
+    assert s.choose(100, E, now(s)) == "refine"
     E = passes(s, ("refine", 100, 0.5 * RATIO * 1e-3, 1.0), ("sweep", 100, 0.5 * RATIO * 1e-3, 1.0),
                ("polish", 100, 0.9 * RATIO * 1e-3, 1.0))
-    assert s.choose(100, E) is None
-    assert s.choose(99, E) == "grow"  # below full size the basis grows instead
+    assert s.choose(100, E, now(s)) is None and s.stopped == "exhausted"
+    assert s.advantage(100) == pytest.approx(1e-3 / (0.9 * RATIO * 1e-3))
+    assert s.choose(99, E, now(s)) == "grow"  # below full size the basis grows instead
 
     t = Adaptive(resolved(Optimiser(size=8, tolerance=1e-6), prebo.System(["alpha", "e", "e"])))
     E = passes(t, ("grow", 8, None, 1.0), ("refine", 8, 2e-6, 1.0), ("sweep", 8, 1e-7, 1.0), ("polish", 8, 1e-7, 1.0))
-    assert t.choose(8, E) == "refine"  # one pass in one growth step: no growth rate, the tolerance decides
+    assert t.choose(8, E, now(t)) == "refine"  # one pass in one growth step: no growth rate, the tolerance decides
     E = passes(t, ("refine", 8, 5e-7, 1.0))
-    assert t.choose(8, E) is None
+    assert t.choose(8, E, now(t)) is None and t.stopped == "converged"
+
+
+def test_a_budget_overrides_exhaustion_until_the_time_left_would_gain_less_than_the_tolerance():
+    """The rates of the exhausted basis above, but with a budget: the run goes on while the best
+    kind's last rate times the seconds left exceeds the tolerance, and then has converged."""
+    he = prebo.System(["alpha", "e", "e"])
+    rows = (("grow", 80, None, 1.0), ("grow", 100, 1e-3, 1.0), ("refine", 100, 0.5 * RATIO * 1e-3, 1.0),
+            ("sweep", 100, 0.5 * RATIO * 1e-3, 1.0), ("polish", 100, 0.9 * RATIO * 1e-3, 1.0))
+    s = Adaptive(resolved(Optimiser(size=100, budget=600.0), he))
+    E = passes(s, *rows)
+    assert s.choose(100, E, now(s)) == "polish" and s.stopped is None  # 1.8e-5 Eh/s for 595 s more
+    assert s.advantage(100) > 1 / RATIO  # the report still says a larger basis would gain faster
+    tolerance = s.tolerance(E)
+    end = 600.0 - 0.5 * tolerance / (0.9 * RATIO * 1e-3)  # half the tolerance left to gain
+    assert s.choose(100, E, end) is None and s.stopped == "converged"
 
 
 def test_without_a_growth_rate_the_best_rate_at_full_size_is_the_reference():
@@ -144,12 +165,12 @@ def test_without_a_growth_rate_the_best_rate_at_full_size_is_the_reference():
     less than RATIO of the best rate seen at full size, though each still gains above the tolerance."""
     s = Adaptive(resolved(Optimiser(size=6), prebo.System(["p", "e", "e"])))
     E = passes(s, ("grow", 6, None, 1.0), ("refine", 6, 1e-2, 1.0), ("sweep", 6, 1e-3, 1.0), ("polish", 6, 1e-3, 1.0))
-    assert s.choose(6, E) == "refine"
+    assert s.choose(6, E, now(s)) == "refine"
     E = passes(s, ("refine", 6, 0.9 * RATIO * 1e-2, 1.0), ("sweep", 6, 0.5 * RATIO * 1e-2, 1.0))
-    assert s.choose(6, E) == "polish"  # polish's last rate, 1e-3, is above RATIO of the best
+    assert s.choose(6, E, now(s)) == "polish"  # polish's last rate, 1e-3, is above RATIO of the best
     E = passes(s, ("polish", 6, 0.5 * RATIO * 1e-2, 1.0))
     assert 0.5 * RATIO * 1e-2 > s.tolerance(E)
-    assert s.choose(6, E) is None
+    assert s.choose(6, E, now(s)) is None
 
 
 @pytest.mark.parametrize("block", [
@@ -190,10 +211,10 @@ def test_an_input_without_optimiser_table_runs_to_an_exhausted_basis_with_a_repo
     r = subprocess.run([sys.executable, "-m", "prebo", "run", tmp_path / "he.toml", "--out", tmp_path / "he"],
                        capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
-    assert "stopped" in r.stdout and "basis exhausted" in r.stdout
+    assert "stopped" in r.stdout and "basis exhausted" in r.stdout and "basis size" not in r.stdout
     result = json.loads((tmp_path / "he" / "result.json").read_text())
     c = result["convergence"]
-    assert c["stopped"] == "exhausted" and c["adaptive"] and 0 < c["seconds"] <= result["wall_seconds"] + 0.05  # 0.1 s
+    assert c["stopped"] == "exhausted" and c["advantage"] > 1 / RATIO and c["adaptive"] and 0 < c["seconds"] <= result["wall_seconds"] + 0.05  # 0.1 s
     assert c["recent"]["steps"] >= 1 and c["recent"]["gain"] >= 0 and c["recent"]["seconds"] >= 0
     assert c["extrapolation"] is None or (c["extrapolation"]["remaining"] > 0 and c["extrapolation"]["caveat"])
     assert result["n_basis"] == 24 and result["basis_type"] == "pecg"
@@ -230,5 +251,5 @@ def test_growth_that_stalls_ends_at_the_size_reached_in_an_adaptive_schedule(tmp
         prebo.optimise(h, Optimiser(size=10, max_overlap=1e-9, sweeps=0), progress=False)
     basis = prebo.optimise(h, Optimiser(size=10, max_overlap=1e-9), out=tmp_path, progress=False)
     d = json.loads((tmp_path / "basis.json").read_text())
-    assert len(basis) == d["schedule"]["stalled"] == 1 and basis.convergence["stopped"] == "exhausted"
+    assert len(basis) == d["schedule"]["stalled"] == 1 and basis.convergence["stopped"] == "converged"
     assert {p[0] for p in d["schedule"]["passes"]} == {"grow", "refine", "sweep", "polish"}

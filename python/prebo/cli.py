@@ -31,14 +31,12 @@ def _result(basis, where, coordinates: str = "lab", operators=()) -> dict:
     return r
 
 
-#: why a run stopped (optimise.convergence), as the result table says it
-STOPPED = {"exhausted": "basis exhausted (a larger basis would gain faster)", "budget": "wall-time budget used",
-           "schedule": "schedule completed", None: "interrupted"}
-
-
 def _print_result(r: dict) -> None:
     from rich.console import Console
     from rich.table import Table
+
+    from .optimise.convergence import STOPPED
+    from .optimise.schedule import RATIO
 
     t = Table(show_header=False, box=None)
     t.add_row("energy (translation-free)", f"{r['energy']:.12f} Eh")
@@ -56,6 +54,9 @@ def _print_result(r: dict) -> None:
     if r.get("convergence"):
         c = r["convergence"]
         t.add_row("stopped", f"{STOPPED[c['stopped']]} after {c['seconds']:.1f} s")
+        if c.get("advantage") is not None and c["advantage"] > 1 / RATIO and c["stopped"] != "exhausted":
+            t.add_row("basis size", f"growth was gaining {c['advantage']:.0f}× faster than the last passes: "
+                      "a larger basis would gain faster")
         if c["recent"]:
             rate = c["recent"]["rate"]
             t.add_row(f"last {c['recent']['steps']} steps", f"ΔE = {-c['recent']['gain']:.2e} Eh in "

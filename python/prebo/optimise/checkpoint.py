@@ -67,13 +67,11 @@ class Cursor:
 
 
 
-STOPPED = (None, "schedule", "exhausted", "budget")  # why a run stopped (None: it has not)
-
-
 def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> tuple:
     """The basis, cursor, history, elapsed seconds, adaptive schedule (schedule.Adaptive) and
     stop reason of checkpoint content `d` (`rng` takes its state); BasisFileError naming `where`
     for anything that does not fit."""
+    from .convergence import STOPPED
     from .schedule import Adaptive
 
     basis = Basis.from_dict(d, where, empty=True)
@@ -85,7 +83,7 @@ def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> t
         history, elapsed = d["history"], number(d.get("elapsed", 0.0), "elapsed")
         schedule, stopped = Adaptive.check(opts, d.get("schedule")), d.get("stopped")
         if stopped not in STOPPED:
-            raise ValueError(f"stopped = {stopped!r}: must be one of {STOPPED}")
+            raise ValueError(f"stopped = {stopped!r}: must be one of {tuple(STOPPED)}")
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise BasisFileError(f"{where}: malformed run state ({exc})") from exc
     if not (isinstance(history, list) and all(isinstance(h, list) and len(h) >= 3 for h in history)):

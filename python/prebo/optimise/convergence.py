@@ -1,10 +1,11 @@
 """The convergence report of a run (result.json's "convergence"), from its history of accepted
 steps [n_b, E, phase, seconds]:
 
-- `stopped`: why the run ended — "exhausted" (the adaptive schedule: every kind of pass gains
-  less than a fiftieth of what growth gained per second, or than `tolerance`), "budget" (the
-  wall-time budget) or "schedule" (a fixed schedule ran out) — and `seconds` of optimisation
-  over every segment of the run;
+- `stopped`: why the run ended, a key of STOPPED (the adaptive schedule's reasons are those of
+  schedule.py) — and `seconds` of optimisation over every segment of the run;
+- `advantage`: in an adaptive run at full size, how many times faster than the best kind of pass
+  growth was gaining at the end (schedule.Adaptive.advantage; above 1/RATIO a larger basis is
+  the better use of time), else None;
 - `stalled`: where growth of an adaptive schedule stopped short of `size` (every trial refused;
   the basis kept the size it reached), with the settings to change, or None;
 - `recent`: the energy gained by the last RECENT accepted steps, the seconds they span and the
@@ -21,6 +22,10 @@ from .methods import stalled
 from .settings import Optimiser
 
 RECENT = 10
+#: why a run stopped, as the result table says it (None: interrupted, or not yet stopped)
+STOPPED = {"converged": "converged at this basis size (gains below the tolerance)",
+           "exhausted": "basis exhausted (a larger basis would gain faster)", "budget": "wall-time budget used",
+           "schedule": "schedule completed", None: "interrupted"}
 CAVEAT = ("the gain still to be had at this basis size were the gains to keep falling geometrically (Aitken's "
           "delta-squared over three equal spans of time since growth ended); not the error against the exact "
           "energy, which also holds the error of the basis size; too small where the gains fall more slowly "
@@ -33,12 +38,12 @@ def energy_at(steps: list, t: float) -> float:
 
 
 def convergence(history: list, opts: Optimiser, stopped: str | None, seconds: float,
-                stalled_at: int | None = None) -> dict:
+                stalled_at: int | None = None, advantage: float | None = None) -> dict:
     """The report of a run with `history` (module docstring); `stalled_at`: the size at which growth
-    stalled."""
+    stalled; `advantage`: that of the adaptive schedule."""
     steps = [h for h in history if len(h) >= 4]
-    report = {"stopped": stopped, "seconds": seconds, "adaptive": opts.adaptive, "recent": None,
-              "extrapolation": None,
+    report = {"stopped": stopped, "seconds": seconds, "adaptive": opts.adaptive, "advantage": advantage,
+              "recent": None, "extrapolation": None,
               "stalled": None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts)}}
     if len(steps) >= 2:
         last = steps[-min(RECENT + 1, len(steps)):]

@@ -106,12 +106,13 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
             else:
                 cursor = cursor.advance(len(ex.basis), opts)
             if cursor.phase == "done":
-                stopped = "exhausted" if opts.adaptive else "schedule"
+                stopped = schedule.stopped if opts.adaptive else "schedule"
             elif opts.budget is not None and now >= opts.budget:
                 cursor, stopped = Cursor("done"), "budget"
             checkpoint()
     ex.basis.coefficients = ex.eig.vectors[:, 0]
-    ex.basis.convergence = convergence(history, opts, stopped, wall(), schedule.stalled)
+    ex.basis.convergence = convergence(history, opts, stopped, wall(), schedule.stalled,
+                                       schedule.advantage(len(ex.basis)) if opts.adaptive else None)
     return ex.basis
 
 

@@ -12,11 +12,15 @@ stays in use as long as it pays best. Growth is a kind while the basis is smalle
 and growth has not stalled (`stall`: every trial of STALL_STEPS steps linearly dependent on the
 basis; the basis then keeps the size it reached).
 
-At full size the basis is exhausted, and the schedule ends, when the last pass of every kind
-gains less than RATIO of what the last growth pass gained per second (a larger basis would
-gain faster; where growth took one pass, which has no rate, RATIO of the best rate of a pass
-at full size), or, over a whole sweep, less than `tolerance` Eh (default TOLERANCE |E|). The
-wall-time budget stops any schedule (driver.py).
+At full size the schedule ends when the basis has converged: a whole sweep of every kind gains
+less than `tolerance` Eh (default TOLERANCE |E|), or, with a wall-time budget, the best kind's
+last rate would gain less than that in the seconds left. Without a budget it also ends when the
+basis is exhausted: the last pass of every kind gains less than RATIO of the reference rate, what
+the last growth pass gained per second (a larger basis would gain faster; where growth took one
+pass, which has no rate, the best rate of a pass at full size). A budget is the user's word on
+how long to spend at this size, so it overrides exhaustion, which the convergence report then
+states as `advantage`, the reference over the best kind's last rate. The budget stops any
+schedule (driver.py).
 
 The choices follow measured seconds, so two runs of one input may part in their last digits; a
 fixed schedule (any of sweeps, refine, polish, cycles given) repeats bit for bit.
@@ -38,7 +42,7 @@ from .settings import Optimiser
 GROWTH = 8
 #: the most functions a refinement or replacement pass visits
 CHUNK = 50
-#: exhausted below this share of the last growth pass's gain per second
+#: exhausted below this share of the reference gain per second (module docstring)
 RATIO = 0.02
 #: the default tolerance relative to |E|: a sweep that gains less has exhausted the basis
 TOLERANCE = 1e-10
@@ -52,7 +56,7 @@ class Adaptive:
 
     def __init__(self, opts: Optimiser, passes: list | None = None, start: list | None = None,
                  next: dict | None = None, stalled: int | None = None):
-        self.opts, self.stalled = opts, stalled
+        self.opts, self.stalled, self.stopped = opts, stalled, None
         self.passes = [list(p) for p in passes or []]
         self.start = list(start) if start is not None else [None, 0.0]  # no energy before the first function
         self.next = dict(next or {"refine": 0, "sweep": 0})
@@ -94,7 +98,7 @@ class Adaptive:
         functions = visited if phase in ("sweep", "refine") else nb
         self.passes.append([phase, nb, self.start[0], energy, self.start[1], now, functions])
         self.start = [energy, now]
-        kind = self.choose(nb, energy)
+        kind = self.choose(nb, energy, now)
         return Cursor("done") if kind is None else self.begin(kind, nb, cursor.cycle + 1)
 
     @staticmethod
@@ -106,20 +110,35 @@ class Adaptive:
         """Energy gained per second by pass `p`."""
         return self.gain(p) / max(p[5] - p[4], 1e-3)
 
-    def exhausted(self, last: dict, nb: int, energy: float) -> bool:
-        """Whether every kind's last pass gained less than RATIO of the last growth pass's rate (of
-        the best pass at full size where growth has none), or less than the tolerance over a whole
-        sweep (module docstring)."""
+    def advantage(self, nb: int) -> float | None:
+        """The reference rate (module docstring) over the best last rate of a kind of pass, at full
+        size `nb`; None while the basis grows, before every kind has run or when none gains."""
+        last = {p[0]: p for p in self.passes}
+        if nb < self.size or any(k not in last for k in IMPROVE):
+            return None
         grow = last.get("grow", [0, 0, None])
         if math.isfinite(self.gain(grow)):
             reference = self.rate(grow)
         else:
-            reference = max(self.rate(p) for p in self.passes if p[0] in IMPROVE and p[1] == nb)
-        return (all(self.rate(last[k]) < RATIO * reference for k in IMPROVE)
-                or all(self.gain(last[k]) * nb / last[k][6] < self.tolerance(energy) for k in IMPROVE))
+            reference = max((self.rate(p) for p in self.passes if p[0] in IMPROVE and p[1] == nb), default=0.0)
+        best = max(self.rate(last[k]) for k in IMPROVE)
+        return reference / best if best > 0 else None
 
-    def choose(self, nb: int, energy: float) -> str | None:
-        """The kind of the next pass, or None when the basis is exhausted (module docstring)."""
+    def stop(self, last: dict, nb: int, energy: float, now: float) -> str | None:
+        """Why the schedule ends at full size — "converged" or "exhausted" — or None (module
+        docstring); `now`: seconds of the run."""
+        tolerance = self.tolerance(energy)
+        if all(self.gain(last[k]) * nb / last[k][6] < tolerance for k in IMPROVE):
+            return "converged"
+        if self.opts.budget is not None:
+            left = self.opts.budget - now
+            return "converged" if max(self.rate(last[k]) for k in IMPROVE) * left < tolerance else None
+        advantage = self.advantage(nb)
+        return "exhausted" if advantage is not None and advantage > 1 / RATIO else None
+
+    def choose(self, nb: int, energy: float, now: float) -> str | None:
+        """The kind of the next pass, or None when the schedule ends (`stopped` says why; module
+        docstring); `now`: seconds of the run."""
         last = {p[0]: p for p in self.passes}
         growing = nb < self.size
         if growing and "grow" not in last:
@@ -127,8 +146,10 @@ class Adaptive:
         untried = [k for k in IMPROVE if k not in last]
         if untried:
             return untried[0]
-        if not growing and self.exhausted(last, nb, energy):
-            return None
+        if not growing:
+            self.stopped = self.stop(last, nb, energy, now)
+            if self.stopped is not None:
+                return None
         return max((("grow",) if growing else ()) + IMPROVE, key=lambda k: self.rate(last[k]))
 
     def to_dict(self) -> dict:
