@@ -203,7 +203,8 @@ pub fn matrices_with<const D: usize>(basis: &Symmetrised<D>, ops: &Operators<D>,
     dispatch!(isa, matrices_w::<D>(basis, ops))
 }
 
-fn isa_available(isa: Isa) -> bool {
+/// Whether this CPU has `isa`.
+pub(crate) fn isa_available(isa: Isa) -> bool {
     match isa {
         Isa::Plain => true,
         #[cfg(target_arch = "x86_64")]

@@ -180,3 +180,44 @@ fn rows_patched_into_matrices_give_the_full_build() {
         assert_eq!([d[0].s, d[0].t, d[0].t_ti, d[0].v].map(f64::to_bits), diag.map(f64::to_bits));
     }
 }
+
+/// Symmetry images in lanes (`gvr_kernel::symmetrised`, four at a time, the rest one by one)
+/// against the images one by one (`gvr_kernel::element`), bit for bit: one, four and six
+/// images, and four where one image's `A_I + A_J` is not positive definite (every lane again
+/// one by one, that image's element NaN).
+#[test]
+fn images_in_lanes_have_the_bits_of_one_by_one() {
+    let mut rng = Rng(11);
+    let (mut sym, ops) = system::<4>(&mut rng, true);
+    let perm = |p: [usize; 4]| Mat::<4>::from_fn(|i, j| if p[i] == j { 1.0 } else { 0.0 });
+    sym.extend([(perm([1, 2, 0, 3]), 0.3), (perm([0, 3, 2, 1]), -0.9)]);
+    let basis = Basis::random::<4>(&mut rng, 6, 30);
+    let go = <EcgGvr as Family<4>>::context(ops, 1, &[&basis.params()]).unwrap();
+    let k = basis.k.clone();
+    let (table, pairs) = (Table::new(&go, k.iter().flat_map(|&i| k.iter().map(move |&j| (i, j)))), Pairs::new(&go.ops));
+    let bits = |e: Element| [e.s, e.t, e.t_ti, e.v].map(f64::to_bits);
+    for images in [1, 4, 6] {
+        let side = Side::new(&go, &sym[..images], &basis.params()).unwrap();
+        for (bra, (ket, coef)) in side.functions.iter().zip(side.images.iter().zip(std::iter::repeat(&side.coef))) {
+            let mut one_by_one = Element::zero();
+            for (k, c) in ket.iter().zip(coef) {
+                one_by_one += (*c, crate::gvr_kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass));
+            }
+            let lanes = crate::gvr_kernel::symmetrised::<4, 4>(bra, ket, coef, &table, &pairs, go.ops.cm_mass);
+            assert_eq!(bits(lanes), bits(one_by_one), "{images} images");
+        }
+    }
+    let side = Side::new(&go, &sym[..4], &basis.params()).unwrap();
+    let mut images = side.images[1].clone();
+    images[2].a = std::array::from_fn(|i| std::array::from_fn(|j| -2.0 * side.functions[0].a[i][j]));
+    let bra = &side.functions[0];
+    let each: Vec<Element> =
+        images.iter().map(|k| crate::gvr_kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass)).collect();
+    assert!(each[2].s.is_nan() && each.iter().enumerate().all(|(i, e)| i == 2 || e.s.is_finite()));
+    let mut one_by_one = Element::zero();
+    for (e, c) in each.into_iter().zip(&side.coef) {
+        one_by_one += (*c, e);
+    }
+    let lanes = crate::gvr_kernel::symmetrised::<4, 4>(bra, &images, &side.coef, &table, &pairs, go.ops.cm_mass);
+    assert_eq!(bits(lanes), bits(one_by_one));
+}

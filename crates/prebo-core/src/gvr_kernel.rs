@@ -9,7 +9,9 @@
 //!   a multiple of [`MAX_W`] nodes.
 //! - Per element: `B = A_I + A_J = L D Lᵀ` (root-free Cholesky), `B⁻¹ = L⁻ᵀ D⁻¹ L⁻¹`,
 //!   `ln|B| = ln Π d_k`; `x, y, z`, Ω and its derivatives by Horner in `ρ²`, the kinetic
-//!   scalars of the gvr.rs formula; per Coulomb pair `c = wᵀB⁻¹w` and `γ_I, γ_J`.
+//!   scalars of the gvr.rs formula; per Coulomb pair `c = wᵀB⁻¹w` and `γ_I, γ_J`. This algebra
+//!   runs on [`MAX_LANES`] symmetry images of a ket at once, structure of arrays (`lanes`), each
+//!   lane with the bits of the one-image kernel.
 //! - The Coulomb τ-quadrature (`integrals`) in lanes of `W` nodes, several pairs and node
 //!   blocks at once: at a node,
 //!   with `α_I = γ_I²/x`, `α_J = γ_J²/y`, `β = z/√(xy)`, `δ = γ_Iγ_J/√(xy)`,
@@ -25,6 +27,7 @@ use std::f64::consts::PI;
 
 use crate::ecg::{Element, Operators};
 use crate::gvr::{Coefficients, Gvr, GvrOps};
+use crate::lanes::{Lane, Lanes};
 
 /// The widest lane count (AVX-512); rules are padded to a multiple of it.
 pub const MAX_W: usize = 8;
@@ -175,25 +178,28 @@ impl<const D: usize> Pairs<D> {
     }
 }
 
-/// `Σ_k coef_k r^k` (Horner, as `gvr::horner`).
+/// `x^k` by binary exponentiation for `B` blocks of `W` lanes, every lane with the same
+/// operations (one loop over the bits of `k` for all blocks).
 #[inline(always)]
-fn horner(coef: &[f64], r: f64) -> f64 {
-    coef.iter().rev().fold(0.0, |acc, ck| acc * r + ck)
-}
-
-/// `x^k` by binary exponentiation, every lane with the same operations.
-#[inline(always)]
-pub fn pow<const W: usize>(x: [f64; W], k: u32) -> [f64; W] {
-    let (mut r, mut base, mut k) = ([1.0; W], x, k);
+pub fn pow<const W: usize, const B: usize>(x: [[f64; W]; B], k: u32) -> [[f64; W]; B] {
+    let (mut r, mut base, mut k) = ([[1.0; W]; B], x, k);
     loop {
         if k & 1 == 1 {
-            r = std::array::from_fn(|l| r[l] * base[l]);
+            for j in 0..B {
+                for l in 0..W {
+                    r[j][l] *= base[j][l];
+                }
+            }
         }
         k >>= 1;
         if k == 0 {
             return r;
         }
-        base = std::array::from_fn(|l| base[l] * base[l]);
+        for j in 0..B {
+            for l in 0..W {
+                base[j][l] *= base[j][l];
+            }
+        }
     }
 }
 
@@ -214,6 +220,19 @@ fn positive(v: f64) -> f64 {
 /// Most Coulomb pairs of a call (stack storage): the pairs of `engine::MAX_DIM` particles.
 pub const MAX_PAIRS: usize = crate::engine::MAX_DIM * (crate::engine::MAX_DIM - 1) / 2;
 
+/// Block `c` of `W` lanes of `v` (one bounds check, so the block's loops stay in vector lanes).
+#[inline(always)]
+fn lanes<const W: usize>(v: &[f64], c: usize) -> &[f64; W] {
+    v[c * W..(c + 1) * W].try_into().expect("a block of W lanes")
+}
+
+/// The `W` slots of `MAX_W` that node block `c` adds into (node `i` in slot `i mod MAX_W`).
+#[inline(always)]
+fn slot_lanes<const W: usize>(slots: &mut [f64; MAX_W], c: usize) -> &mut [f64; W] {
+    let at = (c * W) % MAX_W;
+    (&mut slots[at..at + W]).try_into().expect("a block of W slots")
+}
+
 /// Lane blocks evaluated together: independent Horner chains that hide the latency.
 const SLOTS: usize = 8;
 
@@ -226,17 +245,17 @@ pub fn integrals<const W: usize>(s: &Series, inputs: &[[f64; 4]], out: &mut [f64
     let blocks = s.tau2.len() / W;
     let jobs = inputs.len() * blocks;
     let mut slots = [[0.0f64; MAX_W]; MAX_PAIRS];
+    let mut a = [[0.0f64; W]; SLOTS];
+    let mut b = [[0.0f64; W]; SLOTS];
+    let mut zeta = [[0.0f64; W]; SLOTS];
     let mut first = 0;
     while first < jobs {
         let n = SLOTS.min(jobs - first);
-        let mut a = [[0.0f64; W]; SLOTS];
-        let mut b = [[0.0f64; W]; SLOTS];
-        let mut zeta = [[0.0f64; W]; SLOTS];
         let mut r = [[0.0f64; W]; SLOTS];
         for j in 0..n {
             let (p, c) = ((first + j) / blocks, (first + j) % blocks);
             let [al_i, al_j, beta, delta] = inputs[p];
-            let t2 = &s.tau2[c * W..(c + 1) * W];
+            let t2 = lanes::<W>(s.tau2, c);
             for l in 0..W {
                 a[j][l] = positive(1.0 - al_i * t2[l]);
                 b[j][l] = positive(1.0 - al_j * t2[l]);
@@ -253,13 +272,15 @@ pub fn integrals<const W: usize>(s: &Series, inputs: &[[f64; 4]], out: &mut [f64
                 }
             }
         }
+        // all SLOTS blocks (unused ones hold earlier or zero values, never read)
+        let (pa, pb, pz) = (pow(a, s.ki), pow(b, s.kj), pow(zeta, s.n));
         for j in 0..n {
             let (p, c) = ((first + j) / blocks, (first + j) % blocks);
-            let (pa, pb, pz) = (pow(a[j], s.ki), pow(b[j], s.kj), pow(zeta[j], s.n));
-            let wt = &s.weight[c * W..(c + 1) * W];
-            let at = (c * W) % MAX_W;
+            let wt = lanes::<W>(s.weight, c);
+            let term: [f64; W] = std::array::from_fn(|l| wt[l] * pa[j][l] * pb[j][l] * pz[j][l] * g[j][l]);
+            let slot = slot_lanes::<W>(&mut slots[p], c);
             for l in 0..W {
-                slots[p][at + l] += wt[l] * pa[l] * pb[l] * pz[l] * g[j][l];
+                slot[l] += term[l];
             }
         }
         first += n;
@@ -269,27 +290,29 @@ pub fn integrals<const W: usize>(s: &Series, inputs: &[[f64; 4]], out: &mut [f64
     }
 }
 
-/// `B⁻¹` (full) and `|B|` of `B = L D Lᵀ`; `None` unless every pivot is positive and finite.
+/// `B⁻¹` (full) and `|B|` of `B = L D Lᵀ`, with the pivots; `None` unless every pivot of every
+/// lane is positive and finite.
 #[inline(always)]
-fn inverse_det<const D: usize>(m: &[[f64; D]; D]) -> Option<([[f64; D]; D], f64, [f64; D])> {
-    let mut lo = [[0.0f64; D]; D];
-    let mut e = [[0.0f64; D]; D];
-    let mut rd = [0.0f64; D];
-    let mut dk = [0.0f64; D];
-    let mut det = 1.0;
+fn inverse_det<T: Lane, const D: usize>(m: &[[T; D]; D]) -> Option<([[T; D]; D], T, [T; D])> {
+    let zero = T::splat(0.0);
+    let mut lo = [[zero; D]; D];
+    let mut e = [[zero; D]; D];
+    let mut rd = [zero; D];
+    let mut dk = [zero; D];
+    let mut det = T::splat(1.0);
     for k in 0..D {
         for i in k..D {
             let mut v = m[k][i];
             for r in 0..k {
-                v -= e[i][r] * lo[k][r];
+                v = v - e[i][r] * lo[k][r];
             }
             if i == k {
-                if !(v > 0.0 && v.is_finite()) {
+                if !v.all(|v| v > 0.0 && v.is_finite()) {
                     return None;
                 }
-                rd[k] = 1.0 / v;
+                rd[k] = T::splat(1.0) / v;
                 dk[k] = v;
-                det *= v;
+                det = det * v;
             } else {
                 e[i][k] = v;
                 lo[i][k] = v * rd[k];
@@ -297,24 +320,24 @@ fn inverse_det<const D: usize>(m: &[[f64; D]; D]) -> Option<([[f64; D]; D], f64,
         }
     }
     // L⁻¹ (unit lower triangular)
-    let mut inv = [[0.0f64; D]; D];
+    let mut inv = [[zero; D]; D];
     for k in 0..D {
-        inv[k][k] = 1.0;
+        inv[k][k] = T::splat(1.0);
         for i in (k + 1)..D {
             let mut x = -lo[i][k];
             for r in (k + 1)..i {
-                x -= lo[i][r] * inv[r][k];
+                x = x - lo[i][r] * inv[r][k];
             }
             inv[i][k] = x;
         }
     }
     // B⁻¹_ab = Σ_{k >= max(a, b)} (L⁻¹)_ka (L⁻¹)_kb / d_k
-    let mut b = [[0.0f64; D]; D];
+    let mut b = [[zero; D]; D];
     for a in 0..D {
         for c in a..D {
-            let mut x = 0.0;
+            let mut x = zero;
             for k in c..D {
-                x += inv[k][a] * inv[k][c] * rd[k];
+                x = x + inv[k][a] * inv[k][c] * rd[k];
             }
             b[a][c] = x;
             b[c][a] = x;
@@ -324,16 +347,170 @@ fn inverse_det<const D: usize>(m: &[[f64; D]; D]) -> Option<([[f64; D]; D], f64,
 }
 
 #[inline(always)]
-fn dot<const D: usize>(p: &[f64; D], q: &[f64; D]) -> f64 {
-    (0..D).fold(0.0, |acc, k| acc + p[k] * q[k])
+fn dot<T: Lane, const D: usize>(p: &[T; D], q: &[T; D]) -> T {
+    (0..D).fold(T::splat(0.0), |acc, k| acc + p[k] * q[k])
 }
 
 #[inline(always)]
-fn mat_vec<const D: usize>(m: &[[f64; D]; D], v: &[f64; D]) -> [f64; D] {
+fn mat_vec<T: Lane, const D: usize>(m: &[[T; D]; D], v: &[T; D]) -> [T; D] {
     std::array::from_fn(|i| dot(&m[i], v))
 }
 
-/// `<φ_I| 1, T, T_TI, V |φ_J>` of two prepared functions (`gvr::element`'s formulas).
+/// `Σ_k coef_k r^k` (Horner, as `gvr::horner`).
+#[inline(always)]
+fn horner<T: Lane>(coef: &[f64], r: T) -> T {
+    coef.iter().rev().fold(T::splat(0.0), |acc, &ck| acc * r + ck)
+}
+
+/// `x^k` by binary exponentiation ([`pow`] in the kernel's values).
+#[inline(always)]
+fn power<T: Lane>(x: T, k: u32) -> T {
+    let (mut r, mut base, mut k) = (T::splat(1.0), x, k);
+    loop {
+        if k & 1 == 1 {
+            r = r * base;
+        }
+        k >>= 1;
+        if k == 0 {
+            return r;
+        }
+        base = base * base;
+    }
+}
+
+/// The fields of `T::L` kets (symmetry images of one function) in lanes.
+struct Ket<T, const D: usize> {
+    a: [[T; D]; D],
+    u: [T; D],
+    lambda_u: [T; D],
+    log_norm: T,
+    c_a: T,
+    c_u: T,
+}
+
+impl<T: Lane, const D: usize> Ket<T, D> {
+    #[inline(always)]
+    fn new(kets: &[Prepared<D>]) -> Self {
+        let v = |f: &dyn Fn(&Prepared<D>) -> f64| T::from_lanes(|l| f(&kets[l]));
+        Self {
+            a: std::array::from_fn(|i| std::array::from_fn(|j| v(&|k| k.a[i][j]))),
+            u: std::array::from_fn(|i| v(&|k| k.u[i])),
+            lambda_u: std::array::from_fn(|i| v(&|k| k.lambda_u[i])),
+            log_norm: v(&|k| k.log_norm),
+            c_a: v(&|k| k.c_a),
+            c_u: v(&|k| k.c_u),
+        }
+    }
+}
+
+/// `<φ_I| 1, T, T_TI, V |φ_J>` of `bra` with each of `kets` (`T::L` of them, one power K), in
+/// lanes (`gvr::element`'s formulas); `None` where some `A_I + A_J` is not positive definite.
+#[inline(always)]
+fn elements<const D: usize, const W: usize, T: Lane>(
+    bra: &Prepared<D>,
+    kets: &[Prepared<D>],
+    table: &Table,
+    pairs: &Pairs<D>,
+    cm_mass: Option<f64>,
+) -> Option<Element<T>> {
+    let ket = Ket::<T, D>::new(kets);
+    let bra_u = bra.u.map(T::splat);
+    let bsum: [[T; D]; D] = std::array::from_fn(|i| std::array::from_fn(|j| ket.a[i][j] + bra.a[i][j]));
+    let (binv, det, dk) = inverse_det(&bsum)?;
+    let log_det = T::from_lanes(|l| {
+        let det = det.lane(l);
+        if det.is_normal() { det.ln() } else { dk.map(|d| d.lane(l)).iter().map(|d| d.ln()).sum() }
+    });
+    let gi = mat_vec(&binv, &bra_u);
+    let gj = mat_vec(&binv, &ket.u);
+    let x = dot(&bra_u, &gi) * 0.5;
+    let y = dot(&ket.u, &gj) * 0.5;
+    let z = dot(&bra_u, &gj) * 0.5;
+    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
+    let s = table.series(bra.k, kets[0].k);
+    let (l, om, ox, oy, oz) = omega(&s, x, y, z);
+    let scale = (log_s0 + l - bra.log_norm - ket.log_norm).map(f64::exp);
+
+    // kinetic with Λ (gvr.rs module docs)
+    let zl = mat_vec(&ket.a, &bra.lambda_u.map(T::splat)); // A_J Λ u_I
+    let zr = mat_vec(&bra.a.map(|r| r.map(T::splat)), &ket.lambda_u); // A_I Λ u_J
+    let w: [[T; D]; D] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| (0..D).fold(T::splat(0.0), |acc, k| acc + ket.a[k][j] * bra.a_lambda[i][k]))
+    });
+    let mut tr_wc = T::splat(0.0);
+    for a in 0..D {
+        for b in 0..D {
+            tr_wc = tr_wc + binv[a][b] * w[b][a];
+        }
+    }
+    let tr_wc = tr_wc * 0.5;
+    let hi: [T; D] = std::array::from_fn(|k| gi[k] * 0.5);
+    let hj: [T; D] = std::array::from_fn(|k| gj[k] * 0.5);
+    let (w_hi, w_hj) = (mat_vec(&w, &hi), mat_vec(&w, &hj));
+    let t = dot(&bra_u, &ket.lambda_u) * oz - dot(&zl, &hi) * 4.0 * ox - dot(&zl, &hj) * 2.0 * oz
+        - dot(&zr, &hj) * 4.0 * oy
+        - dot(&zr, &hi) * 2.0 * oz
+        + tr_wc * 12.0 * om
+        + dot(&hi, &w_hi) * 8.0 * ox
+        + (dot(&hi, &w_hj) + dot(&hj, &w_hi)) * 4.0 * oz
+        + dot(&hj, &w_hj) * 8.0 * oy;
+    let t = scale * t;
+    let t_ti = match cm_mass {
+        Some(m) => t - scale * cm_kinetic(T::splat(bra.c_a), ket.c_a, T::splat(bra.c_u), ket.c_u, m, (om, ox, oy, oz)),
+        None => t,
+    };
+
+    // Coulomb: the τ-quadrature of every pair, lane by lane
+    let rt = (x * y).map(f64::sqrt);
+    let np = pairs.pairs.len();
+    let mut inputs = [[[0.0f64; 4]; MAX_PAIRS]; MAX_LANES];
+    let mut factor = [T::splat(0.0); MAX_PAIRS];
+    for (p, (q2, wv, terms)) in pairs.pairs.iter().enumerate() {
+        let c = terms.iter().fold(T::splat(0.0), |acc, &(a, b, f)| acc + binv[a][b] * f);
+        let sq = (c * 2.0).map(f64::sqrt);
+        let wv = wv.map(T::splat);
+        let (gam_i, gam_j) = (dot(&gi, &wv) / sq, dot(&gj, &wv) / sq);
+        let (al_i, al_j, beta, delta) = (gam_i * gam_i / x, gam_j * gam_j / y, z / rt, gam_i * gam_j / rt);
+        for (l, input) in inputs.iter_mut().take(T::L).enumerate() {
+            input[p] = [al_i.lane(l), al_j.lane(l), beta.lane(l), delta.lane(l)];
+        }
+        factor[p] = T::splat(*q2) / (c * PI).map(f64::sqrt);
+    }
+    let mut integral = [[0.0f64; MAX_PAIRS]; MAX_LANES];
+    for (input, out) in inputs.iter().zip(integral.iter_mut()).take(T::L) {
+        integrals::<W>(&s, &input[..np], &mut out[..np]);
+    }
+    let v = (0..np).fold(T::splat(0.0), |acc, p| acc + factor[p] * T::from_lanes(|l| integral[l][p]));
+    Some(Element { s: scale * om, t, t_ti, v: scale * v })
+}
+
+/// `gvr::omega` from the tabulated series: `(L, ω, ω_x, ω_y, ω_z)`.
+#[inline(always)]
+fn omega<T: Lane>(s: &Series, x: T, y: T, z: T) -> (T, T, T, T, T) {
+    let nf = s.n as f64;
+    let rt = (x * y).map(f64::sqrt);
+    let rho = (z / rt).map(|v| v.clamp(-1.0, 1.0));
+    let r2 = rho * rho;
+    let (g, gx, gy, gz) = (horner(s.c, r2), horner(s.cx, r2), horner(s.cy, r2), horner(s.cz, r2));
+    let rho_n = power(rho, s.n);
+    let l = x.map(f64::ln) * (s.ki as f64 + 0.5 * nf) + y.map(f64::ln) * (s.kj as f64 + 0.5 * nf);
+    let omega_z = if s.n == 0 { rho * gz / rt } else { power(rho, s.n - 1) * gz / rt };
+    (l, rho_n * g, rho_n * gx / x, rho_n * gy / y, omega_z)
+}
+
+/// `gvr::cm_kinetic` in the kernel's values.
+#[inline(always)]
+fn cm_kinetic<T: Lane>(ci: T, cj: T, ui: T, uj: T, m: f64, w: (T, T, T, T)) -> T {
+    let (om, ox, oy, oz) = w;
+    let s = ci + cj;
+    om * (ci * 3.0 * cj / (s * m)) - (ui * ui * cj * ox + uj * uj * ci * oy) / (s * m)
+        + (ui * ui * ox + ui * uj * oz + uj * uj * oy) * (ci * cj) / (s * m * s)
+}
+
+/// Images of one ket evaluated together in lanes.
+const MAX_LANES: usize = 4;
+
+/// `<φ_I| 1, T, T_TI, V |φ_J>` of two prepared functions.
 #[inline(always)]
 pub fn element<const D: usize, const W: usize>(
     bra: &Prepared<D>,
@@ -342,90 +519,12 @@ pub fn element<const D: usize, const W: usize>(
     pairs: &Pairs<D>,
     cm_mass: Option<f64>,
 ) -> Element {
-    let bsum: [[f64; D]; D] = std::array::from_fn(|i| std::array::from_fn(|j| bra.a[i][j] + ket.a[i][j]));
-    let Some((binv, det, dk)) = inverse_det(&bsum) else {
-        return Element::nan();
-    };
-    let log_det = if det.is_normal() { det.ln() } else { dk.iter().map(|d| d.ln()).sum() };
-    let gi = mat_vec(&binv, &bra.u);
-    let gj = mat_vec(&binv, &ket.u);
-    let x = dot(&bra.u, &gi) * 0.5;
-    let y = dot(&ket.u, &gj) * 0.5;
-    let z = dot(&bra.u, &gj) * 0.5;
-    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
-    let s = table.series(bra.k, ket.k);
-    let (l, om, ox, oy, oz) = omega(&s, x, y, z);
-    let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
-
-    // kinetic with Λ (gvr.rs module docs)
-    let zl = mat_vec(&ket.a, &bra.lambda_u); // A_J Λ u_I
-    let zr = mat_vec(&bra.a, &ket.lambda_u); // A_I Λ u_J
-    let w: [[f64; D]; D] = std::array::from_fn(|i| std::array::from_fn(|j| (0..D).fold(0.0, |acc, k| acc + bra.a_lambda[i][k] * ket.a[k][j])));
-    let mut tr_wc = 0.0;
-    for a in 0..D {
-        for b in 0..D {
-            tr_wc += binv[a][b] * w[b][a];
-        }
-    }
-    let tr_wc = tr_wc * 0.5;
-    let hi: [f64; D] = std::array::from_fn(|k| gi[k] * 0.5);
-    let hj: [f64; D] = std::array::from_fn(|k| gj[k] * 0.5);
-    let (w_hi, w_hj) = (mat_vec(&w, &hi), mat_vec(&w, &hj));
-    let t = dot(&bra.u, &ket.lambda_u) * oz - 4.0 * dot(&zl, &hi) * ox - 2.0 * dot(&zl, &hj) * oz
-        - 4.0 * dot(&zr, &hj) * oy
-        - 2.0 * dot(&zr, &hi) * oz
-        + 12.0 * tr_wc * om
-        + 8.0 * dot(&hi, &w_hi) * ox
-        + 4.0 * (dot(&hi, &w_hj) + dot(&hj, &w_hi)) * oz
-        + 8.0 * dot(&hj, &w_hj) * oy;
-    let t = scale * t;
-    let t_ti = match cm_mass {
-        Some(m) => t - scale * cm_kinetic(bra.c_a, ket.c_a, bra.c_u, ket.c_u, m, (om, ox, oy, oz)),
-        None => t,
-    };
-
-    // Coulomb: the τ-quadrature of every pair
-    let rt = (x * y).sqrt();
-    let np = pairs.pairs.len();
-    let mut inputs = [[0.0f64; 4]; MAX_PAIRS];
-    let mut factor = [0.0f64; MAX_PAIRS];
-    for (p, (q2, wv, terms)) in pairs.pairs.iter().enumerate() {
-        let c = terms.iter().fold(0.0, |acc, &(a, b, f)| acc + f * binv[a][b]);
-        let sq = (c * 2.0).sqrt();
-        let (gam_i, gam_j) = (dot(&gi, wv) / sq, dot(&gj, wv) / sq);
-        inputs[p] = [gam_i * gam_i / x, gam_j * gam_j / y, z / rt, gam_i * gam_j / rt];
-        factor[p] = q2 / (c * PI).sqrt();
-    }
-    let mut integral = [0.0f64; MAX_PAIRS];
-    integrals::<W>(&s, &inputs[..np], &mut integral[..np]);
-    let v = (0..np).fold(0.0, |acc, p| acc + factor[p] * integral[p]);
-    Element { s: scale * om, t, t_ti, v: scale * v }
+    elements::<D, W, f64>(bra, std::slice::from_ref(ket), table, pairs, cm_mass).unwrap_or_else(Element::nan)
 }
 
-/// `gvr::omega` from the tabulated series: `(L, ω, ω_x, ω_y, ω_z)`.
-#[inline(always)]
-fn omega(s: &Series, x: f64, y: f64, z: f64) -> (f64, f64, f64, f64, f64) {
-    let nf = s.n as f64;
-    let rt = (x * y).sqrt();
-    let rho = (z / rt).clamp(-1.0, 1.0);
-    let r2 = rho * rho;
-    let (g, gx, gy, gz) = (horner(s.c, r2), horner(s.cx, r2), horner(s.cy, r2), horner(s.cz, r2));
-    let rho_n = pow([rho], s.n)[0];
-    let l = x.ln() * (s.ki as f64 + 0.5 * nf) + y.ln() * (s.kj as f64 + 0.5 * nf);
-    let omega_z = if s.n == 0 { rho * gz / rt } else { pow([rho], s.n - 1)[0] * gz / rt };
-    (l, rho_n * g, rho_n * gx / x, rho_n * gy / y, omega_z)
-}
-
-/// `gvr::cm_kinetic` in f64.
-#[inline(always)]
-fn cm_kinetic(ci: f64, cj: f64, ui: f64, uj: f64, m: f64, w: (f64, f64, f64, f64)) -> f64 {
-    let (om, ox, oy, oz) = w;
-    let s = ci + cj;
-    om * (3.0 * ci * cj / (m * s)) - (ui * ui * cj * ox + uj * uj * ci * oy) / (m * s)
-        + (ui * ui * ox + ui * uj * oz + uj * uj * oy) * (ci * cj) / (m * s * s)
-}
-
-/// `Σ_P c_P <bra| O |P ket>` over the images of one ket.
+/// `Σ_P c_P <bra| O |P ket>` over the images of one ket: [`MAX_LANES`] images at a time in lanes
+/// (one by one where a lane's `A_I + A_J` is not positive definite), the rest one by one, summed
+/// in the order of the images (each lane has the bits of [`element`]).
 #[inline(always)]
 pub fn symmetrised<const D: usize, const W: usize>(
     bra: &Prepared<D>,
@@ -436,7 +535,23 @@ pub fn symmetrised<const D: usize, const W: usize>(
     cm_mass: Option<f64>,
 ) -> Element {
     let mut e = Element::zero();
-    for (ket, c) in images.iter().zip(coef) {
+    let whole = images.len() / MAX_LANES * MAX_LANES;
+    for (kets, c) in images[..whole].chunks_exact(MAX_LANES).zip(coef.chunks_exact(MAX_LANES)) {
+        match elements::<D, W, Lanes<MAX_LANES>>(bra, kets, table, pairs, cm_mass) {
+            Some(v) => {
+                for l in 0..MAX_LANES {
+                    let lane = Element { s: v.s.0[l], t: v.t.0[l], t_ti: v.t_ti.0[l], v: v.v.0[l] };
+                    e += (c[l], lane);
+                }
+            }
+            None => {
+                for (ket, c) in kets.iter().zip(c) {
+                    e += (*c, element::<D, W>(bra, ket, table, pairs, cm_mass));
+                }
+            }
+        }
+    }
+    for (ket, c) in images[whole..].iter().zip(&coef[whole..]) {
         e += (*c, element::<D, W>(bra, ket, table, pairs, cm_mass));
     }
     e
@@ -549,9 +664,9 @@ fn partial_sums<const W: usize>(
                 let blk = first + j;
                 let (t2, wt) = (&tau2[blk * W..(blk + 1) * W], &weight[blk * W..(blk + 1) * W]);
                 let (aj, bj, zj, rj, gj, gpj) = (a[j], b[j], zeta[j], r[j], g[j], gp[j]);
-                let pa1 = if ki > 0 { pow(aj, ki - 1) } else { one };
-                let pb1 = if kj > 0 { pow(bj, kj - 1) } else { one };
-                let pz1 = if n > 0 { pow(zj, n - 1) } else { one };
+                let pa1 = if ki > 0 { pow([aj], ki - 1)[0] } else { one };
+                let pb1 = if kj > 0 { pow([bj], kj - 1)[0] } else { one };
+                let pz1 = if n > 0 { pow([zj], n - 1)[0] } else { one };
                 let pa: [f64; W] = std::array::from_fn(|l| if ki > 0 { pa1[l] * aj[l] } else { 1.0 });
                 let pb: [f64; W] = std::array::from_fn(|l| if kj > 0 { pb1[l] * bj[l] } else { 1.0 });
                 let pz: [f64; W] = std::array::from_fn(|l| if n > 0 { pz1[l] * zj[l] } else { 1.0 });

@@ -26,6 +26,7 @@ mod gvr_coulomb;
 pub mod gvr_gradient;
 pub mod gvr_kernel;
 pub mod images;
+pub mod lanes;
 pub mod matrices;
 pub mod operators;
 pub mod path;

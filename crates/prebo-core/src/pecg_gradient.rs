@@ -24,7 +24,7 @@ use std::f64::consts::PI;
 use nalgebra::Cholesky;
 use rayon::prelude::*;
 
-use crate::build::{best_isa, Isa};
+use crate::build::{isa_available, Isa};
 use crate::ecg::{Element, Gaussian, Mat, Operators};
 use crate::images::Images;
 use crate::matrices::Matrices;
@@ -301,68 +301,80 @@ isa_block!(avx2, 4, "avx2");
 #[cfg(target_arch = "x86_64")]
 isa_block!(avx512, 8, "avx512f");
 
-/// The row of the trial `f` (bra) against the symmetrised `basis` and its derivatives along the
-/// directions `da` of `A`: `(1 + P) x nb` matrices, row 0 the values (`path::row_gradient`'s layout).
-pub fn row_gradient<const D: usize>(
-    f: &Gaussian<D>,
-    da: &[Mat<D>],
-    basis: &Images<Gaussian<D>>,
-    ops: &Operators<D>,
-) -> Matrices {
-    row_gradient_with(f, da, basis, ops, best_isa())
+/// The basis in the gradient's lanes for one instruction set: blocks of `W` functions, each image
+/// `P` in lanes (`KetLanes`), with the images' coefficients. It depends on the basis alone, so
+/// the optimiser keeps it with the basis side (`cache`).
+pub struct Kets<const D: usize> {
+    isa: Isa,
+    nb: usize,
+    coef: Vec<f64>,
+    w8: Vec<Vec<KetLanes<D, 8>>>,
+    w4: Vec<Vec<KetLanes<D, 4>>>,
 }
 
-/// `row_gradient` with a chosen instruction set (plain code where the CPU lacks it).
-pub fn row_gradient_with<const D: usize>(
-    f: &Gaussian<D>,
-    da: &[Mat<D>],
-    basis: &Images<Gaussian<D>>,
-    ops: &Operators<D>,
-    isa: Isa,
-) -> Matrices {
+impl<const D: usize> Kets<D> {
+    /// `basis` in the lanes of `isa` (plain code's where the CPU lacks it).
+    pub fn new(basis: &Images<Gaussian<D>>, isa: Isa) -> Self {
+        let isa = if isa_available(isa) { isa } else { Isa::Plain };
+        let (w8, w4) = if isa == Isa::Avx512 { (lanes(basis), vec![]) } else { (vec![], lanes(basis)) };
+        Self { isa, nb: basis.len(), coef: basis.coef.clone(), w8, w4 }
+    }
+}
+
+/// Blocks of `W` functions of `basis`, each image in lanes (the last block repeats its last function).
+fn lanes<const D: usize, const W: usize>(basis: &Images<Gaussian<D>>) -> Vec<Vec<KetLanes<D, W>>> {
+    let nb = basis.len();
+    (0..nb.div_ceil(W))
+        .into_par_iter()
+        .map(|c| {
+            (0..basis.coef.len())
+                .map(|p| {
+                    let g: Vec<&Gaussian<D>> = (c * W..((c + 1) * W).min(nb)).map(|j| &basis.images[j][p]).collect();
+                    KetLanes::from_gaussians(&g)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The row of the trial `f` (bra) against the symmetrised basis `kets` and its derivatives along
+/// the directions `da` of `A`: `(1 + P) x nb` matrices, row 0 the values (`path::row_gradient`'s
+/// layout), on the instruction set of `kets`.
+pub fn row_gradient<const D: usize>(f: &Gaussian<D>, da: &[Mat<D>], kets: &Kets<D>, ops: &Operators<D>) -> Matrices {
     let ops = Ops::new(ops);
     let trial = Trial::new(f, da, &ops);
-    match isa {
+    let (nb, coef) = (kets.nb, &kets.coef[..]);
+    match kets.isa {
+        // Safety (each arm): `Kets::new` chose an instruction set the CPU has.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if std::arch::is_x86_feature_detected!("avx512f") => {
-            // Safety: the CPU has the feature.
-            blocks::<D, 8>(&trial, basis, &ops, |t, k, c, o, out| unsafe {
-                avx512::block::<D>(t, k, c, o, out)
-            })
-        }
+        Isa::Avx512 => blocks(&trial, &kets.w8, nb, coef, &ops, |t, k, c, o, out| unsafe {
+            avx512::block::<D>(t, k, c, o, out)
+        }),
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if std::arch::is_x86_feature_detected!("avx2") => {
-            // Safety: as above.
-            blocks::<D, 4>(&trial, basis, &ops, |t, k, c, o, out| unsafe {
-                avx2::block::<D>(t, k, c, o, out)
-            })
-        }
-        // Safety: plain code runs everywhere.
-        _ => blocks::<D, 4>(&trial, basis, &ops, |t, k, c, o, out| unsafe {
+        Isa::Avx2 => blocks(&trial, &kets.w4, nb, coef, &ops, |t, k, c, o, out| unsafe {
+            avx2::block::<D>(t, k, c, o, out)
+        }),
+        _ => blocks(&trial, &kets.w4, nb, coef, &ops, |t, k, c, o, out| unsafe {
             plain::block::<D>(t, k, c, o, out)
         }),
     }
 }
 
-/// The basis in blocks of `W` (every image in lanes), in parallel, gathered into the matrices.
+/// The blocks in parallel, gathered into the matrices.
 fn blocks<const D: usize, const W: usize>(
     trial: &Trial<D>,
-    basis: &Images<Gaussian<D>>,
+    kets: &[Vec<KetLanes<D, W>>],
+    nb: usize,
+    coef: &[f64],
     ops: &Ops<D>,
     block: impl Fn(&Trial<D>, &[KetLanes<D, W>], &[f64], &Ops<D>, &mut [[Element; W]]) + Sync,
 ) -> Matrices {
-    let (nb, rows) = (basis.len(), 1 + trial.weights.len());
-    let parts: Vec<Vec<[Element; W]>> = (0..nb.div_ceil(W))
-        .into_par_iter()
-        .map(|c| {
-            let kets: Vec<KetLanes<D, W>> = (0..basis.coef.len())
-                .map(|p| {
-                    let g: Vec<&Gaussian<D>> = (c * W..((c + 1) * W).min(nb)).map(|j| &basis.images[j][p]).collect();
-                    KetLanes::from_gaussians(&g)
-                })
-                .collect();
+    let rows = 1 + trial.weights.len();
+    let parts: Vec<Vec<[Element; W]>> = kets
+        .par_iter()
+        .map(|k| {
             let mut out = vec![[Element::default(); W]; rows];
-            block(trial, &kets, &basis.coef, ops, &mut out);
+            block(trial, k, coef, ops, &mut out);
             out
         })
         .collect();

@@ -156,7 +156,7 @@ fn row_gradient_matches_the_dual_path() {
 fn against_finite_differences<const D: usize>() {
     for lab in [true, false] {
         let case = Case::<D>::new(21 ^ D as u64, lab, 6, 3);
-        let basis = case.images();
+        let basis = Kets::new(&case.images(), crate::build::best_isa());
         let m = row_gradient(&case.trial, &case.da, &basis, &case.ops);
         let scales = case.scales();
         for (p, d) in case.da.iter().enumerate() {
@@ -192,7 +192,7 @@ fn row_gradient_matches_finite_differences() {
 fn same_bits<const D: usize>() {
     let case = Case::<D>::new(31 ^ D as u64, true, 13, 5);
     let basis = case.images();
-    let run = |isa| row_gradient_with(&case.trial, &case.da, &basis, &case.ops, isa);
+    let run = |isa| row_gradient(&case.trial, &case.da, &Kets::new(&basis, isa), &case.ops);
     let plain = run(Isa::Plain);
     for isa in [Isa::Avx2, Isa::Avx512] {
         let m = run(isa);

@@ -85,8 +85,9 @@ impl<const D: usize> Family<D> for PlainEcg {
         Ok(build::rows(&gaussians(trials, sym)?, &b, &go.ops, position))
     }
 
-    /// The row from `pecg_gradient` (directions of `A` only, as `seeded`); the diagonal, where
-    /// both sides move, by dual numbers (`path::row_gradient` against no basis).
+    /// The row from `pecg_gradient` (directions of `A` only, as `seeded`), the basis in its lanes
+    /// kept in `cache`; the diagonal, where both sides move, by dual numbers (`path::row_gradient`
+    /// against no basis).
     fn row_gradient(
         go: &GvrOps<D>,
         sym: &Symmetry<D>,
@@ -99,7 +100,9 @@ impl<const D: usize> Family<D> for PlainEcg {
         let (_, diag) = path::row_gradient::<D, Self>(go, sym, trial, dir, &Params::default(), &Cache::default())?;
         let f = Gaussian::new(trial.exponents::<D>()?[0], trial.c_a[0], 0)?;
         let (da, _) = dir.exponents::<D>()?;
-        let b = cache.get(basis, || gaussians(basis, sym))?;
-        Ok((pecg_gradient::row_gradient(&f, &da, &b, &go.ops), diag))
+        let kets = cache.get(basis, || {
+            Ok(pecg_gradient::Kets::new(&*cache.get(basis, || gaussians(basis, sym))?, build::best_isa()))
+        })?;
+        Ok((pecg_gradient::row_gradient(&f, &da, &kets, &go.ops), diag))
     }
 }

@@ -1,0 +1,98 @@
+//! Values of the ECG-GVR kernel (`gvr_kernel::element`): one element (`f64`), or the elements of
+//! one bra with `L` symmetry images of a ket at once ([`Lanes`]), structure of arrays. Every
+//! operation is the scalar one, lane by lane (no fused multiply-add, the libm `ln`/`exp` called
+//! per lane), so each lane has the bits of the scalar kernel on every instruction set.
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+/// A value of the kernel: `f64` or [`Lanes`].
+pub trait Lane:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + Add<f64, Output = Self>
+    + Sub<f64, Output = Self>
+    + Mul<f64, Output = Self>
+    + Div<f64, Output = Self>
+{
+    /// Lanes
+    const L: usize;
+    /// The value with lane `l` equal to `f(l)`.
+    fn from_lanes(f: impl Fn(usize) -> f64) -> Self;
+    /// Lane `l`.
+    fn lane(self, l: usize) -> f64;
+
+    fn splat(x: f64) -> Self {
+        Self::from_lanes(|_| x)
+    }
+    fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        Self::from_lanes(|l| f(self.lane(l)))
+    }
+    /// Whether `p` holds in every lane.
+    fn all(self, p: impl Fn(f64) -> bool) -> bool {
+        (0..Self::L).all(|l| p(self.lane(l)))
+    }
+}
+
+impl Lane for f64 {
+    const L: usize = 1;
+    #[inline(always)]
+    fn from_lanes(f: impl Fn(usize) -> f64) -> Self {
+        f(0)
+    }
+    #[inline(always)]
+    fn lane(self, _: usize) -> f64 {
+        self
+    }
+}
+
+/// `L` values in lanes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lanes<const L: usize>(pub [f64; L]);
+
+impl<const L: usize> Lane for Lanes<L> {
+    const L: usize = L;
+    #[inline(always)]
+    fn from_lanes(f: impl Fn(usize) -> f64) -> Self {
+        Self(std::array::from_fn(f))
+    }
+    #[inline(always)]
+    fn lane(self, l: usize) -> f64 {
+        self.0[l]
+    }
+}
+
+/// The lane-by-lane operators `$op` of `Lanes` with `Lanes` and with `f64` on the right.
+macro_rules! lane_op {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl<const L: usize> $trait for Lanes<L> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, o: Self) -> Self {
+                Self(std::array::from_fn(|l| self.0[l] $op o.0[l]))
+            }
+        }
+        impl<const L: usize> $trait<f64> for Lanes<L> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, o: f64) -> Self {
+                Self(std::array::from_fn(|l| self.0[l] $op o))
+            }
+        }
+    };
+}
+
+lane_op!(Add, add, +);
+lane_op!(Sub, sub, -);
+lane_op!(Mul, mul, *);
+lane_op!(Div, div, /);
+
+impl<const L: usize> Neg for Lanes<L> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Self(self.0.map(|v| -v))
+    }
+}
