@@ -86,8 +86,8 @@ impl<const D: usize> Family<D> for PlainEcg {
     }
 
     /// The row from `pecg_gradient` (directions of `A` only, as `seeded`), the basis in its lanes
-    /// kept in `cache`; the diagonal, where both sides move, by dual numbers (`path::row_gradient`
-    /// against no basis).
+    /// kept in `cache`; the diagonal, where both sides move, from the same kernel (`diagonal`),
+    /// or by dual numbers (`path::row_gradient` against no basis) where that does not apply.
     fn row_gradient(
         go: &GvrOps<D>,
         sym: &Symmetry<D>,
@@ -97,12 +97,62 @@ impl<const D: usize> Family<D> for PlainEcg {
         cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
         check(trial.len(), 1, "trial functions")?;
-        let (_, diag) = path::row_gradient::<D, Self>(go, sym, trial, dir, &Params::default(), &Cache::default())?;
         let f = Gaussian::new(trial.exponents::<D>()?[0], trial.c_a[0], 0)?;
         let (da, _) = dir.exponents::<D>()?;
+        let diag = match diagonal(&f, &da, sym, &go.ops)? {
+            Some(diag) => diag,
+            None => path::row_gradient::<D, Self>(go, sym, trial, dir, &Params::default(), &Cache::default())?.1,
+        };
         let kets = cache.get(basis, || {
             Ok(pecg_gradient::Kets::new(&*cache.get(basis, || gaussians(basis, sym))?, build::best_isa()))
         })?;
         Ok((pecg_gradient::row_gradient(&f, &da, &kets, &go.ops), diag))
     }
+}
+
+/// Whether the operators commute with the permutation `p`: `Pᵀ Λ P = Λ`, and every Coulomb
+/// vector maps to one of the same charge (up to sign).
+fn commutes<const D: usize>(p: &Mat<D>, ops: &Operators<D>) -> bool {
+    p.transpose() * ops.lambda * p == ops.lambda
+        && ops.pairs.iter().all(|(w, q)| {
+            let pw = p * w;
+            ops.pairs.iter().any(|(v, r)| r == q && (pw == *v || pw == -v))
+        })
+}
+
+/// The trial's diagonal `Σ_P c_P <φ|O|Pφ>` with its derivatives along `da`, both sides moving,
+/// from the bra-side kernel: the operators commute with the operations, so `Σ_P c_P <φ|O|P dφ>
+/// = Σ_P c_P <P⁻¹φ|O|dφ> = Σ_P c_{P⁻¹} <dφ|O|Pφ>`, the bra's derivative with the coefficients
+/// `c_{P⁻¹}`, added to that with `c_P`. None where an operation does not commute with the
+/// operators or its inverse is not among them.
+pub(crate) fn diagonal<const D: usize>(
+    f: &Gaussian<D>,
+    da: &[Mat<D>],
+    sym: &Symmetry<D>,
+    ops: &Operators<D>,
+) -> Result<Option<Vec<Element>>> {
+    let inverse: Option<Vec<f64>> = sym
+        .iter()
+        .map(|(p, _)| sym.iter().find(|(q, _)| *q == p.transpose()).map(|&(_, c)| c))
+        .collect();
+    let Some(inverse) = inverse.filter(|_| sym.iter().all(|(p, _)| commutes(p, ops))) else {
+        return Ok(None);
+    };
+    let mut own = Images::new(vec![f.clone()], sym, &())?;
+    let isa = build::best_isa();
+    let bra = pecg_gradient::row_gradient(f, da, &pecg_gradient::Kets::new(&own, isa), ops);
+    own.coef = inverse;
+    let ket = pecg_gradient::row_gradient(f, da, &pecg_gradient::Kets::new(&own, isa), ops);
+    let at = |m: &Matrices, r: usize| Element { s: m.s[r], t: m.t[r], t_ti: m.t_ti[r], v: m.v[r] };
+    Ok(Some(
+        (0..bra.rows)
+            .map(|r| {
+                let mut e = at(&bra, r);
+                if r > 0 {
+                    e += (1.0, at(&ket, r));
+                }
+                e
+            })
+            .collect(),
+    ))
 }
