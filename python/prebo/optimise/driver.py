@@ -37,8 +37,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
              resume: dict | None = None) -> Basis:
     """Optimise a basis of `opts.kind` for the state of `system`: with the adaptive schedule
     (schedule.py), growth to `opts.size` and refinement, replacement and joint passes chosen by
-    the energy each gains per second until the basis is exhausted; with a fixed one, growth to
-    `opts.size` by competitive selection, then `opts.cycles` times `opts.sweeps` random
+    the energy each gains per second until the basis has converged or is exhausted; with a fixed
+    one, growth to `opts.size` by competitive selection, then `opts.cycles` times `opts.sweeps` random
     replacement sweeps, `opts.refine` refinement sweeps and `opts.polish` joint steps
     (methods.py). Either stops after `opts.budget` seconds. Settings left at None are chosen
     for the system first (defaults.resolved).

@@ -44,7 +44,7 @@ GROWTH = 8
 CHUNK = 50
 #: exhausted below this share of the reference gain per second (module docstring)
 RATIO = 0.02
-#: the default tolerance relative to |E|: a sweep that gains less has exhausted the basis
+#: the default tolerance relative to |E|: a sweep that gains less has converged
 TOLERANCE = 1e-10
 #: the kinds of pass that improve a basis of fixed size, in the order they are first tried
 IMPROVE = ("refine", "sweep", "polish")
@@ -82,7 +82,7 @@ class Adaptive:
         return Cursor(kind, index=self.next.get(kind, 0) % max(nb, 1), cycle=number)
 
     def tolerance(self, energy: float) -> float:
-        """The gain (Eh) of a whole sweep below which the basis counts as exhausted."""
+        """The gain (Eh) of a whole sweep below which the basis counts as converged."""
         return self.opts.tolerance if self.opts.tolerance is not None else TOLERANCE * abs(energy)
 
     def advance(self, cursor: Cursor, nb: int, energy: float, now: float) -> Cursor:
@@ -110,6 +110,10 @@ class Adaptive:
         """Energy gained per second by pass `p`."""
         return self.gain(p) / max(p[5] - p[4], 1e-3)
 
+    def best(self, last: dict) -> float:
+        """The best rate among the last passes `last` of the kinds that improve a basis."""
+        return max(self.rate(last[k]) for k in IMPROVE)
+
     def advantage(self, nb: int) -> float | None:
         """The reference rate (module docstring) over the best last rate of a kind of pass, at full
         size `nb`; None while the basis grows, before every kind has run or when none gains."""
@@ -121,7 +125,7 @@ class Adaptive:
             reference = self.rate(grow)
         else:
             reference = max((self.rate(p) for p in self.passes if p[0] in IMPROVE and p[1] == nb), default=0.0)
-        best = max(self.rate(last[k]) for k in IMPROVE)
+        best = self.best(last)
         return reference / best if best > 0 else None
 
     def stop(self, last: dict, nb: int, energy: float, now: float) -> str | None:
@@ -132,7 +136,7 @@ class Adaptive:
             return "converged"
         if self.opts.budget is not None:
             left = self.opts.budget - now
-            return "converged" if max(self.rate(last[k]) for k in IMPROVE) * left < tolerance else None
+            return "converged" if self.best(last) * left < tolerance else None
         advantage = self.advantage(nb)
         return "exhausted" if advantage is not None and advantage > 1 / RATIO else None
 

@@ -47,7 +47,7 @@ SETTINGS = {
     "cycles": Setting(Automatic(Integer(1)), "repetitions of the sweep-refine-polish block", "[optimiser] cycles"),
     "budget": Setting(Automatic(Real(0.0)), "wall-time budget of the run in seconds", "[optimiser] budget"),
     "tolerance": Setting(Automatic(Real(0.0)), "energy gain (Eh) below which a pass over the basis counts as "
-                         "exhausted (adaptive schedule)", "[optimiser] tolerance"),
+                         "converged (adaptive schedule)", "[optimiser] tolerance"),
     "learned": Setting(Real(0.0, 1.0, True, True), "share of trials from the learned distributions",
                        "[optimiser] learned"),
     "learn_after": Setting(Integer(1), "functions of a channel before its distribution is learned",
