@@ -16,7 +16,8 @@ use crate::ecg::Element;
 use crate::error::Result;
 use crate::family::{Params, Symmetry};
 use crate::gvr::{EcgGvr, Gvr, GvrOps};
-use crate::gvr_kernel::{integral_partials, symmetrised, Pairs, Prepared, Table};
+use crate::gvr_gradient::{self, Grad, Series};
+use crate::gvr_kernel::{symmetrised, Pairs, Prepared, Table};
 use crate::images::Images;
 use crate::matrices::Matrices;
 use crate::path;
@@ -45,6 +46,7 @@ macro_rules! isa_kernels {
             }
 
             /// Safety: as `element`.
+            #[cfg(test)]
             $(#[target_feature(enable = $feature)])?
             pub(super) unsafe fn partials(
                 c: (&[f64], &[f64]),
@@ -54,7 +56,20 @@ macro_rules! isa_kernels {
                 inputs: &[[f64; 5]],
                 out: &mut [(f64, [f64; 5])],
             ) {
-                integral_partials::<$w>(c, k, tau2, weight, inputs, out)
+                crate::gvr_kernel::integral_partials::<$w>(c, k, tau2, weight, inputs, out)
+            }
+
+            /// Safety: as `element`.
+            $(#[target_feature(enable = $feature)])?
+            pub(super) unsafe fn gradient<const D: usize>(
+                bra: &Prepared<D>,
+                images: &[Prepared<D>],
+                coef: &[f64],
+                series: &Series,
+                lambda: &[[f64; D]; D],
+                go: &GvrOps<D>,
+            ) -> ([f64; 4], [Grad<D>; 4]) {
+                gvr_gradient::symmetrised::<D, $w>(bra, images, coef, series, lambda, go)
             }
         }
     };
@@ -81,8 +96,36 @@ fn kernel<const D: usize>(isa: Isa) -> ElementFn<D> {
     plain::element::<D>
 }
 
+/// The values `[S, T, T_TI, V]` of one trial against the images of one function and their
+/// gradients (`gvr_gradient::symmetrised`).
+pub(crate) type GradientFn<const D: usize> =
+    unsafe fn(&Prepared<D>, &[Prepared<D>], &[f64], &Series, &[[f64; D]; D], &GvrOps<D>) -> ([f64; 4], [Grad<D>; 4]);
+
+/// The row-gradient kernel on the best instruction set (`build::best_isa`, read once per process).
+pub(crate) fn gradient_kernel<const D: usize>() -> GradientFn<D> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let isa = best();
+        if isa == Isa::Avx512 && std::arch::is_x86_feature_detected!("avx512f") {
+            return avx512::gradient::<D>;
+        }
+        if isa == Isa::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            return avx2::gradient::<D>;
+        }
+    }
+    plain::gradient::<D>
+}
+
+/// `build::best_isa`, read once per process.
+fn best() -> Isa {
+    static ISA: std::sync::OnceLock<Isa> = std::sync::OnceLock::new();
+    *ISA.get_or_init(crate::build::best_isa)
+}
+
 /// The Coulomb τ-integrals with their partial derivatives (`gvr_kernel::integral_partials`) for
-/// each of `inputs`, on the best instruction set (`build::best_isa`, read once per process).
+/// each of `inputs`, on the best instruction set (`build::best_isa`, read once per process): the
+/// tests' entry point (the row gradient calls them inside its kernel).
+#[cfg(test)]
 pub(crate) fn partials(
     c: (&[f64], &[f64]),
     k: (u32, u32, u32),
@@ -91,11 +134,11 @@ pub(crate) fn partials(
     inputs: &[[f64; 5]],
     out: &mut [(f64, [f64; 5])],
 ) {
-    static ISA: std::sync::OnceLock<Isa> = std::sync::OnceLock::new();
-    partials_with(*ISA.get_or_init(crate::build::best_isa), c, k, tau2, weight, inputs, out)
+    partials_with(best(), c, k, tau2, weight, inputs, out)
 }
 
 /// `partials` on a chosen instruction set (plain code where this CPU lacks it).
+#[cfg(test)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn partials_with(
     isa: Isa,
@@ -123,14 +166,14 @@ pub(crate) fn partials_with(
 }
 
 /// Functions with their images, prepared for the kernel.
-struct Side<const D: usize> {
-    functions: Vec<Prepared<D>>,
-    images: Vec<Vec<Prepared<D>>>,
-    coef: Vec<f64>,
+pub(crate) struct Side<const D: usize> {
+    pub(crate) functions: Vec<Prepared<D>>,
+    pub(crate) images: Vec<Vec<Prepared<D>>>,
+    pub(crate) coef: Vec<f64>,
 }
 
 impl<const D: usize> Side<D> {
-    fn new(go: &GvrOps<D>, sym: &Symmetry<D>, p: &Params) -> Result<Self> {
+    pub(crate) fn new(go: &GvrOps<D>, sym: &Symmetry<D>, p: &Params) -> Result<Self> {
         let f: Images<Gvr<D>> = path::images::<D, EcgGvr>(go, sym, p)?;
         let prep = |g: &Gvr<D>| Prepared::new(g, &go.ops);
         Ok(Self {

@@ -30,20 +30,45 @@
 //!   `γ = g·w/√(2c)` gives `ḡ += γ̄ w/√(2c)`, and `c = wᵀMw`, `dc = −(Mw)ᵀdA(Mw)`, with
 //!   `c̄ = −s 2q/√(πc) Q/(2c) − (γ̄_Iγ_I + γ̄_Jγ_J)/(2c)`.
 //!
-//! The trial's diagonal (both sides move) stays on the dual-number path (one element).
+//! The algebra of one image runs on [`MAX_LANES`] symmetry images of a ket at once, structure of
+//! arrays (`lanes`, as `gvr_kernel::elements`; each lane with the bits of the one-image path),
+//! compiled per instruction set (`gvr_build::gradient_kernel`). The trial's diagonal (both sides
+//! move) stays on the dual-number path (one element).
 use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
 use crate::cache::Cache;
-use crate::ecg::{inverse_log_det, mul, Element, Mat, Vector};
+use crate::ecg::{Element, Mat, Vector};
 use crate::error::Result;
 use crate::family::{check, matrices_of, Directions, Family, Params, Symmetry};
-use crate::gvr::{omega, series_coefficients, Coefficients, EcgGvr, Gvr, GvrOps};
-use crate::gvr_build;
-use crate::gvr_kernel::{derivative_series, padded_rule, MAX_PAIRS};
+use crate::gvr::{series_coefficients, Coefficients, EcgGvr, Gvr, GvrOps};
+use crate::gvr_build::{self, Side};
+use crate::gvr_kernel::{self as kernel, derivative_series, dot, integral_partials, inverse_log_det, mat_vec, padded_rule, Ket, Prepared, MAX_LANES, MAX_PAIRS};
+use crate::lanes::{array as vector, matrix, Lane, Lanes};
 use crate::matrices::Matrices;
 use crate::path;
+
+type V<T, const D: usize> = [T; D];
+type M<T, const D: usize> = [[T; D]; D];
+
+/// `Σ_k f(k)`, summed from `k = 0`.
+#[inline(always)]
+fn sum<T: Lane, const D: usize>(f: impl Fn(usize) -> T) -> T {
+    (0..D).fold(T::splat(0.0), |acc, k| acc + f(k))
+}
+
+/// `P Q`.
+#[inline(always)]
+fn mat_mul<T: Lane, const D: usize>(p: &M<T, D>, q: &M<T, D>) -> M<T, D> {
+    matrix(|i, j| sum::<T, D>(|k| p[i][k] * q[k][j]))
+}
+
+/// `Pᵀ v`.
+#[inline(always)]
+fn tr_mul<T: Lane, const D: usize>(p: &M<T, D>, v: &V<T, D>) -> V<T, D> {
+    vector(|i| sum::<T, D>(|k| p[k][i] * v[k]))
+}
 
 /// The gradient of one output with respect to the bra: `dO = ⟨G, dA⟩ + g·du` (without `dn_I`).
 #[derive(Clone, Copy, Debug)]
@@ -57,43 +82,45 @@ impl<const D: usize> Grad<D> {
         Self { a: Mat::zeros(), u: Vector::zeros() }
     }
 
-    fn nan() -> Self {
-        Self { a: Mat::repeat(f64::NAN), u: Vector::repeat(f64::NAN) }
-    }
-
-    fn add_scaled(&mut self, c: f64, o: &Self) {
-        self.a += o.a * c;
-        self.u += o.u * c;
-    }
-
     fn along(&self, da: &Mat<D>, du: &Vector<D>) -> f64 {
         self.a.dot(da) + self.u.dot(du)
     }
 }
 
-/// The adjoints of one output of one image: `x̄, ȳ, z̄`, the explicit `Ḡ, ū`, and `ḡ_I, ḡ_J`.
+/// `Grad` of `T::L` images in lanes.
 #[derive(Clone, Copy)]
-struct Adjoint<const D: usize> {
-    xyz: [f64; 3],
-    a: Mat<D>,
-    u: Vector<D>,
-    gi: Vector<D>,
-    gj: Vector<D>,
+struct Gradient<T, const D: usize> {
+    a: M<T, D>,
+    u: V<T, D>,
 }
 
-impl<const D: usize> Adjoint<D> {
-    fn of_xyz(xyz: [f64; 3]) -> Self {
-        Self { xyz, a: Mat::zeros(), u: Vector::zeros(), gi: Vector::zeros(), gj: Vector::zeros() }
+/// The adjoints of one output of one image: `x̄, ȳ, z̄`, the explicit `Ḡ, ū`, and `ḡ_I, ḡ_J`.
+#[derive(Clone, Copy)]
+struct Adjoint<T, const D: usize> {
+    xyz: [T; 3],
+    a: M<T, D>,
+    u: V<T, D>,
+    gi: V<T, D>,
+    gj: V<T, D>,
+}
+
+impl<T: Lane, const D: usize> Adjoint<T, D> {
+    fn of_xyz(xyz: [T; 3]) -> Self {
+        let zero = T::splat(0.0);
+        Self { xyz, a: [[zero; D]; D], u: [zero; D], gi: [zero; D], gj: [zero; D] }
     }
 }
 
-/// The pair's series: `ĉ_k` for the Hessian and the Coulomb quadrature (with G''s),
-/// `Coefficients` for `gvr::omega`, and the quadrature's padded rule (`gvr_kernel::padded_rule`).
+/// The pair's series: Ω's (`Coefficients`), its second derivatives' (`hessian`), and the
+/// Coulomb quadrature's `ĉ_k`, `(k+1) ĉ_{k+1}` and padded rule (`gvr_kernel::padded_rule`).
 pub(crate) struct Series {
     coef: Coefficients,
     c: Vec<f64>,
     /// `(k+1) ĉ_{k+1}`, the series of G' (`gvr_kernel::derivative_series`)
     dc: Vec<f64>,
+    /// `ĉ_k f(K_I−k, K_J−k, N+2k)` from `k = k_0` for the six second derivatives (`hessian`),
+    /// with the power of ρ that multiplies each sum
+    h: [(Vec<f64>, u32); 6],
     ki: u32,
     kj: u32,
     n: u32,
@@ -106,39 +133,51 @@ impl Series {
         let (tau2, weight) = padded_rule(go.rule(ki + kj + go.n_ang));
         let (coef, c) = (Coefficients::new(ki, kj, go.n_ang), series_coefficients(go, ki, kj));
         let dc = derivative_series(&c);
-        Self { coef, c, dc, ki, kj, n: go.n_ang, tau2, weight }
+        let n = go.n_ang;
+        // `l` = the derivatives in z; a term of negative power has f = 0 (n < l), so the sum
+        // starts at k = 1 when N < l
+        let moment = |l: u32, f: fn(f64, f64, f64) -> f64| {
+            let k0 = usize::from(n < l);
+            let terms = c.iter().enumerate().skip(k0).map(|(k, ck)| {
+                let k = k as f64;
+                ck * f(ki as f64 - k, kj as f64 - k, n as f64 + 2.0 * k)
+            });
+            (terms.collect(), n + 2 * k0 as u32 - l)
+        };
+        let h = [
+            moment(0, |a, _, _| a * (a - 1.0)),
+            moment(0, |a, b, _| a * b),
+            moment(0, |_, b, _| b * (b - 1.0)),
+            moment(1, |a, _, m| a * m),
+            moment(1, |_, b, m| b * m),
+            moment(2, |_, _, m| m * (m - 1.0)),
+        ];
+        Self { coef, c, dc, h, ki, kj, n, tau2, weight }
+    }
+
+    /// The series as the kernel's `gvr_kernel::omega` takes it.
+    fn kernel(&self) -> kernel::Series<'_> {
+        let s = &self.coef;
+        let (c, cx, cy, cz) = (&s.c[..], &s.cx[..], &s.cy[..], &s.cz[..]);
+        kernel::Series { ki: self.ki, kj: self.kj, n: self.n, c, cx, cy, cz, tau2: &self.tau2, weight: &self.weight }
     }
 
     /// `e^{-L}` times Ω's second derivatives, `[ω_xx, ω_xy, ω_yy, ω_xz, ω_yz, ω_zz]`: from
     /// `Ω = Σ ĉ_k x^{a} y^{b} z^{n}` (`a = K_I−k`, `b = K_J−k`, `n = N+2k`),
     /// `e^{-L} x^{a−i} y^{b−j} z^{n−l} = ρ^{n−l} x^{−i} y^{−j} (xy)^{−l/2}`.
-    fn hessian(&self, x: f64, y: f64, z: f64) -> [f64; 6] {
-        let rt = (x * y).sqrt();
-        let rho = (z / rt).clamp(-1.0, 1.0);
+    #[inline(always)]
+    fn hessian<T: Lane>(&self, x: T, y: T, z: T) -> [T; 6] {
+        let rt = (x * y).map(f64::sqrt);
+        let rho = (z / rt).map(|v| v.clamp(-1.0, 1.0));
         let r = rho * rho;
-        let (ki, kj, n) = (self.ki as f64, self.kj as f64, self.n);
-        // Σ_k f(a, b, n) ĉ_k ρ^{n−l}; a term of negative power has f = 0 (n < l), so the sum
-        // starts at k = 1 when N < l
-        let sum = |l: u32, f: &dyn Fn(f64, f64, f64) -> f64| {
-            let k0 = usize::from(n < l);
-            let h = self.c.iter().enumerate().skip(k0).rev().fold(0.0, |acc, (k, ck)| {
-                let k = k as f64;
-                acc * r + ck * f(ki - k, kj - k, n as f64 + 2.0 * k)
-            });
-            h * rho.powi((n + 2 * k0 as u32 - l) as i32)
-        };
-        let sxx = sum(0, &|a, _, _| a * (a - 1.0));
-        let sxy = sum(0, &|a, b, _| a * b);
-        let syy = sum(0, &|_, b, _| b * (b - 1.0));
-        let sxz = sum(1, &|a, _, m| a * m);
-        let syz = sum(1, &|_, b, m| b * m);
-        let szz = sum(2, &|_, _, m| m * (m - 1.0));
-        [sxx / (x * x), sxy / (x * y), syy / (y * y), sxz / (x * rt), syz / (y * rt), szz / (x * y)]
+        let s: [T; 6] = vector(|k| kernel::horner(&self.h[k].0, r) * kernel::power(rho, self.h[k].1));
+        [s[0] / (x * x), s[1] / (x * y), s[2] / (y * y), s[3] / (x * rt), s[4] / (y * rt), s[5] / (x * y)]
     }
 }
 
 /// `s (c_Ω ∇ω + c_x ∇ω_x + c_y ∇ω_y + c_z ∇ω_z)` for `∇ = (∂_x, ∂_y, ∂_z)`.
-fn xyz_bar(c: [f64; 4], first: [f64; 3], h: &[f64; 6], s: f64) -> [f64; 3] {
+#[inline(always)]
+fn xyz_bar<T: Lane>(c: [T; 4], first: [T; 3], h: &[T; 6], s: T) -> [T; 3] {
     let [xx, xy, yy, xz, yz, zz] = *h;
     [
         s * (c[0] * first[0] + c[1] * xx + c[2] * xy + c[3] * xz),
@@ -147,52 +186,52 @@ fn xyz_bar(c: [f64; 4], first: [f64; 3], h: &[f64; 6], s: f64) -> [f64; 3] {
     ]
 }
 
-/// `u vᵀ`.
-#[inline]
-fn outer<const D: usize>(u: &Vector<D>, v: &Vector<D>) -> Mat<D> {
-    Mat::from_fn(|i, j| u[i] * v[j])
-}
-
-/// The values `[S, T, T_TI, V]` of one (bra, image) pair and their gradients (module docs).
-fn image<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, ser: &Series) -> ([f64; 4], [Grad<D>; 4]) {
-    let ops = &go.ops;
-    let Some((m, log_det)) = inverse_log_det(&(bra.a + ket.a)) else {
-        return ([f64::NAN; 4], [Grad::nan(); 4]);
-    };
-    let (ui, uj) = (&bra.u, &ket.u);
-    let gi = mul(&m, ui);
-    let gj = mul(&m, uj);
-    let x = ui.dot(&gi) * 0.5;
-    let y = uj.dot(&gj) * 0.5;
-    let z = ui.dot(&gj) * 0.5;
+/// The values `[S, T, T_TI, V]` of the bra against `T::L` images of one ket and their gradients
+/// (module docs); `None` where some `A_I + A_J` is not positive definite.
+#[inline(always)]
+fn images<const D: usize, const W: usize, T: Lane>(
+    bra: &Prepared<D>,
+    kets: &[Prepared<D>],
+    ser: &Series,
+    lambda: &M<f64, D>,
+    go: &GvrOps<D>,
+) -> Option<([T; 4], [Gradient<T, D>; 4])> {
+    let ket = Ket::<T, D>::new(kets);
+    let splat = |m: &M<f64, D>| matrix(|i, j| T::splat(m[i][j]));
+    let (a_i, ui): (M<T, D>, V<T, D>) = (splat(&bra.a), vector(|i| T::splat(bra.u[i])));
+    let uj = &ket.u;
+    let (m, log_det) = inverse_log_det(&matrix(|i, j| a_i[i][j] + ket.a[i][j]))?;
+    let gi = mat_vec(&m, &ui);
+    let gj = mat_vec(&m, uj);
+    let x = dot(&ui, &gi) * 0.5;
+    let y = dot(uj, &gj) * 0.5;
+    let z = dot(&ui, &gj) * 0.5;
     let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
-    let (l, om, ox, oy, oz) = omega(&ser.coef, x, y, z);
-    let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
+    let (l, om, ox, oy, oz) = kernel::omega(&ser.kernel(), x, y, z);
+    let scale = (log_s0 + l - bra.log_norm - ket.log_norm).map(f64::exp);
     let hess = ser.hessian(x, y, z);
     let first = [ox, oy, oz];
     let s = scale * om;
 
     // kinetic (gvr::element): T/scale = λ ω_z − 4 p2 ω_x − 2 p3 ω_z − 4 p4 ω_y − 2 p5 ω_z
     //                                    + 12 tr ω + 8 p7 ω_x + 4 p8 ω_z + 8 p9 ω_y
-    let lam = &ops.lambda;
-    let lam_ui = mul(lam, ui);
-    let lam_uj = mul(lam, uj);
-    let zl = mul(&ket.a, &lam_ui); // A_J Λ u_I
-    let zr = mul(&bra.a, &lam_uj); // A_I Λ u_J
-    let lam_aj = mul(lam, &ket.a); // Λ A_J
-    let w = mul(&bra.a, &lam_aj); // W = A_I Λ A_J
-    let tr = m.component_mul(&w.transpose()).sum() * 0.5;
-    let (hi, hj) = (gi * 0.5, gj * 0.5);
-    let (w_hi, w_hj) = (mul(&w, &hi), mul(&w, &hj));
+    let lam_uj = &ket.lambda_u;
+    let zl = mat_vec(&ket.a, &vector(|i| T::splat(bra.lambda_u[i]))); // A_J Λ u_I
+    let zr = mat_vec(&a_i, lam_uj); // A_I Λ u_J
+    let lam_aj = matrix(|i, j| T::from_lanes(|l| kets[l].a_lambda[j][i])); // Λ A_J = (A_J Λ)ᵀ
+    let w = mat_mul(&splat(&bra.a_lambda), &ket.a); // W = A_I Λ A_J
+    let tr = sum::<T, D>(|a| sum::<T, D>(|b| m[a][b] * w[b][a])) * 0.5;
+    let (hi, hj): (V<T, D>, V<T, D>) = (vector(|k| gi[k] * 0.5), vector(|k| gj[k] * 0.5));
+    let (w_hi, w_hj) = (mat_vec(&w, &hi), mat_vec(&w, &hj));
     let p = [
-        ui.dot(&lam_uj),
-        zl.dot(&hi),
-        zl.dot(&hj),
-        zr.dot(&hj),
-        zr.dot(&hi),
-        hi.dot(&w_hi),
-        hi.dot(&w_hj) + hj.dot(&w_hi),
-        hj.dot(&w_hj),
+        dot(&ui, lam_uj),
+        dot(&zl, &hi),
+        dot(&zl, &hj),
+        dot(&zr, &hj),
+        dot(&zr, &hi),
+        dot(&hi, &w_hi),
+        dot(&hi, &w_hj) + dot(&hj, &w_hi),
+        dot(&hj, &w_hj),
     ];
     let t = p[0] * oz - p[1] * 4.0 * ox - p[2] * 2.0 * oz - p[3] * 4.0 * oy - p[4] * 2.0 * oz
         + tr * 12.0 * om
@@ -200,134 +239,200 @@ fn image<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, ser: &Serie
         + p[6] * 4.0 * oz
         + p[7] * 8.0 * oy;
     let t = scale * t;
-    let c_t = [12.0 * tr, 8.0 * p[5] - 4.0 * p[1], 8.0 * p[7] - 4.0 * p[3], p[0] - 2.0 * p[2] - 2.0 * p[4] + 4.0 * p[6]];
-    let kin = kinetic(ket, lam, &m, &gi, &gj, [scale * om, scale * ox, scale * oy, scale * oz], (&lam_uj, &zl, &zr, &lam_aj, &w));
+    let c_t = [tr * 12.0, p[5] * 8.0 - p[1] * 4.0, p[7] * 8.0 - p[3] * 4.0, p[0] - p[2] * 2.0 - p[4] * 2.0 + p[6] * 4.0];
+    let sw = [scale * om, scale * ox, scale * oy, scale * oz];
+    let kin = kinetic(&ket.a, &splat(lambda), &m, &gi, &gj, sw, (lam_uj, &zl, &zr, &lam_aj, &w));
     let mut adj_t = kin;
     adj_t.xyz = xyz_bar(c_t, first, &hess, scale);
 
     // T_TI = T − T_cm: T_cm/scale = Σ c_cm · (ω, ω_x, ω_y, ω_z) (gvr::cm_kinetic)
-    let (t_ti, adj_ti) = match ops.cm_mass {
+    let (t_ti, adj_ti) = match go.ops.cm_mass {
         Some(mt) => {
-            let (ci, cj, cui, cuj) = (bra.c_a, ket.c_a, bra.c_u, ket.c_u);
-            let (ms, ms2) = (mt * (ci + cj), mt * (ci + cj) * (ci + cj));
+            let (ci, cj, cui, cuj) = (T::splat(bra.c_a), ket.c_a, T::splat(bra.c_u), ket.c_u);
+            let (ms, ms2) = ((ci + cj) * mt, (ci + cj) * mt * (ci + cj));
             let (fx, fy) = (ci * cj / ms2 - cj / ms, ci * cj / ms2 - ci / ms);
-            let c_cm = [3.0 * ci * cj / ms, cui * cui * fx, cuj * cuj * fy, ci * cj * cui * cuj / ms2];
+            let c_cm = [ci * 3.0 * cj / ms, cui * cui * fx, cuj * cuj * fy, ci * cj * cui * cuj / ms2];
             let t_cm = scale * (c_cm[0] * om + c_cm[1] * ox + c_cm[2] * oy + c_cm[3] * oz);
             let mut adj = kin;
-            adj.xyz = xyz_bar(std::array::from_fn(|k| c_t[k] - c_cm[k]), first, &hess, scale);
-            let cui_bar = scale * (ox * 2.0 * cui * fx + oz * ci * cj * cuj / ms2);
-            adj.u.add_scalar_mut(-cui_bar);
+            adj.xyz = xyz_bar(vector(|k| c_t[k] - c_cm[k]), first, &hess, scale);
+            let cui_bar = scale * (ox * cui * 2.0 * fx + oz * ci * cj * cuj / ms2);
+            adj.u = vector(|k| adj.u[k] - cui_bar);
             (t - t_cm, adj)
         }
         None => (t, adj_t),
     };
 
-    let (v, adj_v) = coulomb(go, ser, &m, &gi, &gj, [x, y, z], scale);
-    let adj_s = Adjoint::of_xyz(xyz_bar([1.0, 0.0, 0.0, 0.0], first, &hess, scale));
+    let (v, adj_v) = coulomb::<D, W, T>(go, ser, &m, &gi, &gj, [x, y, z], scale);
+    let one = T::splat(1.0);
+    let zero = T::splat(0.0);
+    let adj_s = Adjoint::of_xyz(xyz_bar([one, zero, zero, zero], first, &hess, scale));
     let values = [s, t, t_ti, v];
     let adjs = [adj_s, adj_t, adj_ti, adj_v];
-    let grads = std::array::from_fn(|o| fold(&adjs[o], values[o], &m, ui, uj, &gi, &gj));
-    (values, grads)
+    let fold = |o: usize| fold(&adjs[o], values[o], &m, &ui, uj, &gi, &gj);
+    Some((values, [fold(0), fold(1), fold(2), fold(3)]))
 }
+
+/// `(Λu_J, A_JΛu_I, A_IΛu_J, ΛA_J, A_IΛA_J)` of one image (lanes).
+type KineticTerms<'a, T, const D: usize> = (&'a V<T, D>, &'a V<T, D>, &'a V<T, D>, &'a M<T, D>, &'a M<T, D>);
 
 /// The explicit and `g`-adjoints of the kinetic scalars `p` (shared by `T` and `T_TI`) for
 /// `sw = s [ω, ω_x, ω_y, ω_z]`; `xyz` left zero (module docs).
-fn kinetic<const D: usize>(
-    ket: &Gvr<D>,
-    lam: &Mat<D>,
-    m: &Mat<D>,
-    gi: &Vector<D>,
-    gj: &Vector<D>,
-    sw: [f64; 4],
-    (lam_uj, zl, zr, lam_aj, w): (&Vector<D>, &Vector<D>, &Vector<D>, &Mat<D>, &Mat<D>),
-) -> Adjoint<D> {
+#[inline(always)]
+fn kinetic<T: Lane, const D: usize>(
+    a_j: &M<T, D>,
+    lam: &M<T, D>,
+    m: &M<T, D>,
+    gi: &V<T, D>,
+    gj: &V<T, D>,
+    sw: [T; 4],
+    (lam_uj, zl, zr, lam_aj, w): KineticTerms<T, D>,
+) -> Adjoint<T, D> {
     let [s0, sx, sy, sz] = sw;
     // adjoints of λ, p2 .. p9 and tr
-    let (b_lam, b2, b3, b4, b5) = (sz, -4.0 * sx, -2.0 * sz, -4.0 * sy, -2.0 * sz);
-    let (b7, b8, b9, b_tr) = (8.0 * sx, 4.0 * sz, 8.0 * sy, 12.0 * s0);
-    let ai = mul(lam_aj, gi); // Λ A_J g_I
-    let aj = mul(lam_aj, gj);
-    let (w_gi, w_gj) = (mul(w, gi), mul(w, gj));
-    let (wt_gi, wt_gj) = (w.tr_mul(gi), w.tr_mul(gj));
-    let (sym_i, sym_j) = (w_gi + wt_gi, w_gj + wt_gj); // (W + Wᵀ) g
-    let u = lam_uj * b_lam + (ai * b2 + aj * b3) * 0.5;
-    let g_i = (zl * b2 + zr * b5) * 0.5 + (sym_i * b7 + sym_j * b8) * 0.25;
-    let g_j = (zl * b3 + zr * b4) * 0.5 + (sym_i * b8 + sym_j * b9) * 0.25;
+    let (b_lam, b2, b3, b4, b5) = (sz, sx * -4.0, sz * -2.0, sy * -4.0, sz * -2.0);
+    let (b7, b8, b9, b_tr) = (sx * 8.0, sz * 4.0, sy * 8.0, s0 * 12.0);
+    let ai = mat_vec(lam_aj, gi); // Λ A_J g_I
+    let aj = mat_vec(lam_aj, gj);
+    let (w_gi, w_gj) = (mat_vec(w, gi), mat_vec(w, gj));
+    let (wt_gi, wt_gj) = (tr_mul(w, gi), tr_mul(w, gj));
+    let sym_i: V<T, D> = vector(|k| w_gi[k] + wt_gi[k]); // (W + Wᵀ) g
+    let sym_j: V<T, D> = vector(|k| w_gj[k] + wt_gj[k]);
+    let u = vector(|k| lam_uj[k] * b_lam + (ai[k] * b2 + aj[k] * b3) * 0.5);
+    let g_i = vector(|k| (zl[k] * b2 + zr[k] * b5) * 0.5 + (sym_i[k] * b7 + sym_j[k] * b8) * 0.25);
+    let g_j = vector(|k| (zl[k] * b3 + zr[k] * b4) * 0.5 + (sym_i[k] * b8 + sym_j[k] * b9) * 0.25);
     // Tr(A_I Λ A_J M)/2: gradient M A_J Λ A_J M / 2 = qᵀ Λ q / 2, q = A_J M
-    let q = mul(&ket.a, m);
-    let a = outer(gi, &(lam_uj * (b5 * 0.5) + (ai * b7 + aj * b8) * 0.25))
-        + outer(gj, &(lam_uj * (b4 * 0.5) + (ai * b8 + aj * b9) * 0.25))
-        + q.tr_mul(&mul(lam, &q)) * (b_tr * 0.5);
-    Adjoint { xyz: [0.0; 3], a, u, gi: g_i, gj: g_j }
+    let q = mat_mul(a_j, m);
+    let lq = mat_mul(lam, &q);
+    let vi: V<T, D> = vector(|k| lam_uj[k] * (b5 * 0.5) + (ai[k] * b7 + aj[k] * b8) * 0.25);
+    let vj: V<T, D> = vector(|k| lam_uj[k] * (b4 * 0.5) + (ai[k] * b8 + aj[k] * b9) * 0.25);
+    let half_tr = b_tr * 0.5;
+    let a = matrix(|r, c| gi[r] * vi[c] + gj[r] * vj[c] + sum::<T, D>(|k| q[k][r] * lq[k][c]) * half_tr);
+    Adjoint { xyz: [T::splat(0.0); 3], a, u, gi: g_i, gj: g_j }
 }
 
-/// `V` of one image and its adjoints (module docs): all pairs in one call of the quadrature
-/// with partials (`gvr_build::partials`, the maths of `gvr::coulomb_partials`).
-#[allow(clippy::too_many_arguments)]
-fn coulomb<const D: usize>(
+/// `V` of `T::L` images and its adjoints (module docs): every pair of every lane in one call of
+/// the quadrature with partials (`gvr_kernel::integral_partials`).
+#[inline(always)]
+fn coulomb<const D: usize, const W: usize, T: Lane>(
     go: &GvrOps<D>,
     ser: &Series,
-    m: &Mat<D>,
-    gi: &Vector<D>,
-    gj: &Vector<D>,
-    [x, y, z]: [f64; 3],
-    scale: f64,
-) -> (f64, Adjoint<D>) {
+    m: &M<T, D>,
+    gi: &V<T, D>,
+    gj: &V<T, D>,
+    [x, y, z]: [T; 3],
+    scale: T,
+) -> (T, Adjoint<T, D>) {
     let pairs = &go.ops.pairs;
     let np = pairs.len();
     assert!(np <= MAX_PAIRS, "at most {MAX_PAIRS} Coulomb pairs");
-    let mut mw = [Vector::<D>::zeros(); MAX_PAIRS];
-    let mut c = [0.0; MAX_PAIRS];
-    let mut inputs = [[0.0; 5]; MAX_PAIRS];
+    let zero = T::splat(0.0);
+    let mut mw = [[zero; D]; MAX_PAIRS];
+    let mut c = [zero; MAX_PAIRS];
+    let mut gam = [[zero; 2]; MAX_PAIRS];
+    let mut inputs = [[0.0; 5]; MAX_LANES * MAX_PAIRS];
     for (k, (w, _)) in pairs.iter().enumerate() {
-        mw[k] = mul(m, w);
-        c[k] = mw[k].dot(w);
-        let sq = (c[k] * 2.0).sqrt();
-        inputs[k] = [x, y, z, gi.dot(w) / sq, gj.dot(w) / sq];
+        mw[k] = vector(|i| sum::<T, D>(|j| m[i][j] * w[j]));
+        c[k] = sum::<T, D>(|i| mw[k][i] * w[i]);
+        let sq = (c[k] * 2.0).map(f64::sqrt);
+        gam[k] = [sum::<T, D>(|i| gi[i] * w[i]) / sq, sum::<T, D>(|i| gj[i] * w[i]) / sq];
+        for l in 0..T::L {
+            inputs[l * np + k] = [x.lane(l), y.lane(l), z.lane(l), gam[k][0].lane(l), gam[k][1].lane(l)];
+        }
     }
-    let mut out = [(0.0, [0.0; 5]); MAX_PAIRS];
-    gvr_build::partials((&ser.c, &ser.dc), (ser.ki, ser.kj, ser.n), &ser.tau2, &ser.weight, &inputs[..np], &mut out[..np]);
-    let mut v = 0.0;
-    let mut adj = Adjoint::of_xyz([0.0; 3]);
-    for k in 0..np {
-        let ((w, q), (f, d), c) = (&pairs[k], &out[k], c[k]);
-        let pref = q * 2.0 / (c * PI).sqrt();
-        v += pref * f;
+    let mut out = [(0.0, [0.0; 5]); MAX_LANES * MAX_PAIRS];
+    let all = T::L * np;
+    integral_partials::<W>((&ser.c, &ser.dc), (ser.ki, ser.kj, ser.n), &ser.tau2, &ser.weight, &inputs[..all], &mut out[..all]);
+    let mut v = zero;
+    let mut adj = Adjoint::of_xyz([zero; 3]);
+    for (k, (w, q)) in pairs.iter().enumerate() {
+        let f = T::from_lanes(|l| out[l * np + k].0);
+        let d: [T; 5] = vector(|t| T::from_lanes(|l| out[l * np + k].1[t]));
+        let pref = T::splat(q * 2.0) / (c[k] * PI).map(f64::sqrt);
+        v = v + pref * f;
         let sp = scale * pref;
-        adj.xyz[0] += sp * d[0];
-        adj.xyz[1] += sp * d[1];
-        adj.xyz[2] += sp * d[2];
-        let sq = (c * 2.0).sqrt();
+        adj.xyz = vector(|t| adj.xyz[t] + sp * d[t]);
+        let sq = (c[k] * 2.0).map(f64::sqrt);
         let (bgi, bgj) = (sp * d[3], sp * d[4]);
-        adj.gi += w * (bgi / sq);
-        adj.gj += w * (bgj / sq);
-        let c_bar = -(sp * f + bgi * inputs[k][3] + bgj * inputs[k][4]) / (2.0 * c);
-        adj.a -= outer(&mw[k], &mw[k]) * c_bar;
+        let (bi, bj) = (bgi / sq, bgj / sq);
+        adj.gi = vector(|i| adj.gi[i] + bi * w[i]);
+        adj.gj = vector(|i| adj.gj[i] + bj * w[i]);
+        let c_bar = -(sp * f + bgi * gam[k][0] + bgj * gam[k][1]) / (c[k] * 2.0);
+        adj.a = matrix(|i, j| adj.a[i][j] - mw[k][i] * mw[k][j] * c_bar);
     }
     let v = scale * v;
     let half_n = 0.5 * go.n_ang as f64;
-    adj.xyz[0] += v * (ser.ki as f64 + half_n) / x;
-    adj.xyz[1] += v * (ser.kj as f64 + half_n) / y;
+    adj.xyz[0] = adj.xyz[0] + v * (ser.ki as f64 + half_n) / x;
+    adj.xyz[1] = adj.xyz[1] + v * (ser.kj as f64 + half_n) / y;
     (v, adj)
 }
 
 /// `(G_O, g_O)` of one output of value `o` from its adjoints (module docs).
-fn fold<const D: usize>(
-    adj: &Adjoint<D>,
-    o: f64,
-    m: &Mat<D>,
-    ui: &Vector<D>,
-    uj: &Vector<D>,
-    gi: &Vector<D>,
-    gj: &Vector<D>,
-) -> Grad<D> {
+#[inline(always)]
+fn fold<T: Lane, const D: usize>(
+    adj: &Adjoint<T, D>,
+    o: T,
+    m: &M<T, D>,
+    ui: &V<T, D>,
+    uj: &V<T, D>,
+    gi: &V<T, D>,
+    gj: &V<T, D>,
+) -> Gradient<T, D> {
     let [xb, yb, zb] = adj.xyz;
-    let m_gi = mul(m, &(adj.gi + ui * (0.5 * xb)));
-    let m_gj = mul(m, &(adj.gj + uj * (0.5 * yb) + ui * (0.5 * zb)));
-    Grad {
-        a: adj.a + m * (-1.5 * o) - outer(&m_gi, gi) - outer(&m_gj, gj),
-        u: adj.u + gi * (0.5 * xb) + gj * (0.5 * zb) + m_gi,
+    let m_gi = mat_vec(m, &vector(|k| adj.gi[k] + ui[k] * (xb * 0.5)));
+    let m_gj = mat_vec(m, &vector(|k| adj.gj[k] + uj[k] * (yb * 0.5) + ui[k] * (zb * 0.5)));
+    let om = o * -1.5;
+    Gradient {
+        a: matrix(|i, j| adj.a[i][j] + m[i][j] * om - m_gi[i] * gi[j] - m_gj[i] * gj[j]),
+        u: vector(|k| adj.u[k] + gi[k] * (xb * 0.5) + gj[k] * (zb * 0.5) + m_gi[k]),
     }
+}
+
+/// Adds `c_P` times each lane (image `P`) of `(values, grads)` to `(o, g)`, in lane order.
+#[inline(always)]
+fn accumulate<T: Lane, const D: usize>(
+    (o, g): (&mut [f64; 4], &mut [Grad<D>; 4]),
+    (values, grads): &([T; 4], [Gradient<T, D>; 4]),
+    coef: &[f64],
+) {
+    for (l, c) in coef.iter().enumerate().take(T::L) {
+        for k in 0..4 {
+            o[k] += values[k].lane(l) * c;
+            g[k].a += Mat::from_fn(|i, j| grads[k].a[i][j].lane(l) * c);
+            g[k].u += Vector::from_fn(|i, _| grads[k].u[i].lane(l) * c);
+        }
+    }
+}
+
+/// `Σ_P c_P` of the values and gradients of the bra against every image of one ket:
+/// [`MAX_LANES`] images at a time in lanes (one by one where a lane's `A_I + A_J` is not positive
+/// definite, giving NaN for that image), the rest one by one, summed in the order of the images.
+#[inline(always)]
+pub(crate) fn symmetrised<const D: usize, const W: usize>(
+    bra: &Prepared<D>,
+    kets: &[Prepared<D>],
+    coef: &[f64],
+    ser: &Series,
+    lambda: &M<f64, D>,
+    go: &GvrOps<D>,
+) -> ([f64; 4], [Grad<D>; 4]) {
+    let mut o = [0.0; 4];
+    let mut g = [Grad::zero(); 4];
+    let one_by_one = |(o, g): (&mut [f64; 4], &mut [Grad<D>; 4]), kets: &[Prepared<D>], coef: &[f64]| {
+        for (ket, c) in kets.iter().zip(coef) {
+            let nan = || ([f64::NAN; 4], [Gradient { a: [[f64::NAN; D]; D], u: [f64::NAN; D] }; 4]);
+            let image = images::<D, W, f64>(bra, std::slice::from_ref(ket), ser, lambda, go).unwrap_or_else(nan);
+            accumulate((o, g), &image, std::slice::from_ref(c));
+        }
+    };
+    let whole = kets.len() / MAX_LANES * MAX_LANES;
+    for (kets, c) in kets[..whole].chunks_exact(MAX_LANES).zip(coef.chunks_exact(MAX_LANES)) {
+        match images::<D, W, Lanes<MAX_LANES>>(bra, kets, ser, lambda, go) {
+            Some(image) => accumulate((&mut o, &mut g), &image, c),
+            None => one_by_one((&mut o, &mut g), kets, c),
+        }
+    }
+    one_by_one((&mut o, &mut g), &kets[whole..], &coef[whole..]);
+    (o, g)
 }
 
 /// `(G_n, g_n)` of the bra's `n_I = ln <φ|φ>^{1/2}` (`Gvr::new`): with `h = A⁻¹u`,
@@ -337,12 +442,12 @@ fn log_norm_gradient<const D: usize>(bra: &Gvr<D>, n_ang: u32) -> Grad<D> {
     let h = ainv * bra.u;
     let xn = bra.u.dot(&h) * 0.25;
     let kn = (2 * bra.k + n_ang) as f64;
-    Grad { a: ainv * -0.75 - outer(&h, &h) * (kn / (8.0 * xn)), u: h * (kn / (4.0 * xn)) }
+    Grad { a: ainv * -0.75 - h * h.transpose() * (kn / (8.0 * xn)), u: h * (kn / (4.0 * xn)) }
 }
 
 /// `EcgGvr::row_gradient` (module docs): the `(1 + P) x nb` row and its derivatives, and the
-/// `1 + P` diagonal (dual numbers, `path::row_gradient` against no basis); the basis images kept
-/// in `cache`.
+/// `1 + P` diagonal (dual numbers, `path::row_gradient` against no basis); the prepared basis
+/// kept in `cache` (shared with `gvr_build::rows`).
 pub fn row_gradient<const D: usize>(
     go: &GvrOps<D>,
     sym: &Symmetry<D>,
@@ -352,8 +457,9 @@ pub fn row_gradient<const D: usize>(
     cache: &Cache,
 ) -> Result<(Matrices, Vec<Element>)> {
     check(trial.len(), 1, "trial functions")?;
-    let bra = <EcgGvr as Family<D>>::functions(trial, go)?.remove(0);
-    let b = path::basis_images::<D, EcgGvr>(go, sym, basis, cache)?;
+    let trial_fn = <EcgGvr as Family<D>>::functions(trial, go)?.remove(0);
+    let bra = Prepared::new(&trial_fn, &go.ops);
+    let b = cache.get(basis, || Side::new(go, sym, basis))?;
     let (da, _) = dir.exponents::<D>()?;
     let du = matrices_of::<D, 1>(dir.v, da.len(), "global-vector directions")?;
     let (_, diag) = path::row_gradient::<D, EcgGvr>(go, sym, trial, dir, &Params::default(), &Cache::default())?;
@@ -362,28 +468,23 @@ pub fn row_gradient<const D: usize>(
     for f in &b.functions {
         series[f.k as usize].get_or_insert_with(|| Series::new(go, bra.k, f.k));
     }
-    let gn = log_norm_gradient(&bra, go.n_ang);
+    let gn = log_norm_gradient(&trial_fn, go.n_ang);
     let dn: Vec<f64> = da.iter().zip(&du).map(|(a, u)| gn.along(a, u)).collect();
-    let rows: Vec<Vec<Element>> = (0..b.len())
+    let lambda: M<f64, D> = matrix(|i, j| go.ops.lambda[(i, j)]);
+    let kernel = gvr_build::gradient_kernel::<D>();
+    let rows: Vec<Vec<Element>> = (0..b.functions.len())
         .into_par_iter()
         .map(|j| {
             let ser = series[b.functions[j].k as usize].as_ref().expect("every K prepared");
-            let mut o = [0.0; 4];
-            let mut g = [Grad::zero(); 4];
-            for (ket, c) in b.images[j].iter().zip(&b.coef) {
-                let (oi, gi) = image(&bra, ket, go, ser);
-                for k in 0..4 {
-                    o[k] += oi[k] * c;
-                    g[k].add_scaled(*c, &gi[k]);
-                }
-            }
+            // Safety: `gradient_kernel` chose an instruction set this CPU has.
+            let (o, g) = unsafe { kernel(&bra, &b.images[j], &b.coef, ser, &lambda, go) };
             let el = |x: [f64; 4]| Element { s: x[0], t: x[1], t_ti: x[2], v: x[3] };
             std::iter::once(el(o))
                 .chain(da.iter().zip(&du).zip(&dn).map(|((a, u), n)| el(std::array::from_fn(|k| g[k].along(a, u) - o[k] * n))))
                 .collect()
         })
         .collect();
-    let mut out = Matrices::zeros(1 + da.len(), b.len());
+    let mut out = Matrices::zeros(1 + da.len(), b.functions.len());
     for (j, r) in rows.iter().enumerate() {
         for (i, e) in r.iter().enumerate() {
             out.set(i, j, e);

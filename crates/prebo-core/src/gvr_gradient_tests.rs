@@ -6,6 +6,7 @@
 //! `‖A_I⁻¹‖‖dA‖ + (2K_I + N + 1)‖du‖/‖u_I‖` (the relative change of φ_I per unit step).
 use super::*;
 use crate::ecg::Operators;
+use crate::gvr_build::Side;
 use crate::gvr::element;
 
 /// xorshift64*: deterministic numbers in [0, 1) without a dependency.
@@ -77,14 +78,17 @@ impl Flat {
     }
 }
 
-/// Identity, a coordinate swap and a random invertible map, with random c_P.
+/// Identity, a coordinate swap and four random invertible maps, with random c_P: a group of
+/// `MAX_LANES` images in lanes and two one by one.
 fn symmetry<const D: usize>(rng: &mut Rng) -> Vec<(Mat<D>, f64)> {
     let swap = Mat::<D>::from_fn(|i, j| {
         let p = |k: usize| if k < 2 { 1 - k } else { k };
         f64::from(p(i) == j)
     });
-    let near = Mat::<D>::identity() + Mat::<D>::from_fn(|_, _| 0.3 * rng.normal());
-    vec![(Mat::identity(), 1.0), (swap, rng.normal()), (near, 0.5 * rng.normal())]
+    let mut near = || (Mat::<D>::identity() + Mat::<D>::from_fn(|_, _| 0.3 * rng.normal()), 0.5 * rng.normal());
+    let maps = [near(), near(), near(), near()];
+    let c = rng.normal();
+    [(Mat::identity(), 1.0), (swap, c)].into_iter().chain(maps).collect()
 }
 
 /// Directions: symmetric dA (as the parametrisation's `dA = dL Lᵀ + L dLᵀ`; the dual path reads
@@ -218,4 +222,47 @@ fn matches_central_differences() {
             }
         }
     }
+}
+
+/// The lanes of `symmetrised` (`MAX_LANES` images at once) have the bits of the images one by
+/// one, also where one image's `A_I + A_J` is not positive definite (NaN for that image alone).
+#[test]
+fn images_in_lanes_have_the_bits_of_one_by_one() {
+    const D: usize = 3;
+    let mut rng = Rng(17);
+    let go = GvrOps::new(operators::<D>(&mut rng, true), 1, 40).unwrap();
+    let sym = symmetry::<D>(&mut rng);
+    let k = rng.k(40);
+    let trial = Flat::random::<D>(&mut rng, &[k]);
+    let basis = Flat::random::<D>(&mut rng, &[0, 7, 40]);
+    let bra = &Side::new(&go, &sym, &trial.params()).unwrap().functions[0];
+    let side = Side::new(&go, &sym, &basis.params()).unwrap();
+    let lambda = matrix(|i, j| go.ops.lambda[(i, j)]);
+    let bits = |(o, g): &([f64; 4], [Grad<D>; 4])| -> Vec<u64> {
+        o.iter().chain(g.iter().flat_map(|g| g.a.iter().chain(g.u.iter()))).map(|v| v.to_bits()).collect()
+    };
+    let check = |kets: &[Prepared<D>], ser: &Series| {
+        let lanes = symmetrised::<D, 4>(bra, kets, &side.coef, ser, &lambda, &go);
+        let (mut o, mut g) = ([0.0; 4], [Grad::<D>::zero(); 4]);
+        for (ket, c) in kets.iter().zip(&side.coef) {
+            let (ok, gk) = symmetrised::<D, 4>(bra, std::slice::from_ref(ket), &[*c], ser, &lambda, &go);
+            for t in 0..4 {
+                o[t] += ok[t];
+                g[t].a += gk[t].a;
+                g[t].u += gk[t].u;
+            }
+        }
+        assert_eq!(bits(&lanes), bits(&(o, g)));
+        lanes
+    };
+    for (f, kets) in side.functions.iter().zip(&side.images) {
+        let lanes = check(kets, &Series::new(&go, bra.k, f.k));
+        assert!(bits(&lanes).into_iter().all(|b| f64::from_bits(b).is_finite()));
+    }
+    let mut kets = side.images[1].clone();
+    kets[2].a = std::array::from_fn(|i| std::array::from_fn(|j| -2.0 * bra.a[i][j]));
+    let ser = Series::new(&go, bra.k, side.functions[1].k);
+    let each: Vec<_> = kets.iter().map(|k| symmetrised::<D, 4>(bra, std::slice::from_ref(k), &[1.0], &ser, &lambda, &go).0[0]).collect();
+    assert!(each[2].is_nan() && each.iter().enumerate().all(|(i, s)| i == 2 || s.is_finite()));
+    check(&kets, &ser);
 }

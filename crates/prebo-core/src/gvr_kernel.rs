@@ -19,6 +19,8 @@
 //!   `a^{K_I} b^{K_J} ζ^N G(ζ²/(ab))` (`gvr::quadrature_partials`); the integer powers by
 //!   binary exponentiation ([`pow`]), the same squarings and products in every lane. The lane
 //!   values are summed node by node in order, so the integral has the same bits for every `W`.
+//! - The row gradient's τ-quadrature with partial derivatives (`integral_partials`) has `W`
+//!   inputs (pairs and images) in lanes instead, each lane summing its nodes in order.
 //!
 //! The lanes are `[f64; W]` arrays (no fused multiply-add), instantiated per instruction set
 //! (`kernels`, chosen with `build::best_isa`): every path gives the same bits.
@@ -346,25 +348,37 @@ fn inverse_det<T: Lane, const D: usize>(m: &[[T; D]; D]) -> Option<([[T; D]; D],
     Some((b, det, dk))
 }
 
+/// `B⁻¹` and `ln|B|` ([`inverse_det`]; the log of the product, or the sum of the pivots' logs
+/// where the product under- or overflows).
 #[inline(always)]
-fn dot<T: Lane, const D: usize>(p: &[T; D], q: &[T; D]) -> T {
+pub(crate) fn inverse_log_det<T: Lane, const D: usize>(m: &[[T; D]; D]) -> Option<([[T; D]; D], T)> {
+    let (inv, det, dk) = inverse_det(m)?;
+    let log_det = T::from_lanes(|l| {
+        let det = det.lane(l);
+        if det.is_normal() { det.ln() } else { dk.map(|d| d.lane(l)).iter().map(|d| d.ln()).sum() }
+    });
+    Some((inv, log_det))
+}
+
+#[inline(always)]
+pub(crate) fn dot<T: Lane, const D: usize>(p: &[T; D], q: &[T; D]) -> T {
     (0..D).fold(T::splat(0.0), |acc, k| acc + p[k] * q[k])
 }
 
 #[inline(always)]
-fn mat_vec<T: Lane, const D: usize>(m: &[[T; D]; D], v: &[T; D]) -> [T; D] {
+pub(crate) fn mat_vec<T: Lane, const D: usize>(m: &[[T; D]; D], v: &[T; D]) -> [T; D] {
     std::array::from_fn(|i| dot(&m[i], v))
 }
 
 /// `Σ_k coef_k r^k` (Horner, as `gvr::horner`).
 #[inline(always)]
-fn horner<T: Lane>(coef: &[f64], r: T) -> T {
+pub(crate) fn horner<T: Lane>(coef: &[f64], r: T) -> T {
     coef.iter().rev().fold(T::splat(0.0), |acc, &ck| acc * r + ck)
 }
 
 /// `x^k` by binary exponentiation ([`pow`] in the kernel's values).
 #[inline(always)]
-fn power<T: Lane>(x: T, k: u32) -> T {
+pub(crate) fn power<T: Lane>(x: T, k: u32) -> T {
     let (mut r, mut base, mut k) = (T::splat(1.0), x, k);
     loop {
         if k & 1 == 1 {
@@ -379,18 +393,18 @@ fn power<T: Lane>(x: T, k: u32) -> T {
 }
 
 /// The fields of `T::L` kets (symmetry images of one function) in lanes.
-struct Ket<T, const D: usize> {
-    a: [[T; D]; D],
-    u: [T; D],
-    lambda_u: [T; D],
-    log_norm: T,
-    c_a: T,
-    c_u: T,
+pub(crate) struct Ket<T, const D: usize> {
+    pub(crate) a: [[T; D]; D],
+    pub(crate) u: [T; D],
+    pub(crate) lambda_u: [T; D],
+    pub(crate) log_norm: T,
+    pub(crate) c_a: T,
+    pub(crate) c_u: T,
 }
 
 impl<T: Lane, const D: usize> Ket<T, D> {
     #[inline(always)]
-    fn new(kets: &[Prepared<D>]) -> Self {
+    pub(crate) fn new(kets: &[Prepared<D>]) -> Self {
         let v = |f: &dyn Fn(&Prepared<D>) -> f64| T::from_lanes(|l| f(&kets[l]));
         Self {
             a: std::array::from_fn(|i| std::array::from_fn(|j| v(&|k| k.a[i][j]))),
@@ -416,11 +430,7 @@ fn elements<const D: usize, const W: usize, T: Lane>(
     let ket = Ket::<T, D>::new(kets);
     let bra_u = bra.u.map(T::splat);
     let bsum: [[T; D]; D] = std::array::from_fn(|i| std::array::from_fn(|j| ket.a[i][j] + bra.a[i][j]));
-    let (binv, det, dk) = inverse_det(&bsum)?;
-    let log_det = T::from_lanes(|l| {
-        let det = det.lane(l);
-        if det.is_normal() { det.ln() } else { dk.map(|d| d.lane(l)).iter().map(|d| d.ln()).sum() }
-    });
+    let (binv, log_det) = inverse_log_det(&bsum)?;
     let gi = mat_vec(&binv, &bra_u);
     let gj = mat_vec(&binv, &ket.u);
     let x = dot(&bra_u, &gi) * 0.5;
@@ -486,7 +496,7 @@ fn elements<const D: usize, const W: usize, T: Lane>(
 
 /// `gvr::omega` from the tabulated series: `(L, ω, ω_x, ω_y, ω_z)`.
 #[inline(always)]
-fn omega<T: Lane>(s: &Series, x: T, y: T, z: T) -> (T, T, T, T, T) {
+pub(crate) fn omega<T: Lane>(s: &Series, x: T, y: T, z: T) -> (T, T, T, T, T) {
     let nf = s.n as f64;
     let rt = (x * y).map(f64::sqrt);
     let rho = (z / rt).map(|v| v.clamp(-1.0, 1.0));
@@ -508,7 +518,7 @@ fn cm_kinetic<T: Lane>(ci: T, cj: T, ui: T, uj: T, m: f64, w: (T, T, T, T)) -> T
 }
 
 /// Images of one ket evaluated together in lanes.
-const MAX_LANES: usize = 4;
+pub(crate) const MAX_LANES: usize = 4;
 
 /// `<φ_I| 1, T, T_TI, V |φ_J>` of two prepared functions.
 #[inline(always)]
@@ -559,20 +569,19 @@ pub fn symmetrised<const D: usize, const W: usize>(
 
 /// `∫_0^1 P dτ` with its partial derivatives with respect to `[x, y, z, γ_I, γ_J]`
 /// (`gvr::quadrature_partials`: the same chain rule through `a`, `b`, `ζ`) for each of `inputs`,
-/// into `out`, in lanes of `W` nodes of the padded rule (`tau2`, `weight`); `c` = the series
-/// `ĉ_k` and its derivative's (`derivative_series`). The series of `P_a`, `P_b`, `P_ζ` come from
-/// G and G' alone: `Σ ĉ_k(K_I−k) r^k = K_I G − r G'`, likewise K_J, and `Σ ĉ_k(N+2k) r^k =
-/// N G + 2 r G'` (for N = 0 over r: `2 G'`). The derivatives' node sums carry no division: with
-/// `α_I = γ_I²/x`, `α_J = γ_J²/y`,
+/// into `out`, `W` inputs at a time in lanes (`partial_sums`); `tau2`, `weight` = the padded rule
+/// (`padded_rule`), `c` = the series `ĉ_k` and its derivative's (`derivative_series`). The
+/// series of `P_a`, `P_b`, `P_ζ` come from G and G' alone: `Σ ĉ_k(K_I−k) r^k = K_I G − r G'`,
+/// likewise K_J, and `Σ ĉ_k(N+2k) r^k = N G + 2 r G'` (for N = 0 over r: `2 G'`). The
+/// derivatives' node sums carry no division: with `α_I = γ_I²/x`, `α_J = γ_J²/y`,
 ///
 /// ```text
 ///     ∂_x = (α_I/x) Σ P_a τ² − Σ P_ζ ζ/(2x),       ∂_γI = −(2γ_I/x) Σ P_a τ² − (γ_J/√(xy)) Σ P_ζ τ²,
 ///     ∂_y = (α_J/y) Σ P_b τ² − Σ P_ζ ζ/(2y),       ∂_γJ = −(2γ_J/y) Σ P_b τ² − (γ_I/√(xy)) Σ P_ζ τ²,
-///     ∂_z = Σ P_ζ/√(xy),
+///     ∂_z = Σ P_ζ/√(xy).
 /// ```
 ///
-/// the sums taken in an order that does not depend on `W` (`partial_sums`), so `out` has the
-/// same bits for every `W`.
+/// Each lane is one input, its nodes summed in order, so `out` has the same bits for every `W`.
 #[inline(always)]
 pub fn integral_partials<const W: usize>(
     c: (&[f64], &[f64]),
@@ -582,12 +591,16 @@ pub fn integral_partials<const W: usize>(
     inputs: &[[f64; 5]],
     out: &mut [(f64, [f64; 5])],
 ) {
-    for (inputs, out) in inputs.chunks(MAX_PAIRS).zip(out.chunks_mut(MAX_PAIRS)) {
-        let mut sums = [[0.0f64; 6]; MAX_PAIRS];
-        partial_sums::<W>(c, k, tau2, weight, inputs, &mut sums);
-        for ((o, s), &[x, y, _, gam_i, gam_j]) in out.iter_mut().zip(&sums).zip(inputs) {
+    // the rule's nodes in whole groups of NODES (the padding has zero weights: each adds +0)
+    let nodes = weight.iter().rposition(|&w| w != 0.0).map_or(0, |i| i + 1).div_ceil(NODES) * NODES;
+    let (tau2, weight) = (&tau2[..nodes], &weight[..nodes]);
+    for (inputs, out) in inputs.chunks(W).zip(out.chunks_mut(W)) {
+        // lanes beyond the inputs repeat the first (their sums are not read)
+        let lanes: [[f64; W]; 5] = std::array::from_fn(|t| std::array::from_fn(|l| inputs[if l < inputs.len() { l } else { 0 }][t]));
+        let sums = partial_sums::<W>(c, k, tau2, weight, &lanes);
+        for (l, (o, &[x, y, _, gam_i, gam_j])) in out.iter_mut().zip(inputs).enumerate() {
             let rt = (x * y).sqrt();
-            let [f, pa_t, pb_t, pz, pz_zeta, pz_t] = *s;
+            let [f, pa_t, pb_t, pz, pz_zeta, pz_t] = sums.map(|s| s[l]);
             let [al_i, al_j] = [gam_i * gam_i / x, gam_j * gam_j / y];
             *o = (
                 f,
@@ -603,97 +616,85 @@ pub fn integral_partials<const W: usize>(
     }
 }
 
-/// Node blocks of one input evaluated together in `partial_sums` (latency of the Horner chains).
-const BLOCKS: usize = 4;
+/// Nodes evaluated together in `partial_sums` (independent Horner chains hide the latency).
+const NODES: usize = 4;
 
-/// The node sums of `integral_partials` for each of `inputs`: `[Σ P, Σ P_a τ², Σ P_b τ², Σ P_ζ,
-/// Σ P_ζ ζ, Σ P_ζ τ²]` (weights included), into `sums`; `a`, `b`, `ζ` rounded as in
-/// `gvr::quadrature_partials` (`Σ P` keeps its bits, summed node by node: the closed form's
-/// oracle). G and G' are two independent Horner chains (`c` and `dc`, `dc_k = (k+1) ĉ_{k+1}`) over
-/// `BLOCKS` blocks at once. The other sums run in `MAX_W` slots, node `i` in slot `i mod MAX_W`,
-/// added in slot order at the end: vector adds, and the same bits for every `W`.
+/// The node sums of `integral_partials` for `W` inputs in lanes (`[x, y, z, γ_I, γ_J]`, each a
+/// lane vector): `[Σ P, Σ P_a τ², Σ P_b τ², Σ P_ζ, Σ P_ζ ζ, Σ P_ζ τ²]` (weights included), node by
+/// node in order, `a`, `b`, `ζ` rounded as in `gvr::quadrature_partials`. G and G' are two
+/// Horner chains (`c` and `dc`, `dc_k = (k+1) ĉ_{k+1}`) over `NODES` nodes at once; the rule's
+/// length is a multiple of `NODES`.
 #[inline(always)]
 fn partial_sums<const W: usize>(
     (c, dc): (&[f64], &[f64]),
     (ki, kj, n): (u32, u32, u32),
     tau2: &[f64],
     weight: &[f64],
-    inputs: &[[f64; 5]],
-    sums: &mut [[f64; 6]],
-) {
+    [x, y, z, gam_i, gam_j]: &[[f64; W]; 5],
+) -> [[f64; W]; 6] {
     let (kif, kjf, nf) = (ki as f64, kj as f64, n as f64);
-    let one = [1.0f64; W];
-    let blocks = tau2.len() / W;
-    for (s, &[x, y, z, gam_i, gam_j]) in sums.iter_mut().zip(inputs) {
-        let rt = (x * y).sqrt();
-        // the derivative sums by node slot (node i in slot i mod MAX_W), summed in slot order at the end
-        let mut slots = [[0.0f64; MAX_W]; 5];
-        let mut first = 0;
-        while first < blocks {
-            let count = BLOCKS.min(blocks - first);
-            let mut a = [[0.0f64; W]; BLOCKS];
-            let mut b = [[0.0f64; W]; BLOCKS];
-            let mut zeta = [[0.0f64; W]; BLOCKS];
-            let mut r = [[0.0f64; W]; BLOCKS];
-            for j in 0..count {
-                let t2 = &tau2[(first + j) * W..(first + j + 1) * W];
-                for l in 0..W {
-                    a[j][l] = positive(1.0 - gam_i * gam_i * t2[l] / x);
-                    b[j][l] = positive(1.0 - gam_j * gam_j * t2[l] / y);
-                    zeta[j][l] = (z - gam_i * gam_j * t2[l]) / rt;
-                    r[j][l] = ratio(a[j][l], b[j][l], zeta[j][l]);
-                }
+    let one = [[1.0f64; W]; NODES];
+    let rt: [f64; W] = std::array::from_fn(|l| (x[l] * y[l]).sqrt());
+    let gii: [f64; W] = std::array::from_fn(|l| gam_i[l] * gam_i[l]);
+    let gjj: [f64; W] = std::array::from_fn(|l| gam_j[l] * gam_j[l]);
+    let gij: [f64; W] = std::array::from_fn(|l| gam_i[l] * gam_j[l]);
+    let mut s = [[0.0f64; W]; 6];
+    for (t2, wt) in tau2.chunks_exact(NODES).zip(weight.chunks_exact(NODES)) {
+        let mut a = [[0.0f64; W]; NODES];
+        let mut b = [[0.0f64; W]; NODES];
+        let mut zeta = [[0.0f64; W]; NODES];
+        let mut r = [[0.0f64; W]; NODES];
+        for q in 0..NODES {
+            for l in 0..W {
+                a[q][l] = positive(1.0 - gii[l] * t2[q] / x[l]);
+                b[q][l] = positive(1.0 - gjj[l] * t2[q] / y[l]);
+                zeta[q][l] = (z[l] - gij[l] * t2[q]) / rt[l];
+                r[q][l] = ratio(a[q][l], b[q][l], zeta[q][l]);
             }
-            // all BLOCKS blocks (unused ones at r = 0): a fixed trip count keeps them in registers
-            let (mut g, mut gp) = ([[0.0f64; W]; BLOCKS], [[0.0f64; W]; BLOCKS]);
-            for ck in c.iter().rev() {
-                for j in 0..BLOCKS {
-                    for l in 0..W {
-                        g[j][l] = g[j][l] * r[j][l] + ck;
-                    }
-                }
-            }
-            for ck in dc.iter().rev() {
-                for j in 0..BLOCKS {
-                    for l in 0..W {
-                        gp[j][l] = gp[j][l] * r[j][l] + ck;
-                    }
-                }
-            }
-            for j in 0..count {
-                let blk = first + j;
-                let (t2, wt) = (&tau2[blk * W..(blk + 1) * W], &weight[blk * W..(blk + 1) * W]);
-                let (aj, bj, zj, rj, gj, gpj) = (a[j], b[j], zeta[j], r[j], g[j], gp[j]);
-                let pa1 = if ki > 0 { pow([aj], ki - 1)[0] } else { one };
-                let pb1 = if kj > 0 { pow([bj], kj - 1)[0] } else { one };
-                let pz1 = if n > 0 { pow([zj], n - 1)[0] } else { one };
-                let pa: [f64; W] = std::array::from_fn(|l| if ki > 0 { pa1[l] * aj[l] } else { 1.0 });
-                let pb: [f64; W] = std::array::from_fn(|l| if kj > 0 { pb1[l] * bj[l] } else { 1.0 });
-                let pz: [f64; W] = std::array::from_fn(|l| if n > 0 { pz1[l] * zj[l] } else { 1.0 });
-                for l in 0..W {
-                    s[0] += wt[l] * pa[l] * pb[l] * pz[l] * gj[l];
-                }
-                let at = (blk * W) % MAX_W;
-                for l in 0..W {
-                    let (w, rgp) = (wt[l], rj[l] * gpj[l]);
-                    let p_a = if ki > 0 { w * pa1[l] * pb[l] * pz[l] * (kif * gj[l] - rgp) } else { 0.0 };
-                    let p_b = if kj > 0 { w * pa[l] * pb1[l] * pz[l] * (kjf * gj[l] - rgp) } else { 0.0 };
-                    let p_z = match n {
-                        0 if ki > 0 && kj > 0 => w * pa1[l] * pb1[l] * zj[l] * (2.0 * gpj[l]),
-                        0 => 0.0,
-                        _ => w * pa[l] * pb[l] * pz1[l] * (nf * gj[l] + 2.0 * rgp),
-                    };
-                    slots[0][at + l] += p_a * t2[l];
-                    slots[1][at + l] += p_b * t2[l];
-                    slots[2][at + l] += p_z;
-                    slots[3][at + l] += p_z * zj[l];
-                    slots[4][at + l] += p_z * t2[l];
-                }
-            }
-            first += count;
         }
-        for (k, slot) in slots.iter().enumerate() {
-            s[k + 1] = slot.iter().fold(0.0, |acc, v| acc + v);
+        // G and G' in one loop (dc is one shorter), the chains of every node interleaved
+        let (mut g, mut gp) = ([[0.0f64; W]; NODES], [[0.0f64; W]; NODES]);
+        for k in (0..c.len()).rev() {
+            for q in 0..NODES {
+                for l in 0..W {
+                    g[q][l] = g[q][l] * r[q][l] + c[k];
+                }
+            }
+            if k > 0 {
+                for q in 0..NODES {
+                    for l in 0..W {
+                        gp[q][l] = gp[q][l] * r[q][l] + dc[k - 1];
+                    }
+                }
+            }
+        }
+        let pa1 = if ki > 0 { pow(a, ki - 1) } else { one };
+        let pb1 = if kj > 0 { pow(b, kj - 1) } else { one };
+        let pz1 = if n > 0 { pow(zeta, n - 1) } else { one };
+        for q in 0..NODES {
+            let (t2, w) = (t2[q], wt[q]);
+            for l in 0..W {
+                let (aq, bq, zq, gq) = (a[q][l], b[q][l], zeta[q][l], g[q][l]);
+                let (pa1, pb1, pz1) = (pa1[q][l], pb1[q][l], pz1[q][l]);
+                let pa = if ki > 0 { pa1 * aq } else { 1.0 };
+                let pb = if kj > 0 { pb1 * bq } else { 1.0 };
+                let pz = if n > 0 { pz1 * zq } else { 1.0 };
+                s[0][l] += w * pa * pb * pz * gq;
+                let rgp = r[q][l] * gp[q][l];
+                let p_a = if ki > 0 { w * pa1 * pb * pz * (kif * gq - rgp) } else { 0.0 };
+                let p_b = if kj > 0 { w * pa * pb1 * pz * (kjf * gq - rgp) } else { 0.0 };
+                let p_z = match n {
+                    0 if ki > 0 && kj > 0 => w * pa1 * pb1 * zq * (2.0 * gp[q][l]),
+                    0 => 0.0,
+                    _ => w * pa * pb * pz1 * (nf * gq + 2.0 * rgp),
+                };
+                s[1][l] += p_a * t2;
+                s[2][l] += p_b * t2;
+                s[3][l] += p_z;
+                s[4][l] += p_z * zq;
+                s[5][l] += p_z * t2;
+            }
         }
     }
+    s
 }

@@ -96,3 +96,24 @@ impl<const L: usize> Neg for Lanes<L> {
         Self(self.0.map(|v| -v))
     }
 }
+
+/// `[f(0), …, f(N−1)]` in a loop that inlines into the kernels compiled per instruction set
+/// (`std::array::from_fn` does not always).
+#[inline(always)]
+pub fn array<T: Lane, const N: usize>(f: impl Fn(usize) -> T) -> [T; N] {
+    let mut v = [T::splat(0.0); N];
+    for (i, x) in v.iter_mut().enumerate() {
+        *x = f(i);
+    }
+    v
+}
+
+/// `[[f(i, j)]]`, `N × N`, in loops that inline (as `array`).
+#[inline(always)]
+pub fn matrix<T: Lane, const N: usize>(f: impl Fn(usize, usize) -> T) -> [[T; N]; N] {
+    let mut m = [[T::splat(0.0); N]; N];
+    for (i, row) in m.iter_mut().enumerate() {
+        *row = array(|j| f(i, j));
+    }
+    m
+}
