@@ -172,3 +172,29 @@ def test_a_change_within_the_numerical_uncertainty_is_refused():
     _, rows, diag = small.candidates(last)
     assert small.put(len(small.basis), last, {k: v[0] for k, v in rows.items()}, diag[0])
     assert small.energy == pytest.approx(e0, rel=1e-8, abs=0)
+
+
+@pytest.mark.parametrize("K, N", [(0, 0), (1, 0), (7, 0), (30, 0), (4, 1)])
+def test_a_sweep_tries_the_neighbours_in_K_with_the_peak_of_the_global_vector_coordinate_kept(K, N):
+    from prebo.optimise.sampler import Sampler
+    state = prebo.State(N=N, parity=(-1) ** N, spin={"p": N % 2, "e": 0})
+    system = prebo.System([{"name": "p", "mass": 1836.15}, {"name": "p", "mass": 1836.15}, "e", "e"], state)
+    opts = Optimiser(kind="ecg-gvr", K_max=30, channels="all")
+    sampler = Sampler(system, opts, np.random.default_rng(5))
+    f = sampler.fresh()
+    u = f.u + 0.3 * np.random.default_rng(6).standard_normal(f.u.shape)
+    f = prebo.Basis.single(system, f.A[0], f.c_A[0], f.channels[0], f.kind, {"u": u - u.mean(), "K": [K]})
+    near = sampler.neighbours(f)
+    assert sorted(int(g.K[0]) for g in near) == sorted(k for k in (K - 2, K - 1, K + 1, K + 2) if 0 <= k <= 30)
+    u = f.u[0]
+
+    def peak(g):  # |v|^{2K+N} exp(-α_v v²) of the marginal in v = u·r peaks at (p/α_v)^½, p = max(K + N/2, 1)
+        return max(int(g.K[0]) + N / 2, 1.0) * (u @ np.linalg.solve(g.A[0], u))
+
+    for g in near:
+        assert np.allclose(g.u, f.u) and peak(g) == pytest.approx(peak(f), rel=1e-10)  # A^-1 u: cond(A) ~ 1e4
+        moved = max(int(g.K[0]) + N / 2, 1.0) != max(K + N / 2, 1.0)  # p = 1 for K + N/2 ≤ 1, as in fresh draws
+        assert np.linalg.matrix_rank(g.A[0] - f.A[0], tol=1e-12 * np.abs(f.A[0]).max()) == moved  # along u only
+        assert np.all(np.linalg.eigvalsh(g.A[0]) > 0)
+    pecg = Sampler(prebo.System(["alpha", "e", "e"]), Optimiser(kind="pecg", channels="pairs"), np.random.default_rng(1))
+    assert pecg.neighbours(pecg.fresh()) == []

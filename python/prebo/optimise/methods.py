@@ -6,9 +6,11 @@
   core (O(N_b) integrals) and the new lowest eigenvalue from the secular equation (O(N_b^2),
   eigen.lowest_with_added_many); the best is appended if it lowers the energy beyond its
   uncertainty and, with `refine`, refined.
-- `Sweep`: one step of a random replacement sweep: function i competes with `trials` random
-  replacements in the basis without it; with `refine`, the winner is refined and kept only if
-  it then beats the incumbent, which is refined otherwise (refine.regenerate_function).
+- `Sweep`: one step of a replacement sweep: function i competes with `trials` replacements in the
+  basis without it — its neighbours in the power K (Sampler.neighbours: K ± 1, K ± 2 with the
+  peak of the global-vector coordinate kept; refinement cannot change K) and random functions;
+  with `refine`, the winner is refined and kept only if it then beats the incumbent, which is
+  refined otherwise (refine.regenerate_function).
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed (refine.py).
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
 Replacements reach new basins, joint refinement converges within one; the sweep-refine-polish
@@ -21,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..basis import Basis
 from ..errors import StalledError
 from .checkpoint import Cursor
 from .expansion import Expansion
@@ -88,8 +91,9 @@ def stalled(nb: int, opts: Optimiser) -> str:
 
 @dataclass(frozen=True)
 class Sweep:
-    """Replace function `cursor.index` by the best of `trials` random functions if that lowers the
-    energy; with `refine`, the winner is refined first (module docstring)."""
+    """Replace function `cursor.index` by the best of `trials` functions — its neighbours in K, then
+    random ones — if that lowers the energy; with `refine`, the winner is refined first (module
+    docstring)."""
 
     trials: int
     refine: Refinement | None = None
@@ -97,7 +101,8 @@ class Sweep:
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
         ex, i = run.expansion, cursor.index
-        trials = run.sampler.trials(self.trials)
+        near = run.sampler.neighbours(ex.basis.subset([i]))[:self.trials]
+        trials = Basis.concat(near + [run.sampler.draw() for _ in range(self.trials - len(near))])
         rest = ex.without(i)
         energies, rows, diag = ex.candidates(trials, exclude=i, eig=rest)
         run.report.trials(len(trials))

@@ -10,6 +10,8 @@ The family adds its own parameters (Family.draw_power, Family.drawn): ECG-GVR a 
 global vector along the pair or coordinate drawn, floating ECGs centres displaced along it.
 After `learn_after` functions of a channel, a share `learned` of the trials is drawn from the
 normal distribution of the parameters θ (parametrisation.py) selected so far in that channel.
+A replacement sweep also tries a function's neighbours in K (`neighbours`), the only moves in K
+besides a fresh draw: refinement changes θ only.
 """
 from __future__ import annotations
 
@@ -123,6 +125,24 @@ class Sampler:
             self.learned[ch] = (Parametrisation.of(basis.subset(idx[:1])), thetas.mean(axis=0), thetas.std(axis=0),
                                 Ks, len(idx))
         self._thetas = seen
+
+    def neighbours(self, f: Basis) -> list:
+        """Function f of power K moved to K ± 1, K ± 2 (within 0..K_max), the marginal exponent of
+        v = u·r scaled by p'/p (p = max(K + N/2, 1)) so that the peak of |v|^{2K+N} stays put:
+        A' = A + (p'/p - 1) u u^T / (u^T A^-1 u) (Sherman–Morrison: u^T A'^-1 u = u^T A^-1 u p/p')."""
+        Ks = f.family.powers(f, [0])
+        if Ks is None:
+            return []
+        K, N = int(Ks[0]), self.system.state.N
+        A, u = f.A[0], f.u[0]
+        p = max(K + 0.5 * N, 1.0)
+        out = []
+        for K2 in (K - 1, K + 1, K - 2, K + 2):
+            if 0 <= K2 <= self.opts.K_max:
+                g = (max(K2 + 0.5 * N, 1.0) / p - 1.0) / (u @ np.linalg.solve(A, u))
+                out.append(Basis.single(self.system, A + g * np.outer(u, u), f.c_A[0], f.channels[0], f.kind,
+                                        {"u": u[None], "K": [K2]}))
+        return out
 
     def trials(self, k: int) -> Basis:
         """`k` functions of `draw` as one basis."""
