@@ -230,9 +230,11 @@ def test_the_budget_stops_a_run_and_a_resumed_adaptive_run_goes_on(tmp_path):
     assert basis.convergence["stopped"] == "budget" and 2.0 <= basis.convergence["seconds"] < 30
     assert 0 < len(basis) < 400
     d = json.loads((tmp_path / "basis.json").read_text())
-    d["progress"] = vars(Adaptive(Optimiser(size=400)).begin("grow", len(basis), 3))
+    assert d["stopped"] == "budget" and d["progress"]["phase"] != "done"  # where it goes on
+    again, _ = resume_from(tmp_path, progress=False)  # the same budget: nothing more
+    assert again.convergence["stopped"] == "budget" and len(again) == len(basis)
+    assert json.loads((tmp_path / "basis.json").read_text())["history"] == d["history"]
     d["optimiser"]["budget"] = d["elapsed"] + 1.0  # one more second
-    d["stopped"] = None
     (tmp_path / "basis.json").write_text(json.dumps(d))
     more, _ = resume_from(tmp_path, progress=False)
     assert more.convergence["stopped"] == "budget" and len(more) > len(basis)

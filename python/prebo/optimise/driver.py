@@ -40,8 +40,9 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     the energy each gains per second until the basis has converged or is exhausted; with a fixed
     one, growth to `opts.size` by competitive selection, then `opts.cycles` times `opts.sweeps` random
     replacement sweeps, `opts.refine` refinement sweeps and `opts.polish` joint steps
-    (methods.py). Either stops after `opts.budget` seconds. Settings left at None are chosen
-    for the system first (defaults.resolved).
+    (methods.py). Either stops after `opts.budget` seconds and keeps its place in the checkpoint:
+    resumed with a larger budget, it goes on. Settings left at None are chosen for the system
+    first (defaults.resolved).
 
     out: folder of the checkpoint out/basis.json, written atomically after every step (None: no
     checkpoint); progress: show a live line; resume: a checkpoint's content
@@ -88,7 +89,11 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
 
     with run.report, eigen.lapack_threads(opts.size):
         while cursor.phase != "done":
-            old = ex.energy
+            if opts.budget is not None and wall() >= opts.budget:
+                stopped = "budget"  # the cursor is kept: resumed with a larger budget, the run goes on
+                checkpoint()
+                break
+            stopped, old = None, ex.energy
             try:
                 steps[cursor.phase].step(run, cursor)
             except StalledError:
@@ -107,8 +112,6 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 cursor = cursor.advance(len(ex.basis), opts)
             if cursor.phase == "done":
                 stopped = schedule.stopped if opts.adaptive else "schedule"
-            elif opts.budget is not None and now >= opts.budget:
-                cursor, stopped = Cursor("done"), "budget"
             checkpoint()
     ex.basis.coefficients = ex.eig.vectors[:, 0]
     ex.basis.convergence = convergence(history, opts, stopped, wall(), schedule.stalled,
