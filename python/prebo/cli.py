@@ -150,12 +150,12 @@ def cmd_export(args) -> int:
 
 
 def cmd_plot(args) -> int:
-    """`prebo plot RUN... [--reference E] [--out PNG]`: convergence plot of run checkpoints."""
+    """`prebo plot RUN... [--reference E] [--since S] [--out PNG]`: convergence plot of run checkpoints."""
     from .plot import convergence
 
     png = args.out or Path(args.runs[0]) / "convergence.png"
     try:
-        convergence(args.runs, png, args.reference)
+        convergence(args.runs, png, args.reference, args.since)
     except OSError as exc:
         raise OutputError(f"{png}: cannot write ({exc.strerror})") from exc
     print(f"wrote {png}")
@@ -227,6 +227,8 @@ def parser() -> argparse.ArgumentParser:
     pl = sub.add_parser("plot", help="energy against basis size of one or more runs (PNG)")
     pl.add_argument("runs", nargs="+", type=Path, help="run folders (with basis.json checkpoints)")
     pl.add_argument("--reference", type=float, help="exact energy: plot E - E_ref on a log axis")
+    pl.add_argument("--since", type=float, metavar="SECONDS",
+                    help="only the wall time from then on, against time (runs branched from one checkpoint)")
     pl.add_argument("--out", type=Path, help="PNG file (default FIRST-RUN/convergence.png)")
     pl.set_defaults(func=cmd_plot)
     return p

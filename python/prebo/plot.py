@@ -4,7 +4,9 @@
 The growth phase gives one point per basis size; refinement sweeps at the final size are
 drawn as a vertical run of points there, and spread out in the wall-time panel (histories
 written before wall times were recorded leave that panel out). With a reference energy the
-error E - E_ref is drawn on a logarithmic axis.
+error E - E_ref is drawn on a logarithmic axis. From a given wall time on (`since`), only the
+time panel is drawn, each run starting from its state at that moment: branches of one checkpoint
+compared from where they parted.
 """
 from __future__ import annotations
 
@@ -27,26 +29,43 @@ def history(folder: Path) -> list:
     return d["history"]
 
 
-def convergence(folders: list[Path], png: Path, reference: float | None = None) -> Path:
+def since(h: list, seconds: float, where: str = "run") -> list:
+    """The rows of history `h` from wall time `seconds` on, led by the state at that moment (the
+    last row before it, its time set to `seconds`); BasisFileError for a history without wall
+    times or with nothing before `seconds`."""
+    if not all(len(row) > 3 for row in h):
+        raise BasisFileError(f"{where}: its history has no wall times")
+    before = [row for row in h if row[3] < seconds]
+    if not before:
+        raise BasisFileError(f"{where}: nothing in its history before {seconds:g} s")
+    return [before[-1][:3] + [seconds]] + [row for row in h if row[3] >= seconds]
+
+
+def convergence(folders: list[Path], png: Path, reference: float | None = None, start: float | None = None) -> Path:
     """Plot the energies (Eh) of the runs in `folders` against basis size (and wall time, minutes)
-    into the PNG file `png`; with `reference` (Eh) E - E_ref on a log axis. Returns `png`."""
+    into the PNG file `png`; with `reference` (Eh) E - E_ref on a log axis; with `start` (s) only
+    the wall time from then on (`since`: runs branched from one checkpoint). Returns `png`."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     runs = [(Path(folder).name, history(folder)) for folder in folders]
+    if start is not None:
+        runs = [(name, since(h, start, str(folder))) for (name, h), folder in zip(runs, folders)]
     timed = all(len(row) > 3 for _, h in runs for row in h)
-    fig, axes = plt.subplots(1, 2 if timed else 1, figsize=(11.5 if timed else 6.4, 4.4), squeeze=False)
+    panels = [p for p, shown in (("size", start is None), ("time", timed)) if shown]
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.75 * len(panels) + 0.65 * (len(panels) == 1), 4.4),
+                             squeeze=False)
+    t0 = start or 0.0
     for name, h in runs:
         e = [row[1] - reference if reference is not None else row[1] for row in h]
-        axes[0, 0].plot([row[0] for row in h], e, ".-", ms=3, lw=1, label=name)
-        if timed:
-            axes[0, 1].plot([row[3] / 60 for row in h], e, ".-", ms=3, lw=1, label=name)
-    axes[0, 0].set_xlabel("basis size")
-    if timed:
-        axes[0, 1].set_xlabel("wall time / min")
-    for ax in axes[0]:
+        for ax, panel in zip(axes[0], panels):
+            x = [row[0] for row in h] if panel == "size" else [(row[3] - t0) / 60 for row in h]
+            ax.plot(x, e, ".-", ms=3, lw=1, label=name)
+    for ax, panel in zip(axes[0], panels):
+        ax.set_xlabel("basis size" if panel == "size" else
+                      "wall time / min" if start is None else f"wall time after {start:g} s / min")
         if reference is not None:
             ax.set_yscale("log")
             ax.set_ylabel(f"E − E_ref  (E_ref = {reference} Eh)")
