@@ -137,14 +137,15 @@ def test_plot_draws_the_convergence_of_runs(run_dir, tmp_path):
     middle = history[len(history) // 2][3]
     r = prebo("plot", run_dir, "--since", middle, "--out", png)
     assert r.returncode == 0, r.stderr
-    assert_clean_error(prebo("plot", run_dir, "--since", -1.0, "--out", png), "nothing in its history before -1 s")
+    assert_clean_error(prebo("plot", run_dir, "--since", -1.0, "--out", png), "nothing in its history at or before -1 s")
 
 
 def test_plot_since_starts_each_run_from_its_state_at_that_moment():
     from prebo.plot import since
     h = [[1, -0.3, "grow", 1.0], [2, -0.4, "grow", 2.0], [2, -0.45, "sweep", 5.0]]
     assert since(h, 3.0) == [[2, -0.4, "grow", 3.0], [2, -0.45, "sweep", 5.0]]
-    assert since(h, 2.0) == [[1, -0.3, "grow", 2.0], [2, -0.4, "grow", 2.0], [2, -0.45, "sweep", 5.0]]
+    assert since(h, 2.0) == [[2, -0.4, "grow", 2.0], [2, -0.45, "sweep", 5.0]]  # a row at that moment leads
+    assert since([[1, -0.3, "grow", 0.0], [2, -0.4, "grow", 0.0]], 0.0) == [[2, -0.4, "grow", 0.0]]
 
 
 def test_ecgpack_import_export_and_energy(tmp_path):

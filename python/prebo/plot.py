@@ -30,15 +30,15 @@ def history(folder: Path) -> list:
 
 
 def since(h: list, seconds: float, where: str = "run") -> list:
-    """The rows of history `h` from wall time `seconds` on, led by the state at that moment (the
-    last row before it, its time set to `seconds`); BasisFileError for a history without wall
-    times or with nothing before `seconds`."""
+    """The rows of history `h` after wall time `seconds`, led by the state at that moment (the
+    last row at or before it, its time set to `seconds`); BasisFileError for a history without
+    wall times or with nothing at or before `seconds`."""
     if not all(len(row) > 3 for row in h):
         raise BasisFileError(f"{where}: its history has no wall times")
-    before = [row for row in h if row[3] < seconds]
+    before = [row for row in h if row[3] <= seconds]
     if not before:
-        raise BasisFileError(f"{where}: nothing in its history before {seconds:g} s")
-    return [before[-1][:3] + [seconds]] + [row for row in h if row[3] >= seconds]
+        raise BasisFileError(f"{where}: nothing in its history at or before {seconds:g} s")
+    return [before[-1][:3] + [seconds]] + [row for row in h if row[3] > seconds]
 
 
 def convergence(folders: list[Path], png: Path, reference: float | None = None, start: float | None = None) -> Path:

@@ -26,6 +26,9 @@ from ..system import System
 from .parametrisation import Parametrisation
 from .settings import Optimiser
 
+#: the steps in K of a function's neighbours (`Sampler.neighbours`)
+K_STEPS = (1, 2)
+
 
 def coordinate_sets(system: System, channels) -> list[coords.CoordinateSet]:
     """The coordinate sets of the `channels` setting ([] for "pairs"), checked against the system."""
@@ -127,7 +130,7 @@ class Sampler:
         self._thetas = seen
 
     def neighbours(self, f: Basis) -> list:
-        """Function f of power K moved to K ± 1, K ± 2 (within 0..K_max), the marginal exponent of
+        """Function f of power K moved to K ± 1, K ± 2 (K_STEPS; within 0..K_max), the marginal exponent of
         v = u·r scaled by p'/p (p = max(K + N/2, 1)) so that the peak of |v|^{2K+N} stays put:
         A' = A + (p'/p - 1) u u^T / (u^T A^-1 u) (Sherman–Morrison: u^T A'^-1 u = u^T A^-1 u p/p')."""
         Ks = f.family.powers(f, [0])
@@ -137,7 +140,7 @@ class Sampler:
         A, u = f.A[0], f.u[0]
         p = max(K + 0.5 * N, 1.0)
         out = []
-        for K2 in (K - 1, K + 1, K - 2, K + 2):
+        for K2 in (K + sign * step for step in K_STEPS for sign in (-1, 1)):
             if 0 <= K2 <= self.opts.K_max:
                 g = (max(K2 + 0.5 * N, 1.0) / p - 1.0) / (u @ np.linalg.solve(A, u))
                 out.append(Basis.single(self.system, A + g * np.outer(u, u), f.c_A[0], f.channels[0], f.kind,
