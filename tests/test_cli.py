@@ -163,3 +163,22 @@ def test_ecgpack_import_export_and_energy(tmp_path):
     assert back == pytest.approx(reference, rel=1e-13)
     (tmp_path / "bad.inout.txt").write_text("PARTICLES 3\nbroken\n")
     assert_clean_error(prebo("energy", tmp_path / "bad.inout.txt"), "bad.inout.txt")
+
+
+def test_run_budget_from_the_command_line_stops_a_run_and_extends_it_on_resume(tmp_path):
+    """`prebo run INPUT --budget S` stops at S seconds of the run and keeps its place; `--resume DIR
+    --budget S'` (the whole run's seconds) goes on from there; a budget that is not a positive
+    number of seconds is refused in one line."""
+    toml = tmp_path / "he.toml"
+    toml.write_text('[system]\nparticles = ["alpha", "e", "e"]\n[state]\nspin = { e = 0 }\n[basis]\nsize = 400\n')
+    out = tmp_path / "he"
+    assert prebo("run", toml, "--out", out, "--budget", 2, "--quiet").returncode == 0
+    first = json.loads((out / "result.json").read_text())["convergence"]
+    d = json.loads((out / "basis.json").read_text())
+    assert first["stopped"] == "budget" and 2.0 <= first["seconds"] < 30 and d["optimiser"]["budget"] == 2.0
+    assert prebo("run", "--resume", out, "--budget", d["elapsed"] + 2.0, "--quiet").returncode == 0
+    again = json.loads((out / "basis.json").read_text())
+    assert again["stopped"] == "budget" and again["elapsed"] >= d["elapsed"] + 2.0
+    assert again["history"][:len(d["history"])] == d["history"] and len(again["history"]) > len(d["history"])
+    for bad in ("0", "-5", "nan", "inf", "ten"):
+        assert_clean_error(prebo("run", toml, "--out", out, "--budget", bad), "--budget", "seconds above 0")

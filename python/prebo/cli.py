@@ -7,6 +7,7 @@ import math
 import os
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from .errors import NonFiniteError, OutputError, PreboError
@@ -82,9 +83,10 @@ def _warn_if_unbound(r: dict) -> None:
 
 
 def cmd_run(args) -> int:
-    """`prebo run INPUT [--out DIR]` or `prebo run --resume DIR`: optimise, then write DIR/result.json
-    (`_result`, energies in Eh) beside the checkpoint DIR/basis.json; warn when the state is not
-    bound in the basis. Returns the exit status 0."""
+    """`prebo run INPUT [--out DIR]` or `prebo run --resume DIR`, either with `--budget SECONDS` (the
+    wall time of the whole run, resumed parts included, in place of the input's or checkpoint's):
+    optimise, then write DIR/result.json (`_result`, energies in Eh) beside the checkpoint
+    DIR/basis.json; warn when the state is not bound in the basis. Returns the exit status 0."""
     from .io.basis_json import write_json_atomic
     from .errors import InputError, StalledError
     from .io import toml
@@ -106,9 +108,10 @@ def cmd_run(args) -> int:
             raise OutputError(f"--out {out}: cannot create the output folder ({exc.strerror})") from exc
     try:
         if args.resume:
-            basis, _ = resume_from(out, progress=not args.quiet)
+            basis, _ = resume_from(out, progress=not args.quiet, budget=args.budget)
         else:
-            basis = optimise(job.system, job.optimiser, out=out, progress=not args.quiet)
+            opts = job.optimiser if args.budget is None else replace(job.optimiser, budget=args.budget)
+            basis = optimise(job.system, opts, out=out, progress=not args.quiet)
     except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
         raise StalledError(f"{source}: {exc}") from exc
     title = title or basis.system.label()
@@ -194,6 +197,17 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"prebo: error: {self.prog}: {message} (see {self.prog} --help)\n")
 
 
+def seconds(text: str) -> float:
+    """A command line's wall time: a finite number of seconds above 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (0.0 < value < float("inf")):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds above 0")
+    return value
+
+
 def parser() -> argparse.ArgumentParser:
     """The `prebo` argument parser with its five subcommands."""
     p = Parser(prog="prebo", description="pre-Born–Oppenheimer ECG solver")
@@ -202,6 +216,9 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("input", nargs="?", help="TOML input file")
     run.add_argument("--out", help="output folder (default runs/INPUT-STEM)")
     run.add_argument("--resume", metavar="DIR", help="continue the run whose checkpoint is DIR/basis.json")
+    run.add_argument("--budget", type=seconds, metavar="SECONDS",
+                     help="wall-time budget of the whole run, resumed parts included; replaces [optimiser] "
+                          "budget, or the checkpoint's with --resume (a run stopped by its budget goes on)")
     run.add_argument("--quiet", action="store_true", help="no progress display")
     run.set_defaults(func=cmd_run)
     en = sub.add_parser("energy", help="re-evaluate a stored basis")

@@ -12,6 +12,7 @@ written atomically after every step: a killed run loses at most the step in flig
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -119,7 +120,10 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     return ex.basis
 
 
-def resume_from(folder: Path, progress: bool = True) -> tuple[Basis, Optimiser]:
-    """Continue the run whose checkpoint is folder/basis.json; the finished basis and its settings."""
+def resume_from(folder: Path, progress: bool = True, budget: float | None = None) -> tuple[Basis, Optimiser]:
+    """Continue the run whose checkpoint is folder/basis.json, with `budget` (seconds of the whole
+    run) in place of the checkpoint's if given; the finished basis and its settings."""
     d, system, opts = load_checkpoint(folder)
+    if budget is not None:
+        opts = replace(opts, budget=budget)
     return optimise(system, opts, out=Path(folder), progress=progress, resume=d), opts
