@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .system import Particle, System
+from .system import Particle, System, reduced_mass
 
 
 @dataclass(frozen=True)
@@ -41,8 +41,7 @@ class Threshold:
 def pair_energy(a: Particle, b: Particle) -> float:
     """−μ (q_a q_b)² / 2 (Eh): the ground-state energy of two attracting particles (q_a q_b < 0) with
     their centre-of-mass motion separated, μ = m_a m_b / (m_a + m_b)."""
-    mu = a.mass * b.mass / (a.mass + b.mass)
-    return -0.5 * mu * (a.charge * b.charge) ** 2
+    return -0.5 * reduced_mass(a.mass, b.mass) * (a.charge * b.charge) ** 2
 
 
 def hydrogen_like(system: System) -> Threshold:

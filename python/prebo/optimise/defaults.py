@@ -26,7 +26,7 @@ import numpy as np
 
 from ..basis import family
 from ..basis.gvr import K_LIMIT
-from ..system import System
+from ..system import System, reduced_mass
 from .settings import Optimiser
 
 #: a particle this many times heavier than the lightest one moves as a nucleus
@@ -43,7 +43,7 @@ def molecular_pair(system: System) -> tuple[int, int] | None:
     """The heaviest pair of nuclei of one charge sign (a molecule's bond), or None (an atom)."""
     m, q = system.masses, system.charges
     like = [(i, j) for i in nuclei(system) for j in nuclei(system) if i < j and q[i] * q[j] > 0]
-    return max(like, key=lambda p: m[p[0]] * m[p[1]] / (m[p[0]] + m[p[1]]), default=None)
+    return max(like, key=lambda p: reduced_mass(m[p[0]], m[p[1]]), default=None)
 
 
 def resolved(opts: Optimiser, system: System) -> Optimiser:
@@ -57,8 +57,7 @@ def resolved(opts: Optimiser, system: System) -> Optimiser:
         K_max = 0
         if "K" in family(kind).shapes and bond is not None:  # a family with powers K
             m = system.masses
-            mu = m[bond[0]] * m[bond[1]] / (m[bond[0]] + m[bond[1]])
-            K_max = min(K_LIMIT, math.ceil(np.sqrt(mu / m.min())))
+            K_max = min(K_LIMIT, math.ceil(np.sqrt(reduced_mass(m[bond[0]], m[bond[1]]) / m.min())))
     channels = opts.channels or ("all" if bond is not None else "pairs")
     trials = opts.trials or (30 if bond is not None else 20)
     schedule = {}

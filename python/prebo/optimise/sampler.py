@@ -22,7 +22,7 @@ import numpy as np
 from .. import coordinates as coords
 from ..basis import Basis, family
 from ..errors import IllConditionedError, InputError
-from ..system import System
+from ..system import System, reduced_mass
 from .parametrisation import Parametrisation
 from .settings import Optimiser
 
@@ -59,7 +59,7 @@ def pair_lengths(system: System) -> tuple[np.ndarray, np.ndarray]:
     partner at all takes 1/(μ_ij max(|q_i q_j|, 1)) for both.
     """
     m, q, n = system.masses, system.charges, system.n
-    mu = np.outer(m, m) / np.add.outer(m, m)
+    mu = reduced_mass(m[:, None], m[None, :])
     a, outer = np.full((n, n), np.inf), np.zeros((n, n))
     for i, j, _ in system.pairs():
         if q[i] * q[j] < 0:

@@ -58,6 +58,11 @@ ALIASES = {"e-": "e", "electron": "e", "positron": "e+", "proton": "p", "deutero
            "triton": "t", "muon": "mu", "mu-": "mu", "helion": "he3", "he4": "alpha"}
 
 
+def reduced_mass(m_a, m_b):
+    """μ = m_a m_b / (m_a + m_b) (m_e) of a pair of particles; elementwise for arrays."""
+    return m_a * m_b / (m_a + m_b)
+
+
 def particle(spec) -> Particle:
     """A particle from a name (`"p"`) or a mapping (`{name, mass?, charge?, spin?}`).
 
