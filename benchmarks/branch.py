@@ -12,6 +12,8 @@ import argparse
 import json
 from pathlib import Path
 
+from prebo.optimise.settings import SETTINGS
+
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -24,7 +26,7 @@ def main() -> None:
     d = json.loads((a.src / "basis.json").read_text())
     for item in a.settings:
         key, value = item.split("=", 1)
-        if key not in d["optimiser"]:
+        if key not in SETTINGS:
             ap.error(f"unknown setting {key!r}")
         d["optimiser"][key] = json.loads(value)
     if a.phase:

@@ -49,6 +49,30 @@ def test_secular_update_equals_full_solve(problem):
     assert e <= sub.energies[0]  # adding a function never raises the lowest eigenvalue
 
 
+@pytest.mark.parametrize("k", [1, 2, 3, 9])
+def test_block_update_equals_full_solve(problem, k):
+    """The lowest root with the last k functions added at once, and its eigenvector (a, β),
+    are the full problem's; k = 1 is the secular update; a block that repeats a function of
+    the basis is linearly dependent (inf)."""
+    _, _, _, m = problem
+    H, S = m["T_ti"] + m["V"], m["S"]
+    n = 10 - k
+    sub = eigen.solve(H[:n, :n], S[:n, :n]) if n else eigen.Eigen(np.zeros(0), np.zeros((0, 0)), 0, 1.0)
+    e, a, beta, norm2 = eigen.lowest_with_block(sub.energies, sub.vectors, H[n:, :n], S[n:, :n], H[n:, n:], S[n:, n:])
+    full = eigen.solve(H, S)
+    assert e == pytest.approx(full.energies[0], rel=1e-12)
+    c = np.concatenate([sub.vectors @ a, beta])
+    assert c @ S @ c == pytest.approx(norm2, rel=1e-12)
+    assert np.allclose(H @ c, e * S @ c, atol=1e-9 * np.sqrt(norm2))
+    if k == 1:
+        assert e == pytest.approx(eigen.lowest_with_added(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9],
+                                                          S[9, 9]), rel=1e-14)
+    if n:
+        dup = [0] + list(range(n + 1, 10))  # function 0 again, with the others of the block
+        assert eigen.lowest_with_block(sub.energies, sub.vectors, H[dup, :n], S[dup, :n], H[np.ix_(dup, dup)],
+                                       S[np.ix_(dup, dup)])[0] == np.inf
+
+
 def test_rows_from_core_agree_with_matrices(problem):
     _, basis, rep, m = problem
     rows, diag = rep.rows(basis.subset([3, 4]), basis)

@@ -27,6 +27,7 @@ trials = 6
 sweeps = 1
 refine = 1
 refine_evaluations = 30
+refine_group = 2
 polish = 2
 polish_iterations = 5
 cycles = 2
@@ -109,6 +110,8 @@ def test_each_phase_has_its_method_configured_by_the_settings():
                      "polish": Polish(9)}
     refined = methods(Optimiser(trials=3, refine=1, refine_evaluations=40, refine_method="powell"))
     assert refined["grow"] == Grow(3, Refinement(40, "powell")) and refined["sweep"].refine == Refinement(40, "powell")
+    grouped = methods(Optimiser(refine=1, refine_evaluations=40, refine_group=2))  # refinement sweeps only
+    assert grouped["refine"] == Refine(Refinement(40, "gradient", 2)) and grouped["sweep"].refine == Refinement(40, "gradient")
     adaptive = methods(resolved(Optimiser(trials=5), he))  # the adaptive schedule refines every new function
     assert adaptive["grow"] == Grow(5, Refinement(30, "gradient")) and adaptive["sweep"] == Sweep(5, Refinement(30, "gradient"))
 

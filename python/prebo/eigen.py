@@ -1,4 +1,4 @@
-"""The generalised eigenproblem H c = E S c and its O(N^2) update for one added function.
+"""The generalised eigenproblem H c = E S c and its O(N^2) update for one or a few added functions.
 
 Solve: functions are scaled to unit self-overlap, then canonical orthogonalisation
 (Löwdin): S = V s V^T, keep s_k > threshold * max(s), X = V_k s_k^{-1/2}, diagonalise
@@ -14,6 +14,15 @@ below E_0 of f(x) = h' - x - Σ γ_k^2 / (E_k - x), strictly decreasing there.
 Gradient (Hellmann–Feynman for the augmented problem): at the root e the eigenvector is
 c = (C a, 1) with a_k = -(b_k - e d_k)/(E_k - e); when only the new function's parameters move,
 de = [2 (C a)·(dh - e ds) + dh_nn - e ds_nn] / (|a|^2 + 2 a·d + s_nn).
+
+Block update (a few functions at once, `lowest_with_block`): with rows h, s (k x N) of k new
+functions and their k x k blocks H_ff, S_ff, the Schur complement of the eigenbasis in H - x S is
+M(x) = H_ff - x S_ff - G diag(1/(E - x)) G^T, G = (h - x s) C. Below E_0 the block E - x is
+positive, so by Sylvester's law of inertia the number of eigenvalues below x is the number of
+negative eigenvalues of M(x): the lowest root is found by bisection to the last bit. Its
+eigenvector is c = (C a, β), β the null vector of M, a = -G^T β / (E - x); moving the parameters
+of function m alone, de = [2 β_m (dh_m - e ds_m)·(C a) + 2 β_m Σ_{o≠m} β_o (dH_mo - e dS_mo)
++ β_m^2 (dH_mm - e dS_mm)] / c^T S c.
 
 Refinement: LAPACK's eigenvalues of an ill-conditioned basis depend on the BLAS kernel (1e-8
 relative at an overlap condition of 5e12), so `solve` refines the lowest root(s) in the Rust core
@@ -41,6 +50,7 @@ import contextlib
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 from threadpoolctl import ThreadpoolController
 
 from . import _core
@@ -161,6 +171,51 @@ def lowest_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min
     c_old = C @ a
     norm2 = a @ a + 2.0 * a @ d + s_nn
     return e, (2.0 * (dh - e * ds) @ c_old + dh_nn - e * ds_nn) / norm2
+
+
+def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10):
+    """Lowest eigenvalue after adding k functions at once (module docstring, block update), with its
+    eigenvector: (e, a, β, norm2), a over the eigenvectors C, β over the new functions, norm2 =
+    c^T S c. h, s: (k x nb) rows against the basis; H_ff, S_ff: (k x k) among the new functions.
+    (inf, None, None, None) when the block is linearly dependent on the basis (the smallest
+    eigenvalue of its orthogonal part S_ff - D D^T, D = s C, below `min_norm` of its diagonal) or
+    lowers nothing."""
+    if len(E) == 0:  # nothing else in the basis: the k x k problem itself
+        w, V = scipy.linalg.eigh(H_ff, S_ff)
+        return float(w[0]), np.zeros(0), V[:, 0], float(V[:, 0] @ S_ff @ V[:, 0])
+    D, B = s @ C, h @ C
+    scale = 1.0 / np.sqrt(np.diag(S_ff))
+    orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
+    if not np.all(np.isfinite(orthogonal)) or np.linalg.eigvalsh(orthogonal)[0] < min_norm:
+        return np.inf, None, None, None
+
+    def schur(x):
+        G = B - x * D
+        return H_ff - x * S_ff - (G / (E - x)) @ G.T, G
+
+    def below(x):  # whether an eigenvalue lies below x (x < E_0)
+        return np.linalg.eigvalsh(schur(x)[0])[0] < 0
+
+    hi, lo = np.nextafter(E[0], -np.inf), E[0] - 1.0
+    for _ in range(64):  # a lower bound: M(lo) positive definite (the orthogonal part is)
+        if not below(lo):
+            break
+        lo -= 2.0 * abs(lo) + 1.0
+    else:
+        return np.inf, None, None, None
+    if not below(hi):
+        return np.inf, None, None, None
+    for _ in range(2100):  # bisection to adjacent doubles
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        lo, hi = (lo, mid) if below(mid) else (mid, hi)
+    e = hi
+    M, G = schur(e)
+    beta = np.linalg.eigh(M)[1][:, 0]
+    a = -(beta @ G) / (E - e)
+    norm2 = a @ a + 2.0 * a @ (D.T @ beta) + beta @ S_ff @ beta
+    return float(e), a, beta, float(norm2)
 
 
 def lowest_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10) -> np.ndarray:

@@ -109,6 +109,24 @@ class Expansion:
         function's oriented row (`Representation.rows` with position i) or else rebuilt, so that
         the state is a function of the basis alone and a resumed run continues bit for bit."""
         before = self._snapshot()
+        self._place(i, f, row, d)
+        self.solve()
+        return self._keep_if_lower(before)
+
+    def put_group(self, idx: list[int], fs: list[Basis]) -> bool:
+        """Replace the functions `idx` by `fs` (one-function bases) at once if that lowers the
+        energy beyond the uncertainty; True if it did. Rows are patched one function after the
+        other, each against the basis with the ones before it in place (as `put`)."""
+        before = self._snapshot()
+        for i, f in zip(idx, fs):
+            rows, diag = self.rep.rows(f, self.basis, i)
+            self._place(i, f, {k: v[0] for k, v in rows.items()}, diag[0])
+        self.solve()
+        return self._keep_if_lower(before)
+
+    def _place(self, i: int, f: Basis, row: dict | None, d) -> None:
+        """Append (i == len) or replace function i by `f`, the matrices patched from its row and
+        diagonal `d` (S, T, T_ti, V), or rebuilt without them or for a family that is not oriented."""
         nb = len(self.basis)
         if i == nb:
             self.basis.append(f)
@@ -130,5 +148,3 @@ class Expansion:
                     r[i] = values[k]
                     self.m[k][i, :] = r
                     self.m[k][:, i] = r
-        self.solve()
-        return self._keep_if_lower(before)

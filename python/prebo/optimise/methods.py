@@ -11,7 +11,8 @@
   peak of the global-vector coordinate kept; refinement cannot change K) and random functions;
   with `refine`, the winner is refined and kept only if it then beats the incumbent, which is
   refined otherwise (refine.regenerate_function).
-- `Refine`: one step of a refinement sweep, function i refined with all others fixed (refine.py).
+- `Refine`: one step of a refinement sweep, function i refined with all others fixed, or with the
+  functions it overlaps most (`refine_group`; refine.py).
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
 Replacements reach new basins, joint refinement converges within one; the sweep-refine-polish
 block is repeated `cycles` times (Optimiser), or the adaptive schedule chooses among them
@@ -28,7 +29,7 @@ from ..errors import StalledError
 from .checkpoint import Cursor
 from .expansion import Expansion
 from .polish import polish
-from .refine import refine_function, regenerate_function
+from .refine import refine_function, refine_group, regenerate_function
 from .report import Reporter
 from .sampler import Sampler
 from .settings import Optimiser
@@ -50,10 +51,12 @@ class Run:
 @dataclass(frozen=True)
 class Refinement:
     """The refinement of one function: at most `evaluations` energies by `method` ("gradient":
-    L-BFGS on exact gradients, or "powell")."""
+    L-BFGS on exact gradients, or "powell"); in a refinement sweep, together with the `group` - 1
+    functions it overlaps most (refine.refine_group)."""
 
     evaluations: int
     method: str
+    group: int = 1
 
 
 @dataclass(frozen=True)
@@ -122,7 +125,10 @@ class Refine:
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
         run.report.trials(1)
-        refine_function(run.expansion, cursor.index, self.refine.evaluations, self.refine.method)
+        if self.refine.group > 1:
+            refine_group(run.expansion, cursor.index, self.refine.group, self.refine.evaluations)
+        else:
+            refine_function(run.expansion, cursor.index, self.refine.evaluations, self.refine.method)
 
 
 @dataclass(frozen=True)
@@ -140,7 +146,7 @@ def methods(opts: Optimiser) -> dict:
     """The method of each phase of the schedule, configured by `opts` (defaults.resolved): in an
     adaptive schedule, and in a fixed one with `refine`, every grown and replacing function is
     refined."""
-    refinement = Refinement(opts.refine_evaluations, opts.refine_method)
-    on_change = refinement if opts.adaptive or opts.refine else None  # refine grown and replacing functions too
+    refinement = Refinement(opts.refine_evaluations, opts.refine_method, opts.refine_group)
+    on_change = Refinement(opts.refine_evaluations, opts.refine_method) if opts.adaptive or opts.refine else None  # refine grown and replacing functions too
     return {"grow": Grow(opts.trials, on_change), "sweep": Sweep(opts.trials, on_change),
             "refine": Refine(refinement), "polish": Polish(opts.polish_iterations)}

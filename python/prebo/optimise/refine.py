@@ -8,6 +8,12 @@ function: one row of integrals and O(N_b^2) per evaluation.
 Two minimisers: Powell's method on the energy (the paper's), and L-BFGS on the energy and its
 exact gradient — the row's derivatives along ∂(A, u or s)/∂θ_p by forward-mode dual numbers
 in the Rust core (Representation.row_gradient), then eigen.lowest_with_added_gradient.
+
+A group (`refine_group`): function i and the functions it overlaps most (`partners`) move
+together, L-BFGS on all their θ, the energy the lowest root of the block update against the
+basis without them (eigen.lowest_with_block). Strongly overlapping functions of an optimised
+basis act together (a near-duplicate pair is a derivative of a Gaussian): moved one at a time,
+each is held by the other.
 """
 from __future__ import annotations
 
@@ -85,14 +91,109 @@ class Objective:
         return e, g
 
 
+class GroupObjective:
+    """The energy as a function of the θ of functions `idx` (concatenated), all others fixed: the
+    lowest root of the block update against the basis without them, and its exact gradient.
+    Remembers the best group seen (`best_E`, `best_f`: one-function bases in the order of idx);
+    outside the valid region it scores `worse`, like `Objective`."""
+
+    def __init__(self, expansion, idx: list[int]):
+        self.expansion, self.idx = expansion, list(idx)
+        basis = expansion.basis
+        keep = np.ones(len(basis), bool)
+        keep[self.idx] = False
+        H = expansion.m["T_ti"] + expansion.m["V"]
+        sub = eigen.solve(H[np.ix_(keep, keep)], expansion.m["S"][np.ix_(keep, keep)], expansion.threshold)
+        self.E, self.C = sub.energies, sub.vectors
+        self.rest = basis.subset(np.flatnonzero(keep))
+        self.S_rest = np.diag(expansion.m["S"])[keep]
+        self.p = [Parametrisation.of(basis.subset([i])) for i in self.idx]
+        self.split = np.cumsum([len(p.theta()) for p in self.p])[:-1]
+        self.worse = expansion.energy + 1.0
+        self.best_E, self.best_f = expansion.energy, None
+
+    def theta(self) -> np.ndarray:
+        """The θ of the group's functions, concatenated."""
+        return np.concatenate([p.theta() for p in self.p])
+
+    def energy_and_gradient(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
+        """The lowest energy (hartree) with the group at θ and ∂E/∂θ (eigen module docstring)."""
+        st, k, nr = self.expansion, len(self.p), len(self.rest)
+        thetas = np.split(theta, self.split)
+        try:
+            fs = [p.function(t) for p, t in zip(self.p, thetas)]
+            rows = []
+            for m, (p, t) in enumerate(zip(self.p, thetas)):  # member m against the rest, then the others
+                others = Basis.concat([self.rest] + fs[:m] + fs[m + 1:])
+                rows.append(st.rep.row_gradient(fs[m], *p.directions(t), others))
+        except PreboError:
+            return self.worse, np.zeros_like(theta)
+        if not all(st.rep.plausible({"S": r["S"][:1, :nr]}, d[:1], self.S_rest)[0] for r, d in rows):
+            return self.worse, np.zeros_like(theta)
+        X = [({"H": r["T_ti"] + r["V"], "S": r["S"]}, {"H": d[:, 2] + d[:, 3], "S": d[:, 0]}) for r, d in rows]
+        h = np.array([x["H"][0, :nr] for x, _ in X])
+        s = np.array([x["S"][0, :nr] for x, _ in X])
+        others = [[o for o in range(k) if o != m] for m in range(k)]  # column nr + c of member m is others[m][c]
+        block = {}
+        for key in ("H", "S"):
+            B = np.diag([dg[key][0] for _, dg in X])
+            for m in range(k):
+                for c, o in enumerate(others[m]):
+                    if m < o:
+                        B[m, o] = B[o, m] = X[m][0][key][0, nr + c]
+            block[key] = B
+        e, a, beta, norm2 = eigen.lowest_with_block(self.E, self.C, h, s, block["H"], block["S"], st.min_norm)
+        if not np.isfinite(e):
+            return self.worse, np.zeros_like(theta)
+        c_rest = self.C @ a
+        grad = []
+        for m, (x, dg) in enumerate(X):
+            dX = x["H"][1:] - e * x["S"][1:]
+            g = 2.0 * beta[m] * (dX[:, :nr] @ c_rest + dX[:, nr:] @ beta[others[m]])
+            grad.append((g + beta[m] ** 2 * (dg["H"][1:] - e * dg["S"][1:])) / norm2)
+        grad = np.concatenate(grad)
+        if not np.all(np.isfinite(grad)):
+            return self.worse, np.zeros_like(theta)
+        if e < self.best_E:
+            self.best_E, self.best_f = e, fs
+        return e, grad
+
+
+def partners(expansion, i: int, count: int) -> list[int]:
+    """The `count` functions with the largest normalised overlap |S_ij| / (S_ii S_jj)^½ with
+    function i (a function of the basis alone)."""
+    S = expansion.m["S"]
+    overlap = np.abs(S[i]) / np.sqrt(S[i, i] * np.diag(S))
+    overlap[i] = -1.0
+    return [int(j) for j in np.argsort(-overlap, kind="stable")[:count]]
+
+
+def refine_group(expansion, i: int, size: int, max_evaluations: int = 200) -> bool:
+    """Refine function i together with its `size` - 1 `partners` (module docstring) by L-BFGS with
+    exact gradients, with at most `max_evaluations` energies; True if the energy fell beyond its
+    uncertainty (Expansion.put_group)."""
+    if size == 1 or len(expansion.basis) < 2:
+        return refine_function(expansion, i, max_evaluations)
+    obj = GroupObjective(expansion, [i] + partners(expansion, i, min(size, len(expansion.basis)) - 1))
+    lbfgs(obj.energy_and_gradient, obj.theta(), max_evaluations)
+    if obj.best_f is None or not expansion.gains(obj.best_E):
+        return False
+    return expansion.put_group(obj.idx, obj.best_f)
+
+
+def lbfgs(energy_and_gradient, theta0: np.ndarray, max_evaluations: int) -> None:
+    """L-BFGS from θ0 on an objective returning (E, ∂E/∂θ), at most `max_evaluations` energies."""
+    minimize(energy_and_gradient, theta0, jac=True, method="L-BFGS-B",
+             options={"maxfun": max_evaluations, "maxiter": max_evaluations, "ftol": 1e-16, "gtol": 1e-12,
+                      "maxcor": 20})
+
+
 def minimise(obj: Objective, max_evaluations: int, method: str) -> None:
     """Powell's method, or L-BFGS with exact gradients, from the objective's function, with at
     most `max_evaluations` energies; the best function seen is kept in the objective."""
     theta0 = obj.p.theta()
     if method == "gradient":
-        minimize(obj.energy_and_gradient, theta0, jac=True, method="L-BFGS-B",
-                 options={"maxfun": max_evaluations, "maxiter": max_evaluations, "ftol": 1e-16, "gtol": 1e-12,
-                          "maxcor": 20})
+        lbfgs(obj.energy_and_gradient, theta0, max_evaluations)
     else:
         minimize(obj.energy, theta0, method="Powell",
                  options={"maxfev": max_evaluations, "xtol": 1e-4, "ftol": 1e-14, "direc": 0.1 * np.eye(len(theta0))})
