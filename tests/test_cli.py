@@ -138,6 +138,9 @@ def test_plot_draws_the_convergence_of_runs(run_dir, tmp_path):
     r = prebo("plot", run_dir, "--since", middle, "--out", png)
     assert r.returncode == 0, r.stderr
     assert_clean_error(prebo("plot", run_dir, "--since", -1.0, "--out", png), "nothing in its history at or before -1 s")
+    for option in ("--reference", "--since"):  # a NaN or infinite number is refused, not drawn
+        for bad in ("nan", "inf", "-inf", "x"):
+            assert_clean_error(prebo("plot", run_dir, f"{option}={bad}", "--out", png), option, "not a finite number")
 
 
 def test_plot_since_starts_each_run_from_its_state_at_that_moment():

@@ -197,13 +197,24 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"prebo: error: {self.prog}: {message} (see {self.prog} --help)\n")
 
 
-def seconds(text: str) -> float:
-    """A command line's wall time: a finite number of seconds above 0."""
+def finite(text: str) -> float:
+    """A command line's number: finite (no NaN, no infinity)."""
     try:
         value = float(text)
     except ValueError:
         value = float("nan")
-    if not (0.0 < value < float("inf")):
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value
+
+
+def seconds(text: str) -> float:
+    """A command line's wall time: a finite number of seconds above 0."""
+    try:
+        value = finite(text)
+    except argparse.ArgumentTypeError:
+        value = 0.0
+    if not value > 0.0:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds above 0")
     return value
 
@@ -243,8 +254,8 @@ def parser() -> argparse.ArgumentParser:
     ex.set_defaults(func=cmd_export)
     pl = sub.add_parser("plot", help="energy against basis size of one or more runs (PNG)")
     pl.add_argument("runs", nargs="+", type=Path, help="run folders (with basis.json checkpoints)")
-    pl.add_argument("--reference", type=float, help="exact energy: plot E - E_ref on a log axis")
-    pl.add_argument("--since", type=float, metavar="SECONDS",
+    pl.add_argument("--reference", type=finite, help="exact energy: plot E - E_ref on a log axis")
+    pl.add_argument("--since", type=finite, metavar="SECONDS",
                     help="only the wall time from then on, against time (runs branched from one checkpoint)")
     pl.add_argument("--out", type=Path, help="PNG file (default FIRST-RUN/convergence.png)")
     pl.set_defaults(func=cmd_plot)
