@@ -96,18 +96,20 @@ def test_group_energy_and_gradient_match_a_full_solve_and_finite_differences(cas
     assert np.max(np.abs(g - fd)) < 1e-7 * np.max(np.abs(g)), (g, fd)
 
 
-def test_group_refinement_lowers_the_energy_and_keeps_the_matrices_exact():
+def test_partners_are_the_functions_of_largest_normalised_overlap():
     system, basis, _, _ = setup("gvr-H2+", nb=15)
     st = Expansion(basis, laboratory(system), 1e-13)
+    S = st.m["S"]
+    assert partners(st, 3, 2) == [int(j) for j in np.argsort(-np.abs(S[3]) / np.sqrt(S[3, 3] * np.diag(S)))[1:3]]
+
+
+def test_a_group_as_large_as_the_basis_is_refined_whole():
+    """refine_group larger than the basis: every function moves at once against an empty rest."""
+    system, basis, _, _ = setup("pecg-H2+", nb=3)
+    st = Expansion(basis, laboratory(system), 1e-13)
     before = st.energy
-    assert partners(st, 3, 2) == [int(j) for j in np.argsort(-np.abs(st.m["S"][3]) / np.sqrt(
-        st.m["S"][3, 3] * np.diag(st.m["S"])))[1:3]]
-    improved = [refine_group(st, i, 2, 40) for i in range(4)]
-    assert any(improved) and st.energy < before
-    fresh = st.rep.matrices(st.basis)
-    for k in fresh:
-        assert np.array_equal(fresh[k], st.m[k]), k
-    assert st.energy == eigen.solve(fresh["T_ti"] + fresh["V"], fresh["S"], 1e-13).energies[0]
+    assert refine_group(st, 0, 6, 40) and st.energy < before
+    assert_matrices_exact(st)
 
 
 @pytest.mark.parametrize("count", [5, 7, 11, 20])
@@ -127,16 +129,23 @@ def test_any_number_of_directions_gives_the_same_derivatives(count):
     assert np.allclose(diag_r[1:], R @ diag[1:], rtol=1e-10, atol=1e-13)
 
 
-def test_gradient_refinement_lowers_the_energy_and_keeps_the_matrices_exact():
-    system, basis, p, theta = setup("gvr-H2+", nb=15)
-    st = Expansion(basis, laboratory(system), 1e-13)
-    before = st.energy
-    improved = [refine_function(st, i, 40, "gradient") for i in range(4)]
-    assert any(improved) and st.energy < before
+def assert_matrices_exact(st):
+    """The expansion's matrices have the bits of a rebuild and its energy is their eigenvalue."""
     fresh = st.rep.matrices(st.basis)
     for k in fresh:
         assert np.array_equal(fresh[k], st.m[k]), k
     assert st.energy == eigen.solve(fresh["T_ti"] + fresh["V"], fresh["S"], 1e-13).energies[0]
+
+
+@pytest.mark.parametrize("refine", [lambda st, i: refine_function(st, i, 40, "gradient"),
+                                    lambda st, i: refine_group(st, i, 2, 40)], ids=["one", "pairs"])
+def test_gradient_refinement_lowers_the_energy_and_keeps_the_matrices_exact(refine):
+    system, basis, p, theta = setup("gvr-H2+", nb=15)
+    st = Expansion(basis, laboratory(system), 1e-13)
+    before = st.energy
+    improved = [refine(st, i) for i in range(4)]
+    assert any(improved) and st.energy < before
+    assert_matrices_exact(st)
 
 
 def test_regeneration_keeps_the_better_of_refined_newcomer_and_incumbent():
@@ -163,9 +172,7 @@ def test_regeneration_keeps_the_better_of_refined_newcomer_and_incumbent():
     refine_function(refined, i, 5)
     assert regenerated.energy < refined.energy
     assert regenerated.basis.K[i] == good.K[0]
-    fresh = rep.matrices(regenerated.basis)
-    for k in fresh:
-        assert np.array_equal(fresh[k], regenerated.m[k]), k
+    assert_matrices_exact(regenerated)
 
 
 def test_unknown_refine_method_is_refused():
@@ -229,6 +236,4 @@ def test_polish_lowers_the_energy_and_leaves_a_consistent_state():
     st = Expansion(basis, laboratory(system), 1e-13)
     before = st.energy
     assert polish(st, 15) and st.energy < before
-    fresh = st.rep.matrices(st.basis)
-    for k in fresh:
-        assert np.array_equal(fresh[k], st.m[k]), k
+    assert_matrices_exact(st)

@@ -66,9 +66,11 @@ class Expansion:
         self.solve()
         return self._keep_if_lower(before)
 
-    def without(self, i: int):
-        """The eigen-solution of the basis without function i (None if that leaves nothing)."""
-        keep = np.arange(len(self.basis)) != i
+    def without(self, i):
+        """The eigen-solution of the basis without function i, or without the functions of the
+        list i (None if that leaves nothing)."""
+        keep = np.ones(len(self.basis), bool)
+        keep[i] = False
         if not keep.any():
             return None
         H = self.m["T_ti"] + self.m["V"]

@@ -125,10 +125,7 @@ class Refine:
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
         run.report.trials(1)
-        if self.refine.group > 1:
-            refine_group(run.expansion, cursor.index, self.refine.group, self.refine.evaluations)
-        else:
-            refine_function(run.expansion, cursor.index, self.refine.evaluations, self.refine.method)
+        refine_group(run.expansion, cursor.index, self.refine.group, self.refine.evaluations, self.refine.method)
 
 
 @dataclass(frozen=True)

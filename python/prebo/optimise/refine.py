@@ -102,9 +102,8 @@ class GroupObjective:
         basis = expansion.basis
         keep = np.ones(len(basis), bool)
         keep[self.idx] = False
-        H = expansion.m["T_ti"] + expansion.m["V"]
-        sub = eigen.solve(H[np.ix_(keep, keep)], expansion.m["S"][np.ix_(keep, keep)], expansion.threshold)
-        self.E, self.C = sub.energies, sub.vectors
+        sub = expansion.without(self.idx)
+        self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
         self.rest = basis.subset(np.flatnonzero(keep))
         self.S_rest = np.diag(expansion.m["S"])[keep]
         self.p = [Parametrisation.of(basis.subset([i])) for i in self.idx]
@@ -168,12 +167,12 @@ def partners(expansion, i: int, count: int) -> list[int]:
     return [int(j) for j in np.argsort(-overlap, kind="stable")[:count]]
 
 
-def refine_group(expansion, i: int, size: int, max_evaluations: int = 200) -> bool:
+def refine_group(expansion, i: int, size: int, max_evaluations: int = 200, method: str = "gradient") -> bool:
     """Refine function i together with its `size` - 1 `partners` (module docstring) by L-BFGS with
     exact gradients, with at most `max_evaluations` energies; True if the energy fell beyond its
-    uncertainty (Expansion.put_group)."""
+    uncertainty (Expansion.put_group). A group of one is `refine_function` by `method`."""
     if size == 1 or len(expansion.basis) < 2:
-        return refine_function(expansion, i, max_evaluations)
+        return refine_function(expansion, i, max_evaluations, method)
     obj = GroupObjective(expansion, [i] + partners(expansion, i, min(size, len(expansion.basis)) - 1))
     lbfgs(obj.energy_and_gradient, obj.theta(), max_evaluations)
     if obj.best_f is None or not expansion.gains(obj.best_E):
