@@ -18,7 +18,7 @@ ACCEPTANCE = {
     "h-": ("H-", 1e-5),
     "h2plus-pecg": ("H2+", None),
     "h2plus-gvr": ("H2+", 5.2e-9),  # issue 4 run: 4.6e-9 above the reference with 180 functions
-    "h2plus-fecg": ("H2+", None),
+    "h2plus-fecg": ("H2+", 5e-5),  # 4.72e-5 above after 1200 s of the defaults (benchmarks/README)
     "h2-pecg": ("H2", None),
     # inputs without an [optimiser] table (examples/auto, issue 17: within 1e-6 relative)
     "auto-h": ("H", "rel:1e-6"),
@@ -82,10 +82,11 @@ def test_h2plus_gvr_basis_meets_the_issue_targets():
 
 
 def test_h2plus_fecg_basis_meets_the_issue_target_and_reports_n2():
-    """At most 400 floating ECGs, E_TI <= -0.59700 Eh, <N²>_TI reported."""
+    """At most 400 floating ECGs, E_TI <= -0.59704 Eh (issue 16; the paper's Table 1: -0.597006 …
+    -0.597044), <N²>_TI reported and small: the N = 0 state is restored by the optimisation."""
     r = energy(BASES / "h2plus-fecg" / "basis.json")
     assert r["n_basis"] <= 400 and r["basis_type"] == "fecg"
-    assert r["energy"] <= -0.59700 and r["n2"] >= 0.0
+    assert r["energy"] <= -0.59704 and 0.0 <= r["n2"] < 1e-3
 
 
 #: the two evaluation paths, with the eigenvalues refined in extended precision, agree to 2e-15
