@@ -11,7 +11,7 @@ import pytest
 import prebo
 from prebo.optimise import Cursor, Optimiser, resume_from
 from prebo.optimise.convergence import convergence
-from prebo.optimise.defaults import resolved
+from prebo.optimise.defaults import GROUP, resolved
 from prebo.optimise.sampler import pair_lengths
 from prebo.optimise.schedule import CHUNK, RATIO, Adaptive
 
@@ -42,9 +42,11 @@ def test_explicit_settings_override_and_any_schedule_setting_fixes_the_schedule(
     opts = resolved(Optimiser(kind="pecg", channels="pairs", trials=7, K_max=2), h2)
     assert (opts.kind, opts.channels, opts.trials, opts.K_max) == ("pecg", "pairs", 7, 2)
     assert opts.adaptive and opts.refine_evaluations == 30 and opts.sweeps is None
+    assert opts.refine_group == GROUP > 1  # the adaptive refinement passes move groups
     fixed = resolved(Optimiser(refine=2), h2)
     assert not fixed.adaptive and (fixed.sweeps, fixed.refine, fixed.polish, fixed.cycles) == (0, 2, 0, 1)
-    assert fixed.refine_evaluations == 200
+    assert fixed.refine_evaluations == 200 and fixed.refine_group == 1
+    assert resolved(Optimiser(refine_group=1), h2).refine_group == 1  # given, it stays
     assert resolved(fixed, h2) == fixed and resolved(opts, h2) == opts  # a checkpoint's settings stay
 
 

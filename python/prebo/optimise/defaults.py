@@ -14,6 +14,9 @@ None), from the physics of the particles:
   coordinates reach the vibrating nuclei), the particle pairs otherwise;
 - trials per step: 20, or 30 for molecules; refine_evaluations: 30 in the adaptive schedule
   (L-BFGS converges a function in 15–40 energies, benchmarks/README), 200 in a fixed one;
+- refine_group: GROUP in the adaptive schedule, whose refinement passes then move each function
+  with the GROUP − 1 it overlaps most (near-duplicate partners hold a lone function in place;
+  benchmarks/README, "The H2 campaign" and issue 17's rows), 1 in a fixed one;
 - the schedule: adaptive (schedule.py) when none of sweeps, refine, polish, cycles is given,
   else the fixed schedule with the missing ones at 0, 0, 0 and 1.
 """
@@ -29,6 +32,8 @@ from ..basis.gvr import K_LIMIT
 from ..system import System, reduced_mass
 from .settings import Optimiser
 
+#: functions an adaptive refinement pass moves together (module docstring)
+GROUP = 3
 #: a particle this many times heavier than the lightest one moves as a nucleus
 HEAVY = 100.0
 
@@ -65,5 +70,6 @@ def resolved(opts: Optimiser, system: System) -> Optimiser:
         schedule = {k: (v if (v := getattr(opts, k)) is not None else d)
                     for k, d in (("sweeps", 0), ("refine", 0), ("polish", 0), ("cycles", 1))}
     evaluations = opts.refine_evaluations or (30 if opts.adaptive else 200)
+    group = opts.refine_group or (GROUP if opts.adaptive else 1)
     return replace(opts, kind=kind, K_max=K_max, channels=channels, trials=trials, refine_evaluations=evaluations,
-                   **schedule)
+                   refine_group=group, **schedule)

@@ -42,7 +42,7 @@ SETTINGS = {
     "refine_evaluations": Setting(Automatic(Integer(1)), "energies per refinement of one function",
                                   "[optimiser] refine_evaluations"),
     "refine_method": Setting(Choice(REFINE_METHODS), "refinement minimiser", "[optimiser] refine_method"),
-    "refine_group": Setting(Integer(1, 8), "functions a refinement sweep moves together: each with those it "
+    "refine_group": Setting(Automatic(Integer(1, 8)), "functions a refinement sweep moves together: each with those it "
                             "overlaps most (L-BFGS on exact gradients)", "[optimiser] refine_group"),
     "polish": Setting(Automatic(Integer(0)), "joint refinement steps per cycle", "[optimiser] polish"),
     "polish_iterations": Setting(Integer(1), "L-BFGS iterations per joint step", "[optimiser] polish_iterations"),
@@ -97,7 +97,8 @@ class Optimiser:
     the sweep-refine-polish block; `budget` still stops it. refine_evaluations — energies per
     refinement of one function; refine_method — "gradient" (L-BFGS, exact gradients) or
     "powell"; refine_group — functions a refinement sweep moves together (1: one at a time; k: each
-    with the k - 1 it overlaps most, always by L-BFGS); polish_iterations — iterations per joint step.
+    with the k - 1 it overlaps most, always by L-BFGS; chosen by the schedule when not given);
+    polish_iterations — iterations per joint step.
     Linear dependence: min_norm — smallest part of a trial orthogonal to the basis, relative to
     its norm; max_overlap — largest normalised overlap of a trial with a function; threshold —
     relative overlap eigenvalue below which eigen.solve drops directions.
@@ -115,7 +116,7 @@ class Optimiser:
     refine: int | None = None
     refine_evaluations: int | None = None
     refine_method: str = "gradient"
-    refine_group: int = 1
+    refine_group: int | None = None
     polish: int | None = None
     polish_iterations: int = 20
     cycles: int | None = None
