@@ -71,6 +71,9 @@ def test_block_update_equals_full_solve(problem, k):
         dup = [0] + list(range(n + 1, 10))  # function 0 again, with the others of the block
         assert eigen.lowest_with_block(sub.energies, sub.vectors, H[dup, :n], S[dup, :n], H[np.ix_(dup, dup)],
                                        S[np.ix_(dup, dup)])[0] == np.inf
+    twice = [9, 9]  # with nothing else in the basis too (a group as large as the basis)
+    assert eigen.lowest_with_block(np.zeros(0), np.zeros((0, 0)), np.zeros((2, 0)), np.zeros((2, 0)),
+                                   H[np.ix_(twice, twice)], S[np.ix_(twice, twice)])[0] == np.inf
 
 
 def test_rows_from_core_agree_with_matrices(problem):

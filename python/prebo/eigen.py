@@ -180,14 +180,14 @@ def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10):
     (inf, None, None, None) when the block is linearly dependent on the basis (the smallest
     eigenvalue of its orthogonal part S_ff - D D^T, D = s C, below `min_norm` of its diagonal) or
     lowers nothing."""
-    if len(E) == 0:  # nothing else in the basis: the k x k problem itself
-        w, V = scipy.linalg.eigh(H_ff, S_ff)
-        return float(w[0]), np.zeros(0), V[:, 0], float(V[:, 0] @ S_ff @ V[:, 0])
     D, B = s @ C, h @ C
     scale = 1.0 / np.sqrt(np.diag(S_ff))
     orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
     if not np.all(np.isfinite(orthogonal)) or np.linalg.eigvalsh(orthogonal)[0] < min_norm:
         return np.inf, None, None, None
+    if len(E) == 0:  # nothing else in the basis: the k x k problem itself (S_ff positive definite)
+        w, V = scipy.linalg.eigh(H_ff, S_ff)
+        return float(w[0]), np.zeros(0), V[:, 0], float(V[:, 0] @ S_ff @ V[:, 0])
 
     def schur(x):
         G = B - x * D
