@@ -76,6 +76,30 @@ def test_block_update_equals_full_solve(problem, k):
                                    H[np.ix_(twice, twice)], S[np.ix_(twice, twice)])[0] == np.inf
 
 
+@pytest.mark.parametrize("k", [1, 3])
+def test_block_root_is_a_flip_of_the_inertia_wherever_newton_starts(problem, k):
+    """The root is a double where the count of eigenvalues below x changes (bisection to the last
+    bit), from any start of Newton's method — the root itself, above it, far below, or no start —
+    and the starts agree to the rounding of that count near the root (a few ulp)."""
+    _, _, _, m = problem
+    H, S = m["T_ti"] + m["V"], m["S"]
+    n = 10 - k
+    sub = eigen.solve(H[:n, :n], S[:n, :n])
+    E, C = sub.energies, sub.vectors
+    D, B = S[n:, :n] @ C, H[n:, :n] @ C
+
+    def lowest(x):  # the lowest eigenvalue of the Schur complement M(x) (eigen module docstring)
+        G = B - x * D
+        return np.linalg.eigvalsh(H[n:, n:] - x * S[n:, n:] - (G / (E - x)) @ G.T)[0]
+
+    args = (E, C, H[n:, :n], S[n:, :n], H[n:, n:], S[n:, n:])
+    e = eigen.lowest_with_block(*args)[0]
+    for near in (None, e, e + 1e-9, 0.5 * (e + E[0]), e - 1e-3, e - 10.0, E[0] + 1.0):
+        root = eigen.lowest_with_block(*args, near=near)[0]
+        assert lowest(root) < 0 <= lowest(np.nextafter(root, -np.inf))
+        assert abs(root - e) <= 8 * np.spacing(abs(e))
+
+
 def test_rows_from_core_agree_with_matrices(problem):
     _, basis, rep, m = problem
     rows, diag = rep.rows(basis.subset([3, 4]), basis)

@@ -19,8 +19,9 @@ Block update (a few functions at once, `lowest_with_block`): with rows h, s (k x
 functions and their k x k blocks H_ff, S_ff, the Schur complement of the eigenbasis in H - x S is
 M(x) = H_ff - x S_ff - G diag(1/(E - x)) G^T, G = (h - x s) C. Below E_0 the block E - x is
 positive, so by Sylvester's law of inertia the number of eigenvalues below x is the number of
-negative eigenvalues of M(x): the lowest root is found by bisection to the last bit. Its
-eigenvector is c = (C a, β), β the null vector of M, a = -G^T β / (E - x); moving the parameters
+negative eigenvalues of M(x): the lowest root is the zero of λ(x), the lowest eigenvalue of M(x),
+which falls strictly (λ' = v^T M' v = -c^T S c for its eigenvector v), found by Newton's method
+kept inside a bracket and finished by bisection to the last bit. Its eigenvector is c = (C a, β), β the null vector of M, a = -G^T β / (E - x); moving the parameters
 of function m alone, de = [2 β_m (dh_m - e ds_m)·(C a) + 2 β_m Σ_{o≠m} β_o (dH_mo - e dS_mo)
 + β_m^2 (dH_mm - e dS_mm)] / c^T S c.
 
@@ -173,13 +174,15 @@ def lowest_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min
     return e, (2.0 * (dh - e * ds) @ c_old + dh_nn - e * ds_nn) / norm2
 
 
-def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10):
+def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: float | None = None):
     """Lowest eigenvalue after adding k functions at once (module docstring, block update), with its
     eigenvector: (e, a, β, norm2), a over the eigenvectors C, β over the new functions, norm2 =
     c^T S c. h, s: (k x nb) rows against the basis; H_ff, S_ff: (k x k) among the new functions.
     (inf, None, None, None) when the block is linearly dependent on the basis (the smallest
     eigenvalue of its orthogonal part S_ff - D D^T, D = s C, below `min_norm` of its diagonal) or
-    lowers nothing."""
+    lowers nothing. `near`: an estimate of the root, where Newton's method starts (the energy
+    before the block changed); the root found depends on it only where rounding blurs the sign of
+    M's lowest eigenvalue, within a few ulp."""
     D, B = s @ C, h @ C
     scale = 1.0 / np.sqrt(np.diag(S_ff))
     orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
@@ -196,6 +199,13 @@ def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10):
     def below(x):  # whether an eigenvalue lies below x (x < E_0)
         return np.linalg.eigvalsh(schur(x)[0])[0] < 0
 
+    def newton(x):  # the lowest eigenvalue λ of M(x) and the Newton step -λ/λ', λ' = v^T M' v = -c^T S c
+        M, G = schur(x)
+        w, V = np.linalg.eigh(M)
+        v, r = V[:, 0], 1.0 / (E - x)
+        Gv, Dv = v @ G, v @ D
+        return w[0], w[0] / (v @ S_ff @ v - 2.0 * (Dv * r) @ Gv + (Gv * r) @ (Gv * r))
+
     hi, lo = np.nextafter(E[0], -np.inf), E[0] - 1.0
     for _ in range(64):  # a lower bound: M(lo) positive definite (the orthogonal part is)
         if not below(lo):
@@ -205,6 +215,18 @@ def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10):
         return np.inf, None, None, None
     if not below(hi):
         return np.inf, None, None, None
+    x = near if near is not None and lo < near < hi else lo
+    for _ in range(100):  # Newton within the bracket [lo, hi] (λ decreasing in x), bisection where it leaves it
+        lam, step = newton(x)
+        lo, hi = (lo, x) if lam < 0 else (x, hi)
+        if abs(step) <= 1e-12 * abs(x):
+            break
+        x = x + step if lo < x + step < hi else 0.5 * (lo + hi)
+    width = 4e-13 * abs(x)  # a narrow bracket about the converged x, if it holds
+    if lo < x - width and not below(x - width):
+        lo = x - width
+    if x + width < hi and below(x + width):
+        hi = x + width
     for _ in range(2100):  # bisection to adjacent doubles
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:

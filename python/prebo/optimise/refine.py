@@ -141,7 +141,8 @@ class GroupObjective:
                     if m < o:
                         B[m, o] = B[o, m] = X[m][0][key][0, nr + c]
             block[key] = B
-        e, a, beta, norm2 = eigen.lowest_with_block(self.E, self.C, h, s, block["H"], block["S"], st.min_norm)
+        e, a, beta, norm2 = eigen.lowest_with_block(self.E, self.C, h, s, block["H"], block["S"], st.min_norm,
+                                                  near=st.energy)
         if not np.isfinite(e):
             return self.worse, np.zeros_like(theta)
         c_rest = self.C @ a
