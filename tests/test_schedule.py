@@ -11,7 +11,7 @@ import pytest
 import prebo
 from prebo.optimise import Cursor, Optimiser, resume_from
 from prebo.optimise.convergence import convergence
-from prebo.optimise.defaults import GROUP, resolved
+from prebo.optimise.defaults import GROUP, TRIALS, resolved
 from prebo.optimise.sampler import pair_lengths
 from prebo.optimise.schedule import CHUNK, RATIO, Adaptive
 
@@ -24,7 +24,8 @@ def test_a_molecule_gets_ecg_gvr_functions_with_powers_from_its_nuclear_mass():
         opts = resolved(Optimiser(), prebo.System(particles))
         m = prebo.System(particles).masses
         mu = m[0] * m[1] / (m[0] + m[1])
-        assert (opts.kind, opts.channels, opts.trials) == ("ecg-gvr", "all", 30)
+        assert (opts.kind, opts.channels, opts.trials) == ("ecg-gvr", "all", TRIALS)
+        assert resolved(Optimiser(refine=1), prebo.System(particles)).trials == 30  # a fixed schedule
         assert opts.K_max == int(np.ceil(np.sqrt(mu)))  # 31 for H2, as the paper's 30; 43 for D2+
     assert resolved(Optimiser(), prebo.System(["p", "p", "e"])).K_max == 31
 
@@ -32,7 +33,8 @@ def test_a_molecule_gets_ecg_gvr_functions_with_powers_from_its_nuclear_mass():
 def test_an_atom_gets_plain_ecgs_and_a_p_state_ecg_gvr_functions_without_powers():
     for particles in (["alpha", "e", "e"], [LI7, "e", "e", "e"], ["e+", "e", "e"], ["p", "mu", "e"]):
         opts = resolved(Optimiser(), prebo.System(particles))
-        assert (opts.kind, opts.K_max, opts.channels, opts.trials) == ("pecg", 0, "pairs", 20), particles
+        assert (opts.kind, opts.K_max, opts.channels, opts.trials) == ("pecg", 0, "pairs", TRIALS), particles
+        assert resolved(Optimiser(refine=1), prebo.System(particles)).trials == 20  # a fixed schedule
     opts = resolved(Optimiser(), prebo.System(["p", "e"], N=1, parity=-1))
     assert (opts.kind, opts.K_max) == ("ecg-gvr", 0)
 

@@ -12,8 +12,14 @@ None), from the physics of the particles:
   the paper's tables were computed with (30); 0 for atoms;
 - channels: every coordinate set for molecules (functions drawn in Jacobi and heavy-particle
   coordinates reach the vibrating nuclei), the particle pairs otherwise;
-- trials per step: 20, or 30 for molecules; refine_evaluations: 30 in the adaptive schedule
-  (L-BFGS converges a function in 15–40 energies, benchmarks/README), 200 in a fixed one;
+- trials per step: TRIALS in the adaptive schedule — a trial costs one row of N_b integrals and
+  the winner's refinement 30 energies with gradients, (1 + P) rows each, so a wider competition
+  is nearly free and picks better functions (H2 with 300 functions after 600 s: 6.7e-7 and
+  7.2e-7 Eh above with 100 trials against 1.2e-6 and 2.4e-6 with 30; He with 400 in 300 s:
+  7.5e-10 and 8.7e-10 against 1.3–2.1e-9 with 20;
+  benchmarks/README, "Trials in the adaptive schedule"); in a fixed one 20, or 30 for molecules;
+- refine_evaluations: 30 in the adaptive schedule (L-BFGS converges a function in 15–40
+  energies, benchmarks/README), 200 in a fixed one;
 - refine_group: GROUP in the adaptive schedule, whose refinement passes then move each function
   with the GROUP − 1 it overlaps most (near-duplicate partners hold a lone function in place;
   benchmarks/README, "The H2 campaign" and issue 17's rows), 1 in a fixed one;
@@ -34,6 +40,8 @@ from .settings import Optimiser
 
 #: functions an adaptive refinement pass moves together (module docstring)
 GROUP = 3
+#: competitive trials per step of the adaptive schedule (module docstring)
+TRIALS = 100
 #: a particle this many times heavier than the lightest one moves as a nucleus
 HEAVY = 100.0
 
@@ -64,7 +72,7 @@ def resolved(opts: Optimiser, system: System) -> Optimiser:
             m = system.masses
             K_max = min(K_LIMIT, math.ceil(np.sqrt(reduced_mass(m[bond[0]], m[bond[1]]) / m.min())))
     channels = opts.channels or ("all" if bond is not None else "pairs")
-    trials = opts.trials or (30 if bond is not None else 20)
+    trials = opts.trials or (TRIALS if opts.adaptive else 30 if bond is not None else 20)
     schedule = {}
     if not opts.adaptive:
         schedule = {k: (v if (v := getattr(opts, k)) is not None else d)
