@@ -201,3 +201,12 @@ def test_a_sweep_tries_the_neighbours_in_K_with_the_peak_of_the_global_vector_co
         assert np.all(np.linalg.eigvalsh(g.A[0]) > 0)
     pecg = Sampler(prebo.System(["alpha", "e", "e"]), Optimiser(kind="pecg", channels="pairs"), np.random.default_rng(1))
     assert pecg.neighbours(pecg.fresh()) == []
+
+
+def test_the_progress_line_starts_at_the_size_of_the_basis_a_run_resumes_from():
+    from prebo.optimise.report import Reporter
+    with Reporter(Optimiser(size=600), True, 600) as report:
+        task = report.progress.tasks[0]
+        assert (task.completed, task.total) == (600, 600)
+    with Reporter(Optimiser(size=40), True) as report:  # a new run grows from nothing
+        assert (report.progress.tasks[0].completed, report.progress.tasks[0].total) == (0, 40)

@@ -76,7 +76,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
 
     ex = Expansion(basis, rep, opts.threshold, opts.min_norm, opts.max_overlap)
     sampler.learn(ex.basis)
-    run = Run(ex, sampler, Reporter(opts, progress))
+    run = Run(ex, sampler, Reporter(opts, progress, len(ex.basis)))
     steps = methods(opts)
 
     def checkpoint():

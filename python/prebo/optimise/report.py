@@ -12,10 +12,11 @@ from .settings import Optimiser
 
 
 class Reporter:
-    """A live line (rich) while `enabled`: basis size, energy, last improvement, virial, trials per second."""
+    """A live line (rich) while `enabled`: basis size, energy, last improvement, virial, trials per second;
+    it starts at `nb`, the size of the basis the run starts from (a resumed run's)."""
 
-    def __init__(self, opts: Optimiser, enabled: bool):
-        self.opts, self.enabled = opts, enabled
+    def __init__(self, opts: Optimiser, enabled: bool, nb: int = 0):
+        self.opts, self.enabled, self.nb = opts, enabled, nb
         self.n_trials, self.t0 = 0, time.perf_counter()
         self.progress = None
 
@@ -25,7 +26,8 @@ class Reporter:
             self.progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                                      TimeElapsedColumn(), TextColumn("{task.fields[info]}"))
             self.progress.__enter__()
-            self.task = self.progress.add_task("growing", total=self.opts.size, info="")
+            self.task = self.progress.add_task("growing", total=max(self.opts.size, self.nb), completed=self.nb,
+                                               info="")
         return self
 
     def __exit__(self, *exc):
