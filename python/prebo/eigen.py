@@ -21,9 +21,10 @@ M(x) = H_ff - x S_ff - G diag(1/(E - x)) G^T, G = (h - x s) C. Below E_0 the blo
 positive, so by Sylvester's law of inertia the number of eigenvalues below x is the number of
 negative eigenvalues of M(x): the lowest root is the zero of λ(x), the lowest eigenvalue of M(x),
 which falls strictly (λ' = v^T M' v = -c^T S c for its eigenvector v), found by Newton's method
-kept inside a bracket and finished by bisection to the last bit. Its eigenvector is c = (C a, β), β the null vector of M, a = -G^T β / (E - x); moving the parameters
-of function m alone, de = [2 β_m (dh_m - e ds_m)·(C a) + 2 β_m Σ_{o≠m} β_o (dH_mo - e dS_mo)
-+ β_m^2 (dH_mm - e dS_mm)] / c^T S c.
+kept inside a bracket and finished by bisection to the last bit. Its eigenvector is c = (C a, β),
+β the null vector of M, a = -G^T β / (E - x); moving the parameters of function m alone,
+de = [2 β_m (dh_m - e ds_m)·(C a) + 2 β_m Σ_{o≠m} β_o (dH_mo - e dS_mo) + β_m^2 (dH_mm - e dS_mm)]
+/ c^T S c.
 
 Refinement: LAPACK's eigenvalues of an ill-conditioned basis depend on the BLAS kernel (1e-8
 relative at an overlap condition of 5e12), so `solve` refines the lowest root(s) in the Rust core
