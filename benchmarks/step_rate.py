@@ -1,12 +1,14 @@
 """Optimiser steps per minute on a run's checkpoint: `--steps` consecutive steps of one phase
 ("sweep": replacement with `trials` random functions, the winner refined; "refine": L-BFGS
-refinement of one function) from function `--first` on, with the checkpoint's settings, random
+refinement of one function or group; "grow": the basis cut to its first `--first` functions,
+the best of `trials` random functions appended and refined) from function `--first` on, with the checkpoint's settings, random
 state and basis, LAPACK threads as the driver sets them — the quantity the optimiser feels. The matrices of the basis are built before
 the clock starts. The energy after the steps shows that two builds took the same path.
 
     python benchmarks/step_rate.py benchmarks/checkpoints/h2-cycles --phase refine --first 100 --steps 10
     python benchmarks/step_rate.py benchmarks/checkpoints/h2-cycles --phase sweep --first 100 --steps 5
     python benchmarks/step_rate.py examples/bases/auto-he-400 --phase refine --steps 20 --blas-threads 2
+    python benchmarks/step_rate.py examples/bases/auto-he-400 --phase grow --first 350 --steps 30
 """
 from __future__ import annotations
 
@@ -33,7 +35,7 @@ from prebo.optimise.sampler import Sampler
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("checkpoint", help="a run's folder (its basis.json)")
-    ap.add_argument("--phase", choices=("sweep", "refine"), default="refine")
+    ap.add_argument("--phase", choices=("sweep", "refine", "grow"), default="refine")
     ap.add_argument("--first", type=int, default=100, help="the function of the first step")
     ap.add_argument("--steps", type=int, default=10)
     ap.add_argument("--blas-threads", type=int, help="LAPACK/BLAS threads instead of the driver's choice")
@@ -42,6 +44,8 @@ def main():
     rng = np.random.default_rng(opts.seed)
     sampler = Sampler(system, opts, rng)
     basis, *_ = resumed(d, opts, rng, args.checkpoint)
+    if args.phase == "grow":
+        basis = basis.subset(np.arange(args.first))
     ex = Expansion(basis, laboratory(system), opts.threshold, opts.min_norm, opts.max_overlap)
     sampler.learn(ex.basis)
     run = Run(ex, sampler, Reporter(opts, False))

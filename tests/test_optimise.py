@@ -210,3 +210,43 @@ def test_the_progress_line_starts_at_the_size_of_the_basis_a_run_resumes_from():
         assert (task.completed, task.total) == (600, 600)
     with Reporter(Optimiser(size=40), True) as report:  # a new run grows from nothing
         assert (report.progress.tasks[0].completed, report.progress.tasks[0].total) == (0, 40)
+
+
+def test_a_growth_step_refines_the_newcomer_before_it_joins_and_solves_once(monkeypatch):
+    """A grown function is refined against the basis it joins, then appended: one eigen-solution
+    per step (not one for the raw winner, one for the basis without it and one after refinement),
+    and the appended function is the refined one, below the raw winner's energy."""
+    from prebo import eigen
+    from prebo.integrals import laboratory
+    from prebo.optimise import Expansion
+    from prebo.optimise.methods import Grow, Refinement, Run
+    from prebo.optimise.report import Reporter
+    from prebo.optimise.sampler import Sampler
+    system = prebo.System(["p", "e", "e"], spin={"e": 0})
+    basis = prebo.optimise(system, Optimiser(size=6, trials=5, seed=4), progress=False)
+    opts = resolved(Optimiser(size=7, trials=5, seed=5), system)
+    ex = Expansion(basis, laboratory(system), 1e-13)
+    sampler = Sampler(system, opts, np.random.default_rng(5))
+    trials = Sampler(system, opts, np.random.default_rng(5)).trials(5)  # the same draws as the step's
+    raw = float(np.min(ex.candidates(trials)[0]))
+    solves, solve = [], eigen.solve
+    monkeypatch.setattr(eigen, "solve", lambda *a, **k: solves.append(1) or solve(*a, **k))
+    Grow(5, Refinement(30, "gradient")).step(Run(ex, sampler, Reporter(opts, False, 6)), Cursor("grow", sweep=7))
+    assert len(ex.basis) == 7 and len(solves) == 1
+    assert ex.energy < raw - 1e-9
+
+
+def test_a_checkpoint_has_a_line_per_key_and_per_function():
+    """basis.json as write_json_atomic lays it out: strict JSON, a line per top-level key and per
+    element of the function list (compact lines keep json's C encoder: indent would not)."""
+    import tempfile
+    from pathlib import Path
+    basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json")
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "basis.json"
+        basis.save(path)
+        text = path.read_text()
+    d = json.loads(text)
+    assert d["functions"] == json.loads((ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json").read_text())["functions"]
+    lines = text.splitlines()
+    assert len(lines) == 2 + len(d) + 1 + len(d["functions"])  # braces, keys, the list's closing bracket

@@ -4,8 +4,8 @@
 - `Grow`: competitive selection (Suzuki & Varga, Lect. Notes Phys. m54, ch. 4, the stochastic
   variational method): `trials` random functions, each one's row against the basis from the
   core (O(N_b) integrals) and the new lowest eigenvalue from the secular equation (O(N_b^2),
-  eigen.lowest_with_added_many); the best is appended if it lowers the energy beyond its
-  uncertainty and, with `refine`, refined.
+  eigen.lowest_with_added_many); the best, if it lowers the energy beyond its uncertainty, is
+  appended — with `refine`, refined first.
 - `Sweep`: one step of a replacement sweep: function i competes with `trials` replacements in the
   basis without it — its neighbours in the power K (Sampler.neighbours: K ± 1, K ± 2 with the
   peak of the global-vector coordinate kept; refinement cannot change K) and random functions;
@@ -29,7 +29,7 @@ from ..errors import StalledError
 from .checkpoint import Cursor
 from .expansion import Expansion
 from .polish import polish
-from .refine import refine_function, refine_group, regenerate_function
+from .refine import refine_group, refine_newcomer, regenerate_function
 from .report import Reporter
 from .sampler import Sampler
 from .settings import Optimiser
@@ -74,11 +74,14 @@ class Grow:
         energies, rows, diag = ex.candidates(trials)
         best = int(np.argmin(energies))
         run.report.trials(len(trials))
-        if (np.isfinite(energies[best]) and ex.gains(energies[best])
-                and ex.put(len(ex.basis), trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])):
+        nb, gains = len(ex.basis), np.isfinite(energies[best]) and ex.gains(energies[best])
+        if self.refine:
+            grown = gains and refine_newcomer(ex, nb, trials.subset([best]), self.refine.evaluations,
+                                              self.refine.method)
+        else:
+            grown = gains and ex.put(nb, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
+        if grown:
             run.stalled = 0
-            if self.refine:
-                refine_function(ex, len(ex.basis) - 1, self.refine.evaluations, self.refine.method)
             return
         run.stalled += 1
         if run.stalled == STALL_STEPS:

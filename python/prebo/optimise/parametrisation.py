@@ -14,6 +14,7 @@ A function from the pair sampler is parametrised in the first Jacobi set.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -23,6 +24,13 @@ from ..errors import IllConditionedError
 
 LOG_DIAG = (-8.0, 10.0)  # ln L_kk: exponents within ~1e-7..5e8
 MAX_CONDITION = 1e8  # of 𝒜 (module docstring)
+
+
+@lru_cache
+def _entries(d: int) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column of each entry of L that θ moves: the diagonal, then the strict lower part."""
+    rows, cols = np.tril_indices(d, -1)
+    return np.concatenate([np.arange(d), rows]), np.concatenate([np.arange(d), cols])
 
 
 @dataclass
@@ -52,12 +60,12 @@ class Parametrisation:
         A_int, _ = self.x.from_lab(self.f.A[0])
         L = np.linalg.cholesky(A_int)
         d = len(L)
-        return np.concatenate([np.log(np.diag(L)), L[np.tril_indices(d, -1)], self.f.family.theta_tail(self.f, self.x)])
+        return np.concatenate([np.log(np.diag(L)), L[_entries(d)][d:], self.f.family.theta_tail(self.f, self.x)])
 
     def _L(self, theta: np.ndarray) -> np.ndarray:
         d = self.f.system.n - 1
-        L = np.diag(np.exp(np.clip(theta[:d], *LOG_DIAG)))
-        L[np.tril_indices(d, -1)] = theta[d:self._split]
+        L = np.zeros((d, d))
+        L[_entries(d)] = np.concatenate([np.exp(np.clip(theta[:d], *LOG_DIAG)), theta[d:self._split]])
         sv = np.linalg.svd(L, compute_uv=False)
         if not sv[-1] > 0 or (sv[0] / sv[-1]) ** 2 > MAX_CONDITION:
             raise IllConditionedError(f"exponent matrix with condition number above {MAX_CONDITION:.0e}")
@@ -77,12 +85,11 @@ class Parametrisation:
         n = self.f.system.n
         d, P = n - 1, len(theta)
         L = self._L(theta)
+        rows, cols = _entries(d)
         inside = (theta[:d] > LOG_DIAG[0]) & (theta[:d] < LOG_DIAG[1])
-        entries = [(k, k, L[k, k] * inside[k]) for k in range(d)]
-        entries += [(a, b, 1.0) for a, b in zip(*np.tril_indices(d, -1))]
-        dA = np.zeros((P, n, n))
-        for p, (a, b, v) in enumerate(entries):
-            dL = np.zeros((d, d))
-            dL[a, b] = v
-            dA[p] = self.x.to_lab(dL @ L.T + L @ dL.T, 0.0)
-        return dA, self.f.family.tail_directions(self.f, self.x, theta[self._split:], P, self._split)
+        dL = np.zeros((self._split, d, d))
+        dL[np.arange(self._split), rows, cols] = np.concatenate([np.diag(L) * inside, np.ones(self._split - d)])
+        dA_int = np.zeros((P, n, n))  # ∂A^(x): ∂𝒜 in the internal block, nothing on the CM
+        dA_int[:self._split, :-1, :-1] = dL @ L.T + L @ dL.transpose(0, 2, 1)
+        U = self.x.U
+        return U.T @ dA_int @ U, self.f.family.tail_directions(self.f, self.x, theta[self._split:], P, self._split)

@@ -31,14 +31,16 @@ class Objective:
     secular equation against the basis without i. Remembers the best function seen. A θ that
     leaves the valid region (an ill-conditioned 𝒜, elements failing `Representation.plausible`),
     or makes the function linearly dependent on the others, scores worse than the current energy (a finite value keeps the line searches sane).
-    `f`: parametrise this function (a newcomer for slot i) instead of function i; the expansion is
-    not changed, and the best seen starts at f's own energy."""
+    `f`: parametrise this function (a newcomer for slot i; i = N_b appends it) instead of function
+    i; the expansion is not changed, and the best seen starts at f's own energy."""
 
     def __init__(self, expansion, i: int, rest=None, f: Basis | None = None):
         self.expansion, self.i = expansion, i
         basis = expansion.basis
         self.keep = np.arange(len(basis)) != i
-        sub = expansion.without(i) if rest is None else rest
+        if rest is None:
+            rest = expansion.eig if i == len(basis) else expansion.without(i)
+        sub = rest
         self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
         self.rest = basis.subset(np.flatnonzero(self.keep))
         self.S_rest = np.diag(expansion.m["S"])[self.keep]
@@ -47,7 +49,9 @@ class Objective:
         self.best_E, self.best_f = expansion.energy, None
         if f is not None:
             self.best_E = np.inf
-            self.energy(self.p.theta())
+            e = self.energy(self.p.theta())
+            if not np.isfinite(self.worse):  # no function yet: worse than the newcomer's own energy
+                self.worse = e + 1.0
 
     def _seen(self, e: float, f: Basis) -> None:
         if e < self.best_E:
@@ -225,6 +229,18 @@ def regenerate_function(expansion, i: int, f: Basis, max_evaluations: int = 200,
     improved. Both refinements share `rest`, the eigen-solution of the basis without i
     (Expansion.without), and the expansion is changed (and its eigenproblem solved) once at most."""
     rest = expansion.without(i) if rest is None else rest
+    return (refine_newcomer(expansion, i, f, max_evaluations, method, rest)
+            or refine_function(expansion, i, max_evaluations, method, rest))
+
+
+def refine_newcomer(expansion, i: int, f: Basis, max_evaluations: int = 200, method: str = "gradient",
+                    rest=None) -> bool:
+    """Refine `f` in slot i against the basis without function i (`rest`: its eigen-solution, if
+    already at hand) — for i = N_b, against the whole basis — and put it there if it then lowers
+    the energy beyond the uncertainty; True if it did. A grown function is refined
+    before it joins, so the basis is changed and solved once per step."""
     newcomer = Objective(expansion, i, rest, f)
+    if not np.isfinite(newcomer.best_E):  # outside the valid region or linearly dependent
+        return False
     minimise(newcomer, max_evaluations, method)
-    return accept(expansion, i, newcomer) or refine_function(expansion, i, max_evaluations, method, rest)
+    return accept(expansion, i, newcomer)
