@@ -101,13 +101,47 @@ def test_cursor_repeats_the_block_after_growth_in_cycles():
     assert Cursor(**{"phase": "polish", "sweep": 0, "index": 0}).cycle == 0  # checkpoints before cycles
 
 
+def test_each_cycle_grows_past_the_size_and_prunes_back_first():
+    opts = resolved(Optimiser(size=3, prune=2, refine=1, cycles=2), prebo.System(["p", "e"]))
+    c, seen, nb = Cursor().advance(0, opts), [], 0
+    while c.phase != "done":
+        seen.append((c.phase, c.index, c.cycle, nb))
+        nb += 1 if c.phase == "grow" or (c.phase == "prune" and c.index == 0) else -1 if c.phase == "prune" else 0
+        c = c.advance(nb, opts)
+    block = [("prune", 0, 3), ("prune", 0, 4), ("prune", 1, 5), ("prune", 1, 4)] + [("refine", i, 3) for i in range(3)]
+    assert seen == [("grow", 0, 0, k) for k in range(3)] + [(p, i, cycle, n) for cycle in (0, 1)
+                                                           for p, i, n in block]
+
+
+def test_pruning_removes_the_function_that_costs_least():
+    """eigen.lowest_without_each against the basis without each function solved afresh, and a
+    prune step removes the cheapest."""
+    from prebo import eigen
+    from prebo.integrals import laboratory
+    from prebo.optimise import Expansion
+    from prebo.optimise.methods import Grow, Prune, Run
+    from prebo.optimise.report import Reporter
+    basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json").subset(np.arange(40))
+    ex = Expansion(basis, laboratory(basis.system), 1e-13)
+    without = eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors)
+    fresh = np.array([ex.without(i).energies[0] for i in range(40)])
+    assert np.all(without >= ex.energy) and np.allclose(without, fresh, rtol=1e-13, atol=0)
+    cheapest = int(np.argmin(fresh))
+    kept = ex.basis.subset(np.flatnonzero(np.arange(40) != cheapest))
+    opts = resolved(Optimiser(size=39, prune=1, refine=1), basis.system)
+    Prune(Grow(5)).step(Run(ex, None, Reporter(opts, False, 40)), Cursor("prune", index=1))
+    assert np.array_equal(ex.basis.A, kept.A) and ex.energy == pytest.approx(fresh[cheapest], rel=1e-13)
+    rebuilt = laboratory(basis.system).matrices(kept)
+    assert all(np.array_equal(rebuilt[k], ex.m[k]) for k in rebuilt)
+
+
 def test_each_phase_has_its_method_configured_by_the_settings():
     from prebo.optimise import Grow, Polish, Refine, Refinement, Sweep
-    from prebo.optimise.methods import methods
+    from prebo.optimise.methods import Prune, methods
     he = prebo.System(["alpha", "e", "e"])
     plain = methods(resolved(Optimiser(trials=7, polish_iterations=9, sweeps=0), he))
-    assert plain == {"grow": Grow(7), "sweep": Sweep(7), "refine": Refine(Refinement(200, "gradient")),
-                     "polish": Polish(9)}
+    assert plain == {"grow": Grow(7), "prune": Prune(Grow(7)), "sweep": Sweep(7),
+                     "refine": Refine(Refinement(200, "gradient")), "polish": Polish(9)}
     refined = methods(Optimiser(trials=3, refine=1, refine_evaluations=40, refine_method="powell"))
     assert refined["grow"] == Grow(3, Refinement(40, "powell")) and refined["sweep"].refine == Refinement(40, "powell")
     grouped = methods(Optimiser(refine=1, refine_evaluations=40, refine_group=2))  # refinement sweeps only

@@ -261,3 +261,13 @@ def test_growth_that_stalls_ends_at_the_size_reached_in_an_adaptive_schedule(tmp
     d = json.loads((tmp_path / "basis.json").read_text())
     assert len(basis) == d["schedule"]["stalled"] == 1 and basis.convergence["stopped"] == "converged"
     assert {p[0] for p in d["schedule"]["passes"]} == {"grow", "refine", "sweep", "polish"}
+
+
+def test_the_convergence_report_starts_after_the_last_pruning():
+    """A basis grown past its size and pruned back starts again from a higher energy: the recent
+    gain and the extrapolation are those of the steps since, never a loss across the pruning."""
+    grown = [[3, -1.0, "grow", 1.0], [4, -1.2, "prune", 2.0], [5, -1.3, "prune", 3.0]]
+    since = [[3, -1.1 - 0.1 * (1 - 0.5**k), "refine", 4.0 + k] for k in range(7)]
+    report = convergence(grown + since, Optimiser(size=3, prune=2, refine=1), "schedule", 11.0)
+    assert report["recent"]["steps"] == 6 and report["recent"]["gain"] == pytest.approx(since[0][1] - since[-1][1])
+    assert report["extrapolation"]["energy"] == pytest.approx(-1.2, abs=2e-3)

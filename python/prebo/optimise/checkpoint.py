@@ -20,14 +20,15 @@ from .settings import Optimiser
 
 CHECKPOINT = "basis.json"
 
-PHASES = ("grow", "sweep", "refine", "polish", "done")
+PHASES = ("grow", "prune", "sweep", "refine", "polish", "done")
 
 
 @dataclass
 class Cursor:
-    """The next unit of work: one competitive step ("grow"), function `index` of
-    replacement sweep / refinement sweep `sweep` ("sweep", "refine"), joint-refinement step
-    `sweep` ("polish") of the sweep-refine-polish block `cycle`, or "done"."""
+    """The next unit of work: one competitive step ("grow"); one step of growth past the size
+    (`index` 0) or one removal (1) ("prune"), function `index` of replacement sweep / refinement
+    sweep `sweep` ("sweep", "refine"), joint-refinement step `sweep` ("polish") of the
+    prune-sweep-refine-polish block `cycle`, or "done"."""
 
     phase: str = "grow"
     sweep: int = 0
@@ -42,12 +43,19 @@ class Cursor:
 
     def advance(self, nb: int, opts: Optimiser) -> "Cursor":
         """The unit of work after this one, for a basis of `nb` functions and the fixed schedule of
-        `opts` (settings resolved by defaults.resolved: grow to `size`; per cycle `sweeps`
-        replacement sweeps, `refine` refinement sweeps, `polish` joint steps; `cycles` cycles)."""
+        `opts` (settings resolved by defaults.resolved: grow to `size`; per cycle growth to
+        `size` + `prune` and removal back to `size`, `sweeps` replacement sweeps, `refine`
+        refinement sweeps, `polish` joint steps; `cycles` cycles)."""
         if self.phase == "grow":
             if nb < opts.size:
                 return self
-            return Cursor("sweep").settle(opts)
+            return Cursor("prune").settle(opts)
+        if self.phase == "prune":
+            if self.index == 0 and nb < opts.size + opts.prune:
+                return self
+            if nb > opts.size:
+                return Cursor("prune", index=1, cycle=self.cycle)
+            return Cursor("sweep", cycle=self.cycle).settle(opts)
         nxt = Cursor(self.phase, self.sweep, self.index + 1, self.cycle)
         if nxt.index >= nb or self.phase == "polish":
             nxt = Cursor(self.phase, self.sweep + 1, 0, self.cycle)
@@ -55,13 +63,15 @@ class Cursor:
 
     def settle(self, opts: Optimiser) -> "Cursor":
         """Skip phases whose sweeps are used up; after the last polish step, the next cycle."""
+        if self.phase == "prune" and not opts.prune:
+            return Cursor("sweep", cycle=self.cycle).settle(opts)
         if self.phase == "sweep" and self.sweep >= opts.sweeps:
             return Cursor("refine", cycle=self.cycle).settle(opts)
         if self.phase == "refine" and self.sweep >= opts.refine:
             return Cursor("polish", cycle=self.cycle).settle(opts)
         if self.phase == "polish" and self.sweep >= opts.polish:
             if self.cycle + 1 < opts.cycles:
-                return Cursor("sweep", cycle=self.cycle + 1).settle(opts)
+                return Cursor("prune", cycle=self.cycle + 1).settle(opts)
             return Cursor("done")
         return self
 

@@ -1,5 +1,6 @@
 """The convergence report of a run (result.json's "convergence"), from its history of accepted
-steps [n_b, E, phase, seconds]:
+steps [n_b, E, phase, seconds], since the last pruning (a basis grown past its size and pruned
+back starts again from a higher energy; methods.Prune):
 
 - `stopped`: why the run ended, a key of STOPPED (the adaptive schedule's reasons are those of
   schedule.py) — and `seconds` of optimisation over every segment of the run;
@@ -42,6 +43,8 @@ def convergence(history: list, opts: Optimiser, stopped: str | None, seconds: fl
     """The report of a run with `history` (module docstring); `stalled_at`: the size at which growth
     stalled; `advantage`: that of the adaptive schedule."""
     steps = [h for h in history if len(h) >= 4]
+    pruned = [k for k in range(1, len(steps)) if steps[k][0] < steps[k - 1][0]]
+    steps = steps[pruned[-1]:] if pruned else steps
     report = {"stopped": stopped, "seconds": seconds, "adaptive": opts.adaptive, "advantage": advantage,
               "recent": None, "extrapolation": None,
               "stalled": None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts)}}

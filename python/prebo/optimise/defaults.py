@@ -23,8 +23,8 @@ None), from the physics of the particles:
 - refine_group: GROUP in the adaptive schedule, whose refinement passes then move each function
   with the GROUP − 1 it overlaps most (near-duplicate partners hold a lone function in place;
   benchmarks/README, "The H2 campaign" and issue 17's rows), 1 in a fixed one;
-- the schedule: adaptive (schedule.py) when none of sweeps, refine, polish, cycles is given,
-  else the fixed schedule with the missing ones at 0, 0, 0 and 1.
+- the schedule: adaptive (schedule.py) when none of prune, sweeps, refine, polish, cycles is
+  given, else the fixed schedule with the missing ones at 0, 0, 0, 0 and 1.
 """
 from __future__ import annotations
 
@@ -76,7 +76,7 @@ def resolved(opts: Optimiser, system: System) -> Optimiser:
     schedule = {}
     if not opts.adaptive:
         schedule = {k: (v if (v := getattr(opts, k)) is not None else d)
-                    for k, d in (("sweeps", 0), ("refine", 0), ("polish", 0), ("cycles", 1))}
+                    for k, d in (("prune", 0), ("sweeps", 0), ("refine", 0), ("polish", 0), ("cycles", 1))}
     evaluations = opts.refine_evaluations or (30 if opts.adaptive else 200)
     group = opts.refine_group or (GROUP if opts.adaptive else 1)
     return replace(opts, kind=kind, K_max=K_max, channels=channels, trials=trials, refine_evaluations=evaluations,

@@ -39,10 +39,12 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     """Optimise a basis of `opts.kind` for the state of `system`: with the adaptive schedule
     (schedule.py), growth to `opts.size` and refinement, replacement and joint passes chosen by
     the energy each gains per second until the basis has converged or is exhausted; with a fixed
-    one, growth to `opts.size` by competitive selection, then `opts.cycles` times `opts.sweeps` random
-    replacement sweeps, `opts.refine` refinement sweeps and `opts.polish` joint steps
-    (methods.py). Either stops after `opts.budget` seconds and keeps its place in the checkpoint:
-    resumed with a larger budget, it goes on. Settings left at None are chosen for the system
+    one, growth to `opts.size` by competitive selection, then `opts.cycles` times growth by
+    `opts.prune` functions and pruning back to the size, `opts.sweeps` random replacement sweeps,
+    `opts.refine` refinement sweeps and `opts.polish` joint steps (methods.py). Either stops
+    after `opts.budget` seconds and keeps its place in the checkpoint: resumed with a larger
+    budget, it goes on (a budget that ends a run while it prunes leaves up to `opts.prune`
+    functions more). Settings left at None are chosen for the system
     first (defaults.resolved).
 
     out: folder of the checkpoint out/basis.json, written atomically after every step (None: no

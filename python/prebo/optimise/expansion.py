@@ -76,6 +76,14 @@ class Expansion:
         H = self.m["T_ti"] + self.m["V"]
         return eigen.solve(H[np.ix_(keep, keep)], self.m["S"][np.ix_(keep, keep)], self.threshold)
 
+    def remove(self, i: int) -> None:
+        """Remove function i, whatever that costs (the matrices without its row and column, which
+        are the bits of a rebuild: an element depends on its two functions and their order)."""
+        keep = np.arange(len(self.basis)) != i
+        self.basis = self.basis.subset(np.flatnonzero(keep))
+        self.m = {k: v[np.ix_(keep, keep)] for k, v in self.m.items()}
+        self.solve()
+
     def virial(self) -> float:
         """|1 + <V>/(2<T_ti>)| of the ground state: 0 for an exact Coulomb eigenstate (virial theorem)."""
         c = self.eig.vectors[:, 0]

@@ -14,7 +14,7 @@ from ..validation import (MATRICES, MAX_SIZE, Automatic, Channels, Choice, Integ
                           strict_keywords)
 
 REFINE_METHODS = ("powell", "gradient")
-SCHEDULE = ("sweeps", "refine", "polish", "cycles")  # the fixed schedule's settings
+SCHEDULE = ("prune", "sweeps", "refine", "polish", "cycles")  # the fixed schedule's settings
 
 
 @dataclass(frozen=True)
@@ -30,6 +30,8 @@ SETTINGS = {
     "size": Setting(Integer(1, MAX_SIZE), f"basis functions; at most {MAX_SIZE}, what {MATRICES} nb x nb "
                     "matrices in this machine's memory allow", "[basis] size"),
     "trials": Setting(Automatic(Integer(1, MAX_SIZE)), "competitive trials per step", "[optimiser] trials"),
+    "prune": Setting(Automatic(Integer(0)), "functions grown past the size and pruned again at the start of each "
+                     "cycle", "[optimiser] prune"),
     "sweeps": Setting(Automatic(Integer(0)), "random replacement sweeps per cycle", "[optimiser] sweeps"),
     "seed": Setting(Integer(0), "seed of the random numbers", "[optimiser] seed"),
     "channels": Setting(Automatic(Channels()), "coordinate sets the functions are drawn in", "[optimiser] channels"),
@@ -46,7 +48,7 @@ SETTINGS = {
                             "overlaps most (L-BFGS on exact gradients)", "[optimiser] refine_group"),
     "polish": Setting(Automatic(Integer(0)), "joint refinement steps per cycle", "[optimiser] polish"),
     "polish_iterations": Setting(Integer(1), "L-BFGS iterations per joint step", "[optimiser] polish_iterations"),
-    "cycles": Setting(Automatic(Integer(1)), "repetitions of the sweep-refine-polish block", "[optimiser] cycles"),
+    "cycles": Setting(Automatic(Integer(1)), "repetitions of the prune-sweep-refine-polish block", "[optimiser] cycles"),
     "budget": Setting(Automatic(Real(0.0)), "wall-time budget of the run in seconds", "[optimiser] budget"),
     "tolerance": Setting(Automatic(Real(0.0)), "energy gain (Eh) below which a pass over the basis counts as "
                          "converged (adaptive schedule)", "[optimiser] tolerance"),
@@ -88,13 +90,14 @@ class Optimiser:
     [lo, hi] of the drawn lengths in units of each pair's Bohr radius (sampler.pair_lengths);
     learned — share of trials from the learned per-channel distributions (0..1); learn_after —
     functions of a channel before its distribution is learned.
-    Schedule: with none of sweeps, refine, polish and cycles given, the schedule chooses itself
+    Schedule: with none of prune, sweeps, refine, polish and cycles given, the schedule chooses itself
     (schedule.py: growth, refinement, replacement and joint passes by the energy each gains per
     second), stopping at `budget` seconds, or when every kind of pass gains less than
-    `tolerance` Eh. Given any of them, the fixed schedule of methods.py: sweeps — replacement
+    `tolerance` Eh. Given any of them, the fixed schedule of methods.py: prune — functions grown
+    past `size` and then removed, those whose removal costs least, at the start of each cycle; sweeps — replacement
     sweeps per cycle; refine — refinement sweeps per cycle (and refinement of every grown or
     replacing function when > 0); polish — joint L-BFGS steps per cycle; cycles — repetitions of
-    the sweep-refine-polish block; `budget` still stops it. refine_evaluations — energies per
+    the prune-sweep-refine-polish block; `budget` still stops it. refine_evaluations — energies per
     refinement of one function; refine_method — "gradient" (L-BFGS, exact gradients) or
     "powell"; refine_group — functions a refinement sweep moves together (1: one at a time; k: each
     with the k - 1 it overlaps most, always by L-BFGS; chosen by the schedule when not given);
@@ -107,6 +110,7 @@ class Optimiser:
     size: int = 50
     trials: int | None = None
     sweeps: int | None = None
+    prune: int | None = None
     seed: int = 1
     channels: str | list | None = None
     length_range: tuple = (0.01, 15.0)
@@ -130,7 +134,7 @@ class Optimiser:
 
     @property
     def adaptive(self) -> bool:
-        """Whether the schedule chooses itself (none of sweeps, refine, polish, cycles given)."""
+        """Whether the schedule chooses itself (none of prune, sweeps, refine, polish, cycles given)."""
         return all(getattr(self, k) is None for k in SCHEDULE)
 
     def to_dict(self) -> dict:
