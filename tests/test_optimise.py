@@ -119,7 +119,7 @@ def test_pruning_removes_the_function_that_costs_least():
     from prebo import eigen
     from prebo.integrals import laboratory
     from prebo.optimise import Expansion
-    from prebo.optimise.methods import Grow, Prune, Run
+    from prebo.optimise.methods import Grow, Prune, Refinement, Run
     from prebo.optimise.report import Reporter
     basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json").subset(np.arange(40))
     ex = Expansion(basis, laboratory(basis.system), 1e-13)
@@ -129,7 +129,7 @@ def test_pruning_removes_the_function_that_costs_least():
     cheapest = int(np.argmin(fresh))
     kept = ex.basis.subset(np.flatnonzero(np.arange(40) != cheapest))
     opts = resolved(Optimiser(size=39, prune=1, refine=1), basis.system)
-    Prune(Grow(5)).step(Run(ex, None, Reporter(opts, False, 40)), Cursor("prune", index=1))
+    Prune(Grow(5), Refinement(5, "gradient")).step(Run(ex, None, Reporter(opts, False, 40)), Cursor("prune", index=1))
     assert np.array_equal(ex.basis.A, kept.A) and ex.energy == pytest.approx(fresh[cheapest], rel=1e-13)
     rebuilt = laboratory(basis.system).matrices(kept)
     assert all(np.array_equal(rebuilt[k], ex.m[k]) for k in rebuilt)
@@ -140,7 +140,7 @@ def test_each_phase_has_its_method_configured_by_the_settings():
     from prebo.optimise.methods import Prune, methods
     he = prebo.System(["alpha", "e", "e"])
     plain = methods(resolved(Optimiser(trials=7, polish_iterations=9, sweeps=0), he))
-    assert plain == {"grow": Grow(7), "prune": Prune(Grow(7)), "sweep": Sweep(7),
+    assert plain == {"grow": Grow(7), "prune": Prune(Grow(7), Refinement(200, "gradient")), "sweep": Sweep(7),
                      "refine": Refine(Refinement(200, "gradient")), "polish": Polish(9)}
     refined = methods(Optimiser(trials=3, refine=1, refine_evaluations=40, refine_method="powell"))
     assert refined["grow"] == Grow(3, Refinement(40, "powell")) and refined["sweep"].refine == Refinement(40, "powell")
@@ -284,3 +284,22 @@ def test_a_checkpoint_has_a_line_per_key_and_per_function():
     assert d["functions"] == json.loads((ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json").read_text())["functions"]
     lines = text.splitlines()
     assert len(lines) == 2 + len(d) + 1 + len(d["functions"])  # braces, keys, the list's closing bracket
+
+
+def test_a_function_grown_past_the_size_is_refined_with_its_partners(monkeypatch):
+    """Before the removals are weighed, each function grown past the size is refined together with
+    the functions it overlaps most (else the newcomers themselves would be the cheapest to remove)."""
+    from prebo.integrals import laboratory
+    from prebo.optimise import Expansion
+    from prebo.optimise import methods as m
+    from prebo.optimise.report import Reporter
+    from prebo.optimise.sampler import Sampler
+    system = prebo.System(["p", "e", "e"], spin={"e": 0})
+    basis = prebo.optimise(system, Optimiser(size=6, trials=5, seed=4), progress=False)
+    opts = resolved(Optimiser(size=6, prune=2, refine=1, refine_group=3, trials=5, seed=5), system)
+    ex = Expansion(basis, laboratory(system), 1e-13)
+    calls, group = [], m.refine_group
+    monkeypatch.setattr(m, "refine_group", lambda st, i, size, *a: calls.append((i, size)) or group(st, i, size, *a))
+    step = m.methods(opts)["prune"]
+    step.step(m.Run(ex, Sampler(system, opts, np.random.default_rng(5)), Reporter(opts, False, 6)), Cursor("prune"))
+    assert len(ex.basis) == 7 and calls == [(6, 3)]

@@ -11,10 +11,12 @@
   peak of the global-vector coordinate kept; refinement cannot change K) and random functions;
   with `refine`, the winner is refined and kept only if it then beats the incumbent, which is
   refined otherwise (refine.regenerate_function).
-- `Prune`: growth past the size (as `Grow`), then the removal of the function whose removal
-  raises the energy least (eigen.lowest_without_each), one per step back to the size: pruning a
-  basis grown past its size keeps the functions that matter and moves the basis out of the
-  basin refinement has settled in (benchmarks/README, "Grow and prune").
+- `Prune`: growth past the size (as `Grow`, each grown function then refined with the functions
+  it overlaps most, so that it joins the basis before the removals are weighed; without that the
+  cheapest to remove are the newcomers themselves), then the removal of the function whose
+  removal raises the energy least (eigen.lowest_without_each), one per step back to the size:
+  pruning a basis grown past its size keeps the functions that matter and moves the basis out of
+  the basin refinement has settled in (benchmarks/README, "Grow and prune").
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed, or with the
   functions it overlaps most (`refine_group`; refine.py).
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
@@ -126,17 +128,22 @@ class Sweep:
 
 @dataclass(frozen=True)
 class Prune:
-    """At `cursor.index` 0 a `grow` step past the size; at 1 the removal of the function whose
-    removal raises the energy least (module docstring)."""
+    """At `cursor.index` 0 a `grow` step past the size, the grown function then refined with its
+    partners by `refine`; at 1 the removal of the function whose removal raises the energy least
+    (module docstring)."""
 
     grow: Grow
+    refine: Refinement
 
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
-        if cursor.index == 0:
-            self.grow.step(run, cursor)
-            return
         ex = run.expansion
+        if cursor.index == 0:
+            nb = len(ex.basis)
+            self.grow.step(run, cursor)
+            if len(ex.basis) > nb:
+                refine_group(ex, nb, self.refine.group, self.refine.evaluations, self.refine.method)
+            return
         run.report.trials(len(ex.basis))
         ex.remove(int(np.argmin(eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors))))
 
@@ -170,6 +177,6 @@ def methods(opts: Optimiser) -> dict:
     refined."""
     refinement = Refinement(opts.refine_evaluations, opts.refine_method, opts.refine_group)
     on_change = Refinement(opts.refine_evaluations, opts.refine_method) if opts.adaptive or opts.refine else None  # refine grown and replacing functions too
-    return {"grow": Grow(opts.trials, on_change), "prune": Prune(Grow(opts.trials, on_change)),
+    return {"grow": Grow(opts.trials, on_change), "prune": Prune(Grow(opts.trials, on_change), refinement),
             "sweep": Sweep(opts.trials, on_change),
             "refine": Refine(refinement), "polish": Polish(opts.polish_iterations)}
