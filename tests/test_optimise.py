@@ -303,3 +303,28 @@ def test_a_function_grown_past_the_size_is_refined_with_its_partners(monkeypatch
     step = m.methods(opts)["prune"]
     step.step(m.Run(ex, Sampler(system, opts, np.random.default_rng(5)), Reporter(opts, False, 6)), Cursor("prune"))
     assert len(ex.basis) == 7 and calls == [(6, 3)]
+
+
+def test_an_adaptive_pruning_keeps_the_size_and_is_undone_unless_it_gains(monkeypatch):
+    """The adaptive schedule's pruning (methods.Pruning) grows pruned(N_b) functions past the size
+    and removes as many in one step; removing the dearest function instead of the cheapest makes it
+    lose, and the basis before it comes back, bit for bit."""
+    from prebo.integrals import laboratory
+    from prebo.optimise import Expansion
+    from prebo.optimise import methods as m
+    from prebo.optimise.report import Reporter
+    from prebo.optimise.sampler import Sampler
+    system = prebo.System(["p", "e", "e"], spin={"e": 0})
+    basis = prebo.optimise(system, Optimiser(size=20, trials=5, seed=4, sweeps=0), progress=False)  # grown only
+    opts = resolved(Optimiser(size=20, trials=10, seed=5), system)
+    assert opts.adaptive and isinstance(m.methods(opts)["prune"], m.Pruning)
+    ex = Expansion(basis, laboratory(system), 1e-13)
+    run = m.Run(ex, Sampler(system, opts, np.random.default_rng(5)), Reporter(opts, False, 20))
+    E0, grown = ex.energy, []
+    monkeypatch.setattr(m.Expansion, "remove", lambda st, i, f=m.Expansion.remove: grown.append(len(st.basis)) or f(st, i))
+    m.methods(opts)["prune"].step(run, Cursor("prune"))
+    assert len(ex.basis) == 20 and grown == [22, 21] and ex.energy < E0  # pruned(20) = 2
+    before, E1 = ex.basis.subset(slice(None)), ex.energy
+    monkeypatch.setattr(m.np, "argmin", np.argmax)  # the removals now cost the most
+    m.methods(opts)["prune"].step(run, Cursor("prune"))
+    assert len(ex.basis) == 20 and ex.energy == E1 and np.array_equal(ex.basis.A, before.A)

@@ -13,7 +13,7 @@ from prebo.optimise import Cursor, Optimiser, resume_from
 from prebo.optimise.convergence import convergence
 from prebo.optimise.defaults import GROUP, TRIALS, resolved
 from prebo.optimise.sampler import pair_lengths
-from prebo.optimise.schedule import CHUNK, RATIO, Adaptive
+from prebo.optimise.schedule import CHUNK, PRUNE, RATIO, Adaptive, pruned
 
 LI7 = {"name": "li7", "mass": 12786.39227775, "charge": 3, "spin": 1.5}
 
@@ -91,7 +91,7 @@ def passes(schedule, *rows):
     E, t = (schedule.passes[-1][3], schedule.passes[-1][5]) if schedule.passes else (None, 0.0)
     for kind, nb, gain, seconds in rows:
         after = -1.0 if E is None else E - gain
-        schedule.passes.append([kind, nb, E, after, t, t + seconds, nb if kind in ("grow", "polish") else
+        schedule.passes.append([kind, nb, E, after, t, t + seconds, nb if kind in ("grow", "polish", "prune") else
                                 min(CHUNK, nb)])
         E, t = after, t + seconds
     return E
@@ -130,20 +130,33 @@ def test_a_pass_ends_after_a_chunk_and_the_next_sweep_goes_on_where_it_stopped()
     assert s.advance(grow, 9, -3.0, 21.0) == grow  # growth goes on to its target size
 
 
+def test_a_pruning_is_one_pass_of_one_step_at_full_size():
+    s = Adaptive(resolved(Optimiser(size=120), prebo.System(["alpha", "e", "e"])))
+    passes(s, ("grow", 120, None, 1.0), ("refine", 120, 1e-3, 1.0), ("sweep", 120, 1e-3, 1.0), ("polish", 120, 1, 1))
+    assert s.choose(120, -3.0, 4.0) == "prune" and s.choose(119, -3.0, 4.0) == "grow"  # only at full size
+    assert pruned(120) == 12 and pruned(500) == PRUNE and pruned(5) == 1
+    c = s.advance(s.begin("prune", 120, 4), 120, -3.5, 6.0)
+    p = s.passes[-1]
+    assert (p[0], p[1], p[3], p[5], p[6]) == ("prune", 120, -3.5, 6.0, 120) and c.cycle == 5  # visits every function
+
+
 def test_the_basis_is_exhausted_when_every_kind_gains_less_than_a_tenth_of_growth_or_the_tolerance():
     opts = resolved(Optimiser(size=100), prebo.System(["alpha", "e", "e"]))
     s = Adaptive(opts)
     E = passes(s, ("grow", 80, None, 1.0), ("grow", 100, 1e-3, 1.0), ("refine", 100, 2e-4, 1.0),
                ("sweep", 100, 1e-4, 1.0), ("polish", 100, 1e-4, 1.0))
+    assert s.choose(100, E, now(s)) == "prune"  # at full size the pruning is tried too
+    E = passes(s, ("prune", 100, 1e-4, 1.0))
     assert s.choose(100, E, now(s)) == "refine"
     E = passes(s, ("refine", 100, 0.5 * RATIO * 1e-3, 1.0), ("sweep", 100, 0.5 * RATIO * 1e-3, 1.0),
-               ("polish", 100, 0.9 * RATIO * 1e-3, 1.0))
+               ("polish", 100, 0.9 * RATIO * 1e-3, 1.0), ("prune", 100, 0.5 * RATIO * 1e-3, 1.0))
     assert s.choose(100, E, now(s)) is None and s.stopped == "exhausted"
     assert s.advantage(100) == pytest.approx(1e-3 / (0.9 * RATIO * 1e-3))
     assert s.choose(99, E, now(s)) == "grow"  # below full size the basis grows instead
 
     t = Adaptive(resolved(Optimiser(size=8, tolerance=1e-6), prebo.System(["alpha", "e", "e"])))
-    E = passes(t, ("grow", 8, None, 1.0), ("refine", 8, 2e-6, 1.0), ("sweep", 8, 1e-7, 1.0), ("polish", 8, 1e-7, 1.0))
+    E = passes(t, ("grow", 8, None, 1.0), ("refine", 8, 2e-6, 1.0), ("sweep", 8, 1e-7, 1.0), ("polish", 8, 1e-7, 1.0),
+               ("prune", 8, 1e-7, 1.0))
     assert t.choose(8, E, now(t)) == "refine"  # one pass in one growth step: no growth rate, the tolerance decides
     E = passes(t, ("refine", 8, 5e-7, 1.0))
     assert t.choose(8, E, now(t)) is None and t.stopped == "converged"
@@ -154,7 +167,8 @@ def test_a_budget_overrides_exhaustion_until_the_time_left_would_gain_less_than_
     kind's last rate times the seconds left exceeds the tolerance, and then has converged."""
     he = prebo.System(["alpha", "e", "e"])
     rows = (("grow", 80, None, 1.0), ("grow", 100, 1e-3, 1.0), ("refine", 100, 0.5 * RATIO * 1e-3, 1.0),
-            ("sweep", 100, 0.5 * RATIO * 1e-3, 1.0), ("polish", 100, 0.9 * RATIO * 1e-3, 1.0))
+            ("sweep", 100, 0.5 * RATIO * 1e-3, 1.0), ("polish", 100, 0.9 * RATIO * 1e-3, 1.0),
+            ("prune", 100, 0.5 * RATIO * 1e-3, 1.0))
     s = Adaptive(resolved(Optimiser(size=100, budget=600.0), he))
     E = passes(s, *rows)
     assert s.choose(100, E, now(s)) == "polish" and s.stopped is None  # 1.8e-5 Eh/s for 595 s more
@@ -168,7 +182,8 @@ def test_without_a_growth_rate_the_best_rate_at_full_size_is_the_reference():
     """A basis grown in one pass (no energy before it, no rate) is exhausted when every kind gains
     less than RATIO of the best rate seen at full size, though each still gains above the tolerance."""
     s = Adaptive(resolved(Optimiser(size=6), prebo.System(["p", "e", "e"])))
-    E = passes(s, ("grow", 6, None, 1.0), ("refine", 6, 1e-2, 1.0), ("sweep", 6, 1e-3, 1.0), ("polish", 6, 1e-3, 1.0))
+    E = passes(s, ("grow", 6, None, 1.0), ("refine", 6, 1e-2, 1.0), ("sweep", 6, 1e-3, 1.0), ("polish", 6, 1e-3, 1.0),
+               ("prune", 6, 0.5 * RATIO * 1e-2, 1.0))
     assert s.choose(6, E, now(s)) == "refine"
     E = passes(s, ("refine", 6, 0.9 * RATIO * 1e-2, 1.0), ("sweep", 6, 0.5 * RATIO * 1e-2, 1.0))
     assert s.choose(6, E, now(s)) == "polish"  # polish's last rate, 1e-3, is above RATIO of the best
@@ -225,7 +240,9 @@ def test_an_input_without_optimiser_table_runs_to_an_exhausted_basis_with_a_repo
     assert -2.90330455773 < result["energy"] < -2.9030  # the literature energy (Drake), variational
     d = json.loads((tmp_path / "he" / "basis.json").read_text())
     kinds = [p[0] for p in d["schedule"]["passes"]]
-    assert kinds[0] == "grow" and {"refine", "sweep", "polish"} <= set(kinds) and d["stopped"] == "exhausted"
+    assert kinds[0] == "grow" and {"refine", "sweep", "polish", "prune"} <= set(kinds) and d["stopped"] == "exhausted"
+    prunings = [p for p in d["schedule"]["passes"] if p[0] == "prune"]
+    assert all(p[1] == 24 and p[3] <= p[2] for p in prunings)  # back to the size, never above where it began
 
 
 def test_the_budget_stops_a_run_and_a_resumed_adaptive_run_goes_on(tmp_path):
@@ -260,7 +277,7 @@ def test_growth_that_stalls_ends_at_the_size_reached_in_an_adaptive_schedule(tmp
     basis = prebo.optimise(h, Optimiser(size=10, max_overlap=1e-9), out=tmp_path, progress=False)
     d = json.loads((tmp_path / "basis.json").read_text())
     assert len(basis) == d["schedule"]["stalled"] == 1 and basis.convergence["stopped"] == "converged"
-    assert {p[0] for p in d["schedule"]["passes"]} == {"grow", "refine", "sweep", "polish"}
+    assert {p[0] for p in d["schedule"]["passes"]} == {"grow", "refine", "sweep", "polish", "prune"}
 
 
 def test_the_convergence_report_starts_after_the_last_pruning():

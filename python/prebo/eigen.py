@@ -252,10 +252,11 @@ def lowest_without_each(E: np.ndarray, C: np.ndarray) -> np.ndarray:
         return np.full(len(C), np.inf)
     w = C * C
     lo, hi = np.full(len(C), E[0]), np.full(len(C), E[1])
-    for _ in range(64):
-        mid = 0.5 * (lo + hi)
-        below = (w / (E - mid[:, None])).sum(axis=1) < 0
-        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    with np.errstate(divide="ignore", invalid="ignore"):  # mid reaches E_0 only within an ulp of the root
+        for _ in range(64):
+            mid = 0.5 * (lo + hi)
+            below = (w / (E - mid[:, None])).sum(axis=1) < 0
+            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
     return hi
 
 

@@ -46,13 +46,14 @@ class Expansion:
         """Whether `energy` lies below the current energy by more than its uncertainty."""
         return energy < self.energy - self.sigma
 
-    def _snapshot(self) -> tuple:
+    def snapshot(self) -> tuple:
+        """The state to restore if a change does not pay (`keep_if_lower`)."""
         return (self.basis.subset(slice(None)), {k: v.copy() for k, v in self.m.items()}, self.eig, self.energy,
                 self.sigma)
 
-    def _keep_if_lower(self, before: tuple) -> bool:
+    def keep_if_lower(self, before: tuple) -> bool:
         """After a change: keep it if the energy fell by more than the uncertainty before and after
-        it; otherwise restore the state `before` (`_snapshot`). True if kept."""
+        it; otherwise restore the state `before` (`snapshot`). True if kept."""
         if before[3] == np.inf or self.energy < before[3] - max(self.sigma, before[4]):
             return True
         self.basis, self.m, self.eig, self.energy, self.sigma = before
@@ -60,11 +61,11 @@ class Expansion:
 
     def replace_basis(self, basis: Basis) -> bool:
         """Take a whole new basis (matrices rebuilt) if it lowers the energy beyond the uncertainty."""
-        before = self._snapshot()
+        before = self.snapshot()
         self.basis = basis
         self.m = self.rep.matrices(basis)
         self.solve()
-        return self._keep_if_lower(before)
+        return self.keep_if_lower(before)
 
     def without(self, i):
         """The eigen-solution of the basis without function i, or without the functions of the
@@ -118,21 +119,21 @@ class Expansion:
         uncertainty (class docstring); True if it did. The matrices are patched from the
         function's oriented row (`Representation.rows` with position i) or else rebuilt, so that
         the state is a function of the basis alone and a resumed run continues bit for bit."""
-        before = self._snapshot()
+        before = self.snapshot()
         self._place(i, f, row, d)
         self.solve()
-        return self._keep_if_lower(before)
+        return self.keep_if_lower(before)
 
     def put_group(self, idx: list[int], fs: list[Basis]) -> bool:
         """Replace the functions `idx` by `fs` (one-function bases) at once if that lowers the
         energy beyond the uncertainty; True if it did. Rows are patched one function after the
         other, each against the basis with the ones before it in place (as `put`)."""
-        before = self._snapshot()
+        before = self.snapshot()
         for i, f in zip(idx, fs):
             rows, diag = self.rep.rows(f, self.basis, i)
             self._place(i, f, {k: v[0] for k, v in rows.items()}, diag[0])
         self.solve()
-        return self._keep_if_lower(before)
+        return self.keep_if_lower(before)
 
     def _place(self, i: int, f: Basis, row: dict | None, d) -> None:
         """Append (i == len) or replace function i by `f`, the matrices patched from its row and

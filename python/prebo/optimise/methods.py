@@ -17,12 +17,15 @@
   removal raises the energy least (eigen.lowest_without_each), one per step back to the size:
   pruning a basis grown past its size keeps the functions that matter and moves the basis out of
   the basin refinement has settled in (benchmarks/README, "Grow and prune").
+- `Pruning`: the adaptive schedule's pruning, `pruned(N_b)` growth steps and the removals back to
+  N_b in one step, undone unless the energy fell: the schedule's size is a cap at every step and
+  its energy never rises.
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed, or with the
   functions it overlaps most (`refine_group`; refine.py).
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
 Replacements and pruning reach new basins, joint refinement converges within one; the
 prune-sweep-refine-polish block is repeated `cycles` times (Optimiser), or the adaptive schedule
-chooses among grow, sweep, refine and polish (schedule.py).
+chooses among grow, sweep, refine, polish and prune (schedule.py).
 """
 from __future__ import annotations
 
@@ -39,6 +42,7 @@ from .polish import polish
 from .refine import refine_group, refine_newcomer, regenerate_function
 from .report import Reporter
 from .sampler import Sampler
+from .schedule import pruned
 from .settings import Optimiser
 
 STALL_STEPS = 100  # growth steps in a row without an accepted trial before the run stops (StalledError)
@@ -149,6 +153,27 @@ class Prune:
 
 
 @dataclass(frozen=True)
+class Pruning:
+    """`prune`'s growth by `pruned(N_b)` functions (fewer if growth stalls) and its removals back to
+    N_b as one step, kept only if the energy fell beyond its uncertainty (module docstring)."""
+
+    prune: Prune
+
+    def step(self, run: Run, cursor: Cursor) -> None:
+        """One unit of work on `run` at `cursor` (class docstring)."""
+        ex = run.expansion
+        before, nb = ex.snapshot(), len(ex.basis)
+        try:
+            for _ in range(pruned(nb)):
+                self.prune.step(run, Cursor("prune", index=0))
+        except StalledError:
+            run.stalled = 0
+        while len(ex.basis) > nb:
+            self.prune.step(run, Cursor("prune", index=1))
+        ex.keep_if_lower(before)
+
+
+@dataclass(frozen=True)
 class Refine:
     """Refine function `cursor.index` with all others fixed."""
 
@@ -174,9 +199,10 @@ class Polish:
 def methods(opts: Optimiser) -> dict:
     """The method of each phase of the schedule, configured by `opts` (defaults.resolved): in an
     adaptive schedule, and in a fixed one with `refine`, every grown and replacing function is
-    refined."""
+    refined; an adaptive schedule prunes a whole pass in one step."""
     refinement = Refinement(opts.refine_evaluations, opts.refine_method, opts.refine_group)
     on_change = Refinement(opts.refine_evaluations, opts.refine_method) if opts.adaptive or opts.refine else None  # refine grown and replacing functions too
-    return {"grow": Grow(opts.trials, on_change), "prune": Prune(Grow(opts.trials, on_change), refinement),
+    prune = Prune(Grow(opts.trials, on_change), refinement)
+    return {"grow": Grow(opts.trials, on_change), "prune": Pruning(prune) if opts.adaptive else prune,
             "sweep": Sweep(opts.trials, on_change),
             "refine": Refine(refinement), "polish": Polish(opts.polish_iterations)}

@@ -48,13 +48,14 @@ class Reporter:
         if cursor.phase == "grow":
             self.progress.update(self.task, description="growing", completed=len(st.basis), total=self.opts.size,
                                  info=info)
+        elif self.opts.adaptive:
+            done, total = (cursor.sweep + 1, min(CHUNK, len(st.basis))) if cursor.phase not in ("polish", "prune") \
+                else (1, 1)
+            self.progress.update(self.task, description=f"{cursor.phase} (pass {cursor.cycle + 1})", completed=done,
+                                 total=total, info=info)
         elif cursor.phase == "prune":  # growth past the size: the functions to be pruned again
             self.progress.update(self.task, description=f"prune (cycle {cursor.cycle + 1})",
                                  completed=len(st.basis) - self.opts.size, total=self.opts.prune, info=info)
-        elif self.opts.adaptive:
-            done, total = (cursor.sweep + 1, min(CHUNK, len(st.basis))) if cursor.phase != "polish" else (1, 1)
-            self.progress.update(self.task, description=f"{cursor.phase} (pass {cursor.cycle + 1})", completed=done,
-                                 total=total, info=info)
         elif cursor.phase == "polish":
             self.progress.update(self.task, description=f"polish (cycle {cursor.cycle + 1})", completed=cursor.sweep + 1, total=self.opts.polish,
                                  info=info)

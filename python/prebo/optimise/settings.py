@@ -91,8 +91,8 @@ class Optimiser:
     learned — share of trials from the learned per-channel distributions (0..1); learn_after —
     functions of a channel before its distribution is learned.
     Schedule: with none of prune, sweeps, refine, polish and cycles given, the schedule chooses itself
-    (schedule.py: growth, refinement, replacement and joint passes by the energy each gains per
-    second), stopping at `budget` seconds, or when every kind of pass gains less than
+    (schedule.py: growth, refinement, replacement, joint and pruning passes by the energy each
+    gains per second), stopping at `budget` seconds, or when every kind of pass gains less than
     `tolerance` Eh. Given any of them, the fixed schedule of methods.py: prune — functions grown
     past `size` and then removed, those whose removal costs least, at the start of each cycle; sweeps — replacement
     sweeps per cycle; refine — refinement sweeps per cycle (and refinement of every grown or
