@@ -185,3 +185,24 @@ def test_run_budget_from_the_command_line_stops_a_run_and_extends_it_on_resume(t
     assert again["history"][:len(d["history"])] == d["history"] and len(again["history"]) > len(d["history"])
     for bad in ("0", "-5", "nan", "inf", "ten"):
         assert_clean_error(prebo("run", toml, "--out", out, "--budget", bad), "--budget", "seconds above 0")
+
+
+def test_the_result_and_a_re_evaluation_use_the_threshold_of_the_run(tmp_path):
+    """The stored He basis (overlap condition 3e12) with its run's threshold raised to 1e-11: the
+    result of the resumed run and `prebo energy` of its basis.json drop the same directions, and
+    --threshold 1e-13 keeps them all (and a lower energy)."""
+    import shutil
+    from pathlib import Path
+    out = tmp_path / "he"
+    shutil.copytree(Path(__file__).parent.parent / "examples" / "bases" / "auto-he-400", out)
+    d = json.loads((out / "basis.json").read_text())
+    d["optimiser"]["threshold"] = 1e-11
+    (out / "basis.json").write_text(json.dumps(d))
+    r = prebo("run", "--resume", out, "--quiet")
+    assert r.returncode == 0, r.stderr
+    result = json.loads((out / "result.json").read_text())
+    again = json.loads(prebo("energy", out / "basis.json", "--json").stdout)
+    assert result["kept"] == again["kept"] < 400 and result["energy"] == again["energy"]
+    full = json.loads(prebo("energy", out / "basis.json", "--threshold", "1e-13", "--json").stdout)
+    assert full["kept"] == 400 and full["energy"] < again["energy"]
+    assert_clean_error(prebo("energy", out / "basis.json", "--threshold", "0"), "--threshold")

@@ -154,6 +154,16 @@ def test_growth_whose_every_trial_is_rejected_stops_naming_the_setting(tmp_path,
     assert result["n_basis"] == result["convergence"]["stalled"]["size"] == 1
 
 
+
+def test_growth_stalled_at_the_overlap_threshold_names_the_threshold():
+    """Near an overlap condition of 1/threshold a new function costs a dropped direction: the
+    message names `threshold`, not the linear-dependence guard."""
+    from prebo.optimise.methods import stalled
+    opts = prebo.Optimiser(threshold=1e-13)
+    at_limit = stalled(427, opts, 9.98e12)
+    assert "overlap condition, 9.98e+12, is near 1/threshold" in at_limit and "lower threshold (now 1e-13)" in at_limit
+    assert "raise max_overlap" in stalled(427, opts, 9.0e11) and "threshold" not in stalled(427, opts, 9.0e11)
+
 def test_size_beyond_memory_is_refused(tmp_path, capsys):
     from prebo.validation import MAX_SIZE
     err = toml_error(capsys, tmp_path, H_TOML.replace("size = 3", "size = 1_000_000_000"),

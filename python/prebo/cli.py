@@ -14,13 +14,14 @@ from .errors import NonFiniteError, OutputError, PreboError
 from .expectation import OPERATORS
 
 
-def _result(basis, where, coordinates: str = "lab", operators=()) -> dict:
-    """The JSON-ready result of `basis` (with the expectation values of `operators`); NonFiniteError
-    naming the keys that are not finite numbers, and every error prefixed with `where` (the basis file)."""
+def _result(basis, where, coordinates: str = "lab", operators=(), threshold: float = 1e-13) -> dict:
+    """The JSON-ready result of `basis` (with the expectation values of `operators`; overlap
+    directions below `threshold` dropped, results.evaluate); NonFiniteError naming the keys that
+    are not finite numbers, and every error prefixed with `where` (the basis file)."""
     from .results import evaluate, public
 
     try:
-        r = public(evaluate(basis, coordinates=coordinates, operators=operators))
+        r = public(evaluate(basis, coordinates=coordinates, operators=operators, threshold=threshold))
         flat = r | {f"{name} {pair}": v for name, values in r.get("expectation", {}).items()
                     for pair, v in values.items()}
         bad = [f"{k} = {v}" for k, v in flat.items() if isinstance(v, float) and not math.isfinite(v)]
@@ -108,14 +109,14 @@ def cmd_run(args) -> int:
             raise OutputError(f"--out {out}: cannot create the output folder ({exc.strerror})") from exc
     try:
         if args.resume:
-            basis, _ = resume_from(out, progress=not args.quiet, budget=args.budget)
+            basis, opts = resume_from(out, progress=not args.quiet, budget=args.budget)
         else:
             opts = job.optimiser if args.budget is None else replace(job.optimiser, budget=args.budget)
             basis = optimise(job.system, opts, out=out, progress=not args.quiet)
     except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
         raise StalledError(f"{source}: {exc}") from exc
     title = title or basis.system.label()
-    r = _result(basis, out / "basis.json")
+    r = _result(basis, out / "basis.json", threshold=opts.threshold)  # the energy the run optimised
     r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
           "convergence": basis.convergence}
     write_json_atomic(out / "result.json", r)
@@ -175,12 +176,23 @@ def load_basis(path):
     return Basis.load(path)
 
 
+def stored_threshold(path) -> float:
+    """The overlap threshold of the run that wrote the basis file `path` (its "optimiser" block),
+    or the default 1e-13 (an ecgpack file, a basis saved without settings)."""
+    if not str(path).endswith(".json"):
+        return 1e-13
+    block = json.loads(Path(path).read_text()).get("optimiser")  # the file is valid: load_basis read it
+    threshold = block.get("threshold") if isinstance(block, dict) else None
+    return threshold if isinstance(threshold, float) and 0.0 < threshold < 1.0 else 1e-13
+
+
 def cmd_energy(args) -> int:
-    """`prebo energy BASIS [--coordinates lab|ti] [--operator NAME ...] [--json]`: re-evaluate a
-    stored basis (Eh), with the expectation values of registered operators; a warning on stderr
-    (exit status 0) when the state is not bound in the basis."""
+    """`prebo energy BASIS [--coordinates lab|ti] [--operator NAME ...] [--threshold T] [--json]`:
+    re-evaluate a stored basis (Eh), with the expectation values of registered operators; a warning
+    on stderr (exit status 0) when the state is not bound in the basis."""
     basis = load_basis(args.basis)
-    r = _result(basis, args.basis, args.coordinates, args.operator)
+    threshold = args.threshold if args.threshold is not None else stored_threshold(args.basis)
+    r = _result(basis, args.basis, args.coordinates, args.operator, threshold)
     if args.json:
         print(json.dumps(r, allow_nan=False))
     else:
@@ -219,6 +231,17 @@ def seconds(text: str) -> float:
     return value
 
 
+def fraction(text: str) -> float:
+    """A command line's threshold: a number strictly between 0 and 1."""
+    try:
+        value = finite(text)
+    except argparse.ArgumentTypeError:
+        value = 0.0
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number between 0 and 1")
+    return value
+
+
 def parser() -> argparse.ArgumentParser:
     """The `prebo` argument parser with its five subcommands."""
     p = Parser(prog="prebo", description="pre-Born–Oppenheimer ECG solver")
@@ -240,6 +263,9 @@ def parser() -> argparse.ArgumentParser:
                     help="add the expectation value of a registered operator, per class of equivalent "
                          "particle pairs (repeatable): " + "; ".join(f"{k}: {op.meaning} ({op.unit})"
                                                                      for k, op in OPERATORS.items()))
+    en.add_argument("--threshold", type=fraction, metavar="T",
+                    help="relative overlap eigenvalue below which directions are dropped (default: the "
+                         "threshold of the run that wrote the file, else 1e-13)")
     en.add_argument("--json", action="store_true", help="print one JSON object")
     en.set_defaults(func=cmd_energy)
     im = sub.add_parser("import", help="convert an ecgpack / ATOM-MOL-nonBO FILE.inout.txt to basis.json")

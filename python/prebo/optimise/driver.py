@@ -118,7 +118,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
             checkpoint()
     ex.basis.coefficients = ex.eig.vectors[:, 0]
     ex.basis.convergence = convergence(history, opts, stopped, wall(), schedule.stalled,
-                                       schedule.advantage(len(ex.basis)) if opts.adaptive else None)
+                                       schedule.advantage(len(ex.basis)) if opts.adaptive else None,
+                                       ex.eig.overlap_condition)
     return ex.basis
 
 

@@ -96,11 +96,18 @@ class Grow:
             return
         run.stalled += 1
         if run.stalled == STALL_STEPS:
-            raise StalledError(f"optimiser: {stalled(len(ex.basis), run.sampler.opts)}")
+            raise StalledError(f"optimiser: {stalled(len(ex.basis), run.sampler.opts, ex.eig.overlap_condition)}")
 
 
-def stalled(nb: int, opts: Optimiser) -> str:
-    """Why growth stopped at `nb` functions, and the settings to change."""
+def stalled(nb: int, opts: Optimiser, condition: float = 0.0) -> str:
+    """Why growth stopped at `nb` functions, and the settings to change: at an overlap `condition`
+    within a decade of 1/threshold a new function costs a dropped direction (eigen.solve), so no
+    trial lowers the energy (He at 427 functions, benchmarks/README, "Cheaper steps at large N");
+    otherwise every trial was refused by the linear-dependence guard."""
+    if condition * opts.threshold >= 0.1:
+        return (f"no trial of the last {STALL_STEPS} growth steps lowered the energy at {nb} functions: the "
+                f"overlap condition, {condition:.2e}, is near 1/threshold, where a new function costs a dropped "
+                f"direction; lower threshold (now {opts.threshold:g})")
     return (f"every trial of the last {STALL_STEPS} growth steps was rejected at {nb} functions (linearly "
             f"dependent on the basis or implausible); raise max_overlap (now {opts.max_overlap:g}), lower "
             f"min_norm (now {opts.min_norm:g}) or change length_range (now {list(opts.length_range)})")
