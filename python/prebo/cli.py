@@ -14,9 +14,9 @@ from .errors import NonFiniteError, OutputError, PreboError
 from .expectation import OPERATORS
 
 
-def _result(basis, where, coordinates: str = "lab", operators=(), threshold: float = 1e-13) -> dict:
-    """The JSON-ready result of `basis` (with the expectation values of `operators`; overlap
-    directions below `threshold` dropped, results.evaluate); NonFiniteError naming the keys that
+def _result(basis, where, threshold: float, coordinates: str = "lab", operators=()) -> dict:
+    """The JSON-ready result of `basis` (overlap directions below `threshold` dropped, with the
+    expectation values of `operators`; results.evaluate); NonFiniteError naming the keys that
     are not finite numbers, and every error prefixed with `where` (the basis file)."""
     from .results import evaluate, public
 
@@ -116,7 +116,7 @@ def cmd_run(args) -> int:
     except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
         raise StalledError(f"{source}: {exc}") from exc
     title = title or basis.system.label()
-    r = _result(basis, out / "basis.json", threshold=opts.threshold)  # the energy the run optimised
+    r = _result(basis, out / "basis.json", opts.threshold)  # the energy the run optimised
     r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
           "convergence": basis.convergence}
     write_json_atomic(out / "result.json", r)
@@ -146,7 +146,7 @@ def cmd_export(args) -> int:
     """`prebo export BASIS.json --format ecgpack [--out FILE]`: a plain-ECG basis as an ecgpack file."""
     from .io.ecgpack import write_inout
 
-    basis = load_basis(args.basis)
+    basis, _ = load_basis(args.basis)
     out = Path(args.out or str(args.basis).removesuffix(".json") + ".inout.txt")
     write_inout(basis, out)
     print(f"wrote {out}")
@@ -166,33 +166,29 @@ def cmd_plot(args) -> int:
     return 0
 
 
-def load_basis(path):
-    """A basis.json, or an ecgpack ``*.inout.txt`` (recognised by its name)."""
-    from .basis import Basis
+def load_basis(path) -> tuple:
+    """A basis.json, or an ecgpack ``*.inout.txt`` (recognised by its name), and the overlap
+    threshold of the run that wrote it (its "optimiser" block; eigen.THRESHOLD for an ecgpack
+    file or a basis saved without settings)."""
+    from .eigen import THRESHOLD
+    from .io import basis_json
 
     if str(path).endswith(".inout.txt"):
         from .io.ecgpack import read_inout
-        return read_inout(path)
-    return Basis.load(path)
-
-
-def stored_threshold(path) -> float:
-    """The overlap threshold of the run that wrote the basis file `path` (its "optimiser" block),
-    or the default 1e-13 (an ecgpack file, a basis saved without settings)."""
-    if not str(path).endswith(".json"):
-        return 1e-13
-    block = json.loads(Path(path).read_text()).get("optimiser")  # the file is valid: load_basis read it
+        return read_inout(path), THRESHOLD
+    d = basis_json.read(path)
+    basis = basis_json.from_dict(d, str(path))  # d is a checked mapping from here on
+    block = d.get("optimiser")
     threshold = block.get("threshold") if isinstance(block, dict) else None
-    return threshold if isinstance(threshold, float) and 0.0 < threshold < 1.0 else 1e-13
+    return basis, threshold if isinstance(threshold, float) and 0.0 < threshold < 1.0 else THRESHOLD
 
 
 def cmd_energy(args) -> int:
     """`prebo energy BASIS [--coordinates lab|ti] [--operator NAME ...] [--threshold T] [--json]`:
     re-evaluate a stored basis (Eh), with the expectation values of registered operators; a warning
     on stderr (exit status 0) when the state is not bound in the basis."""
-    basis = load_basis(args.basis)
-    threshold = args.threshold if args.threshold is not None else stored_threshold(args.basis)
-    r = _result(basis, args.basis, args.coordinates, args.operator, threshold)
+    basis, stored = load_basis(args.basis)
+    r = _result(basis, args.basis, args.threshold or stored, args.coordinates, args.operator)
     if args.json:
         print(json.dumps(r, allow_nan=False))
     else:
@@ -220,26 +216,25 @@ def finite(text: str) -> float:
     return value
 
 
-def seconds(text: str) -> float:
-    """A command line's wall time: a finite number of seconds above 0."""
+def within(text: str, lo: float, hi: float, what: str) -> float:
+    """A command line's number in the open interval (lo, hi), else an error calling it not `what`."""
     try:
         value = finite(text)
     except argparse.ArgumentTypeError:
-        value = 0.0
-    if not value > 0.0:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds above 0")
+        value = lo
+    if not lo < value < hi:
+        raise argparse.ArgumentTypeError(f"{text!r} is not {what}")
     return value
+
+
+def seconds(text: str) -> float:
+    """A command line's wall time: a finite number of seconds above 0."""
+    return within(text, 0.0, math.inf, "a number of seconds above 0")
 
 
 def fraction(text: str) -> float:
     """A command line's threshold: a number strictly between 0 and 1."""
-    try:
-        value = finite(text)
-    except argparse.ArgumentTypeError:
-        value = 0.0
-    if not 0.0 < value < 1.0:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number between 0 and 1")
-    return value
+    return within(text, 0.0, 1.0, "a number between 0 and 1")
 
 
 def parser() -> argparse.ArgumentParser:

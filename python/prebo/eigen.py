@@ -60,6 +60,8 @@ from .errors import LinearDependenceError, NonFiniteError, NotPositiveDefiniteEr
 
 #: relative error assumed for every stored matrix element: 4 unit roundoffs (a few ulp)
 ELEMENT_ERROR = 4 * 2.0**-53
+#: the default relative overlap eigenvalue below which `solve` drops directions
+THRESHOLD = 1e-13
 #: bases below this many functions are solved with LAPACK on one thread (module docstring)
 SERIAL_BELOW = 2000
 
@@ -84,7 +86,7 @@ class Eigen:
     overlap_condition: float  # max(s)/min(s) of the unit-diagonal overlap
 
 
-def solve(H: np.ndarray, S: np.ndarray, threshold: float = 1e-13, roots: int = 1) -> Eigen:
+def solve(H: np.ndarray, S: np.ndarray, threshold: float = THRESHOLD, roots: int = 1) -> Eigen:
     """All eigenpairs of H c = E S c by canonical orthogonalisation, the lowest `roots` of them
     refined in extended precision (module docstring).
 

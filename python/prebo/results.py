@@ -37,7 +37,7 @@ from .integrals import laboratory, require_shared_c_A, translationally_invariant
 from .thresholds import candidates, lowest
 
 
-def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = 1e-13, operators=()) -> dict:
+def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.THRESHOLD, operators=()) -> dict:
     """The energies of `basis`'s lowest state.
 
     Parameters: `basis`, a non-empty `Basis`; `coordinates`, "lab" (LFCC with the CM kinetic

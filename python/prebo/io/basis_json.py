@@ -99,13 +99,18 @@ def from_dict(d: dict, where: str = "basis", empty: bool = False) -> Basis:
 
 def load(path) -> Basis:
     """The basis of basis.json file `path`; BasisFileError naming the file for anything wrong."""
+    return from_dict(read(path), str(path))
+
+
+def read(path):
+    """The parsed content of basis.json file `path` (not yet checked: `from_dict`); BasisFileError
+    naming the file when it is unreadable or not JSON."""
     path = Path(path)
     text = read_text(path, BasisFileError)
     try:
-        d = json.loads(text)
+        return json.loads(text)
     except json.JSONDecodeError as exc:
         raise BasisFileError(f"{path}: corrupt or truncated JSON (line {exc.lineno}: {exc.msg})") from exc
-    return from_dict(d, str(path))
 
 
 def read_text(path: Path, error: type[PreboError]) -> str:

@@ -11,9 +11,10 @@ energy fell (methods.Pruning; with the fixed schedule's pruning He with 500 func
 After each pass the next one is of the kind whose last pass gained the most energy per second
 of wall time; kinds not yet tried come first. A kind's rate is measured again only when it runs
 again, so the rate it keeps is that of an earlier, richer state: as the running kind's rate
-falls below it, the other kinds are tried again, and each stays in use as long as it pays best. Growth is a kind while the basis is smaller than `size`
-and growth has not stalled (`stall`: every trial of STALL_STEPS steps linearly dependent on the
-basis; the basis then keeps the size it reached).
+falls below it, the other kinds are tried again, and each stays in use as long as it pays best.
+Growth is a kind while the basis is smaller than `size` and growth has not stalled (`stall`:
+every trial of STALL_STEPS steps linearly dependent on the basis; the basis then keeps the size
+it reached).
 
 At full size the schedule ends when the basis has converged: a whole sweep of every kind gains
 less than `tolerance` Eh (default TOLERANCE |E|), or, with a wall-time budget, the best kind's

@@ -9,6 +9,7 @@ from dataclasses import dataclass, fields
 
 from ..basis import FAMILIES
 from ..basis.gvr import K_LIMIT
+from ..eigen import THRESHOLD
 from ..errors import InputError
 from ..validation import (MATRICES, MAX_SIZE, Automatic, Channels, Choice, Integer, Lengths, Real, Refused,
                           strict_keywords)
@@ -130,7 +131,7 @@ class Optimiser:
     learn_after: int = 5
     min_norm: float = 1e-8
     max_overlap: float = 0.99
-    threshold: float = 1e-13
+    threshold: float = THRESHOLD
 
     @property
     def adaptive(self) -> bool:
