@@ -328,3 +328,52 @@ def test_an_adaptive_pruning_keeps_the_size_and_is_undone_unless_it_gains(monkey
     monkeypatch.setattr(m.np, "argmin", np.argmax)  # the removals now cost the most
     m.methods(opts)["prune"].step(run, Cursor("prune"))
     assert len(ex.basis) == 20 and ex.energy == E1 and np.array_equal(ex.basis.A, before.A)
+
+
+def test_a_run_that_stops_above_its_lowest_state_returns_that_state_and_keeps_it_in_lowest_json(tmp_path, monkeypatch):
+    """A fixed-schedule pruning that raises the energy (made to remove the dearest functions)
+    leaves the run above the state it pruned: the run returns that state, out/lowest.json holds
+    it beside the checkpoint, and a resumed run returns it too."""
+    from prebo.optimise import methods as m
+    from prebo.optimise import optimise, resume_from
+
+    without = m.eigen.lowest_without_each
+    monkeypatch.setattr(m.eigen, "lowest_without_each", lambda E, C: -without(E, C))
+    system = prebo.System(["p", "e"])
+    basis = optimise(system, Optimiser(size=3, prune=2, cycles=1, trials=5, seed=3), out=tmp_path, progress=False)
+    checkpoint = json.loads((tmp_path / "basis.json").read_text())
+    lowest = json.loads((tmp_path / "lowest.json").read_text())
+    grown = [h for h in checkpoint["history"] if h[2] == "grow"][-1]  # the state the pruning started from
+    assert grown[0] == 3 and lowest["energy"] == grown[1] < checkpoint["energy"]
+    assert len(basis) == 3 and prebo.evaluate(basis)["energy"] == pytest.approx(lowest["energy"], rel=1e-14)
+    assert prebo.evaluate(prebo.Basis.load(tmp_path / "lowest.json"))["energy"] == pytest.approx(lowest["energy"],
+                                                                                                 rel=1e-14)
+    again, _ = resume_from(tmp_path, progress=False)
+    assert prebo.evaluate(again)["energy"] == pytest.approx(lowest["energy"], rel=1e-14)
+
+
+def test_lowest_json_is_written_when_the_run_leaves_its_lowest_state_and_removed_when_it_is_back(tmp_path):
+    """checkpoint.Lowest: a state above the lowest, or of more than `size` functions, writes the
+    lowest to lowest.json; a state as low at the size removes it; a fresh run's tracker removes a
+    file an earlier run left, a resumed run's reads it back."""
+    from types import SimpleNamespace
+    from prebo.optimise.checkpoint import Lowest
+
+    basis = prebo.Basis.load(ROOT / "examples/bases/h/basis.json")
+
+    def state(n, energy):
+        return SimpleNamespace(basis=basis.subset(slice(0, n)), energy=energy, eig=SimpleNamespace(vectors=np.eye(n)))
+
+    lowest, path = Lowest(3, tmp_path, {"optimiser": {}}, resumed=False), tmp_path / "lowest.json"
+    lowest.see(state(3, -0.4))
+    assert not path.exists() and lowest.energy == -0.4
+    lowest.see(state(4, -0.45))  # beyond the size: not a candidate, the lowest is written
+    assert json.loads(path.read_text())["energy"] == -0.4 and len(lowest.basis) == 3
+    assert Lowest(3, tmp_path, {}, resumed=True).energy == -0.4
+    lowest.see(state(3, -0.3))
+    assert lowest.energy == -0.4 and path.exists()
+    lowest.see(state(2, -0.4))  # back as low: the run stands at its lowest, the file goes
+    assert not path.exists() and len(lowest.basis) == 2
+    lowest.see(state(3, -0.2))
+    assert path.exists()
+    assert Lowest(3, tmp_path, {}, resumed=False).energy == np.inf and not path.exists()

@@ -86,12 +86,15 @@ def _warn_if_unbound(r: dict) -> None:
 def cmd_run(args) -> int:
     """`prebo run INPUT [--out DIR]` or `prebo run --resume DIR`, either with `--budget SECONDS` (the
     wall time of the whole run, resumed parts included, in place of the input's or checkpoint's):
-    optimise, then write DIR/result.json (`_result`, energies in Eh) beside the checkpoint
-    DIR/basis.json; warn when the state is not bound in the basis. Returns the exit status 0."""
+    optimise, then write DIR/result.json (`_result`, energies in Eh) of the lowest state at the
+    size the run passed through, beside the checkpoint DIR/basis.json (and DIR/lowest.json if
+    the run stands above that state); warn when the state is not bound in the basis. Returns
+    the exit status 0."""
     from .io.basis_json import write_json_atomic
     from .errors import InputError, StalledError
     from .io import toml
     from .optimise import optimise, resume_from
+    from .optimise.checkpoint import CHECKPOINT, LOWEST
 
     t0 = time.perf_counter()
     if args.resume:
@@ -116,13 +119,16 @@ def cmd_run(args) -> int:
     except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
         raise StalledError(f"{source}: {exc}") from exc
     title = title or basis.system.label()
-    r = _result(basis, out / "basis.json", opts.threshold)  # the energy the run optimised
+    where = out / LOWEST if (out / LOWEST).exists() else out / CHECKPOINT  # the file of the state returned
+    r = _result(basis, where, opts.threshold)  # the energy the run optimised
     r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
           "convergence": basis.convergence}
     write_json_atomic(out / "result.json", r)
     if not args.quiet:
         _print_result(r)
-        print(f"wrote {out / 'result.json'} and {out / 'basis.json'}")
+        print(f"wrote {out / 'result.json'} ({where.name}: the lowest state at the size; "
+              f"{CHECKPOINT}: where the run stands)" if where.name == LOWEST else
+              f"wrote {out / 'result.json'} and {out / CHECKPOINT}")
     _warn_if_unbound(r)
     if basis.convergence["stalled"]:
         print(f"prebo: warning: growth stalled short of the basis size: {basis.convergence['stalled']['why']}",

@@ -7,7 +7,8 @@ continues a run.
 With an output folder, the basis, the random-number state and the position in the schedule are
 written atomically after every step: a killed run loses at most the step in flight, and
 `prebo run --resume` continues it bit for bit; every start removes the temporary files
-(basis.json.*.tmp) a write killed in flight left.
+(basis.json.*.tmp, lowest.json.*.tmp) a write killed in flight left. The run returns the lowest
+state it passed through (checkpoint.Lowest), kept in lowest.json while it stands above it.
 """
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ from ..errors import InputError, StalledError
 from ..integrals import laboratory
 from ..io.basis_json import remove_stale_temporaries
 from ..system import System
-from .checkpoint import CHECKPOINT, Cursor, load_checkpoint, resumed
+from .checkpoint import CHECKPOINT, LOWEST, Cursor, Lowest, load_checkpoint, resumed
 from .convergence import convergence
 from .defaults import resolved
 from .expansion import Expansion
@@ -43,15 +44,17 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     `opts.prune` functions and pruning back to the size, `opts.sweeps` random replacement sweeps,
     `opts.refine` refinement sweeps and `opts.polish` joint steps (methods.py). Either stops
     after `opts.budget` seconds and keeps its place in the checkpoint: resumed with a larger
-    budget, it goes on (a budget that ends a run while it prunes leaves up to `opts.prune`
-    functions more). Settings left at None are chosen for the system
-    first (defaults.resolved).
+    budget, it goes on (a budget that ends a run while it prunes leaves a checkpoint of up to
+    `opts.prune` functions more). Settings left at None are chosen for the system first
+    (defaults.resolved).
 
     out: folder of the checkpoint out/basis.json, written atomically after every step (None: no
     checkpoint); progress: show a live line; resume: a checkpoint's content
     (checkpoint.load_checkpoint) to continue exactly where it stopped.
-    Returns the basis with the ground state's coefficients and `convergence`, the report of
-    convergence.py; its energy (hartree) is prebo.evaluate(basis)["energy"]. InputError for
+    Returns the lowest state of at most `opts.size` functions the run passed through (with a
+    fixed schedule's pruning, not always where it stopped; checkpoint.Lowest): its basis with the
+    state's coefficients and `convergence`, the report of convergence.py; its energy (hartree)
+    is prebo.evaluate(basis)["energy"]. InputError for
     arguments of the wrong type, StalledError when growth rejects every trial for STALL_STEPS
     steps in a fixed schedule (the adaptive one keeps the size reached), BasisFileError for a
     `resume` that does not fit."""
@@ -70,6 +73,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         basis, cursor, history, elapsed, schedule, stopped = resumed(resume, opts, rng, "checkpoint")
     if out is not None:
         remove_stale_temporaries(Path(out) / CHECKPOINT)
+        remove_stale_temporaries(Path(out) / LOWEST)
     t_start = time.perf_counter()
 
     def wall() -> float:
@@ -77,6 +81,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         return round(elapsed + time.perf_counter() - t_start, 1)
 
     ex = Expansion(basis, rep, opts.threshold, opts.min_norm, opts.max_overlap)
+    lowest = Lowest(opts.size, out, {"optimiser": opts.to_dict()}, resumed=resume is not None)
+    lowest.see(ex)
     sampler.learn(ex.basis)
     run = Run(ex, sampler, Reporter(opts, progress, len(ex.basis)))
     steps = methods(opts)
@@ -115,12 +121,16 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 cursor = cursor.advance(len(ex.basis), opts)
             if cursor.phase == "done":
                 stopped = schedule.stopped if opts.adaptive else "schedule"
+            lowest.see(ex)  # first: a run killed between the two writes keeps its lowest state
             checkpoint()
-    ex.basis.coefficients = ex.eig.vectors[:, 0]
-    ex.basis.convergence = convergence(history, opts, stopped, wall(), schedule.stalled,
-                                       schedule.advantage(len(ex.basis)) if opts.adaptive else None,
-                                       ex.eig.overlap_condition)
-    return ex.basis
+    best = lowest.basis
+    if best is None:  # never at or below the size (a run resumed mid-pruning and stopped there)
+        best = ex.basis
+        best.coefficients = ex.eig.vectors[:, 0]
+    best.convergence = convergence(history, opts, stopped, wall(), schedule.stalled,
+                                   schedule.advantage(len(ex.basis)) if opts.adaptive else None,
+                                   ex.eig.overlap_condition)
+    return best
 
 
 def resume_from(folder: Path, progress: bool = True, budget: float | None = None) -> tuple[Basis, Optimiser]:
