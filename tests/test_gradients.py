@@ -96,6 +96,28 @@ def test_group_energy_and_gradient_match_a_full_solve_and_finite_differences(cas
     assert np.max(np.abs(g - fd)) < 1e-7 * np.max(np.abs(g)), (g, fd)
 
 
+def test_independence_from_the_eigen_solution_matches_the_schur_complement_of_the_rest(monkeypatch):
+    """Expansion.independence (no solve) equals the smallest eigenvalue of the scaled overlap of
+    a group's part orthogonal to the rest, S_ff - S_fB S_BB^-1 S_Bf; a near-duplicate pair below
+    min_norm, which the block update's guard refuses, is not refined and costs no solve."""
+    system, basis, _, _ = setup("pecg-H2", nb=8)
+    p = Parametrisation.of(basis.subset([0]))
+    basis.append(p.function(p.theta() + 1e-5 * np.random.default_rng(1).standard_normal(len(p.theta()))))
+    st = Expansion(basis, laboratory(system), 1e-14)
+    S = st.m["S"]
+    for idx in ([3, 5], [0, len(basis) - 1], [2]):
+        rest = np.setdiff1d(np.arange(len(basis)), idx)
+        O = S[np.ix_(idx, idx)] - S[np.ix_(idx, rest)] @ np.linalg.solve(S[np.ix_(rest, rest)], S[np.ix_(rest, idx)])
+        scale = 1 / np.sqrt(np.diag(S)[idx])
+        assert st.independence(idx) == pytest.approx(np.linalg.eigvalsh(O * np.outer(scale, scale))[0], rel=1e-6)
+    assert st.independence([0, len(basis) - 1]) < st.min_norm
+    solves = []
+    monkeypatch.setattr(eigen, "solve", lambda *a, **k: solves.append(1))
+    before = st.basis.subset(slice(None))
+    assert not refine_group(st, len(basis) - 1, 2, 40) and not solves
+    assert all(np.array_equal(a, b) for a, b in zip(before.parameters.values(), st.basis.parameters.values()))
+
+
 def test_partners_are_the_functions_of_largest_normalised_overlap():
     system, basis, _, _ = setup("gvr-H2+", nb=15)
     st = Expansion(basis, laboratory(system), 1e-13)

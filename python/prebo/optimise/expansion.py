@@ -77,6 +77,17 @@ class Expansion:
         H = self.m["T_ti"] + self.m["V"]
         return eigen.solve(H[np.ix_(keep, keep)], self.m["S"][np.ix_(keep, keep)], self.threshold)
 
+    def independence(self, idx: list[int]) -> float:
+        """The smallest eigenvalue of the part of functions `idx` orthogonal to the others, scaled
+        to unit diagonal (the quantity the linear-dependence guards bound): with every direction
+        kept, S^-1 = C C^T for the S-orthonormal eigenvectors C, and that part's overlap is the
+        inverse of (S^-1)_idx,idx (Schur complement), so it is 1/λ_max(W W^T), W = S_ii^½ C_i,
+        i in idx — O(N_b k^2), no solve. NaN when directions were dropped."""
+        if self.eig is None or self.eig.kept < len(self.basis):
+            return np.nan
+        W = self.eig.vectors[idx] * np.sqrt(np.diag(self.m["S"])[idx])[:, None]
+        return float(1.0 / np.linalg.eigvalsh(W @ W.T)[-1])
+
     def remove(self, i: int) -> None:
         """Remove function i, whatever that costs (the matrices without its row and column, which
         are the bits of a rebuild: an element depends on its two functions and their order)."""
