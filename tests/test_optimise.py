@@ -355,7 +355,7 @@ def test_a_run_that_stops_above_its_lowest_state_returns_that_state_and_keeps_it
 def test_lowest_json_is_written_when_the_run_leaves_its_lowest_state_and_removed_when_it_is_back(tmp_path):
     """checkpoint.Lowest: a state above the lowest, or of more than `size` functions, writes the
     lowest to lowest.json; a state as low at the size removes it; a fresh run's tracker removes a
-    file an earlier run left, a resumed run's reads it back."""
+    file an earlier run left, a resumed run's reads it back and refuses one of another system."""
     from types import SimpleNamespace
     from prebo.optimise.checkpoint import Lowest
 
@@ -364,16 +364,18 @@ def test_lowest_json_is_written_when_the_run_leaves_its_lowest_state_and_removed
     def state(n, energy):
         return SimpleNamespace(basis=basis.subset(slice(0, n)), energy=energy, eig=SimpleNamespace(vectors=np.eye(n)))
 
-    lowest, path = Lowest(3, tmp_path, {"optimiser": {}}, resumed=False), tmp_path / "lowest.json"
+    lowest, path = Lowest(basis, 3, tmp_path, {"optimiser": {}}, resumed=False), tmp_path / "lowest.json"
     lowest.see(state(3, -0.4))
     assert not path.exists() and lowest.energy == -0.4
     lowest.see(state(4, -0.45))  # beyond the size: not a candidate, the lowest is written
     assert json.loads(path.read_text())["energy"] == -0.4 and len(lowest.basis) == 3
-    assert Lowest(3, tmp_path, {}, resumed=True).energy == -0.4
+    assert Lowest(basis, 3, tmp_path, {}, resumed=True).energy == -0.4
+    with pytest.raises(prebo.errors.BasisFileError, match="lowest.json: not a state of this run"):
+        Lowest(prebo.Basis.empty(prebo.System(["alpha", "e", "e"], spin={"e": 0})), 3, tmp_path, {}, resumed=True)
     lowest.see(state(3, -0.3))
     assert lowest.energy == -0.4 and path.exists()
     lowest.see(state(2, -0.4))  # back as low: the run stands at its lowest, the file goes
     assert not path.exists() and len(lowest.basis) == 2
     lowest.see(state(3, -0.2))
     assert path.exists()
-    assert Lowest(3, tmp_path, {}, resumed=False).energy == np.inf and not path.exists()
+    assert Lowest(basis, 3, tmp_path, {}, resumed=False).energy == np.inf and not path.exists()

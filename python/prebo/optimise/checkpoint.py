@@ -86,11 +86,11 @@ class Cursor:
 class Lowest:
     """The lowest state of at most `size` functions a run has passed through (module docstring):
     its `energy` (hartree) and `basis` (with the state's coefficients; None before the first
-    function). With a folder `out`, out/lowest.json holds it whenever the run stands elsewhere,
+    function); `basis` is the run's (its system and kind). With a folder `out`, out/lowest.json holds it whenever the run stands elsewhere,
     written as a basis file with `extra` (the settings) when the run leaves it; a run that is
     not `resumed` removes the file an earlier run in the folder left."""
 
-    def __init__(self, size: int, out: Path | None, extra: dict, resumed: bool):
+    def __init__(self, basis: Basis, size: int, out: Path | None, extra: dict, resumed: bool):
         self.size, self.extra = size, extra
         self.path = None if out is None else Path(out) / LOWEST
         self.energy, self.basis, self.written = np.inf, None, False
@@ -105,6 +105,10 @@ class Lowest:
                 self.energy = number(d.get("energy"), "energy")
             except InputError as exc:
                 raise BasisFileError(f"{self.path}: {exc}") from exc
+            mine = (self.basis.kind, self.basis.system.particles, self.basis.system.state)
+            if mine != (basis.kind, basis.system.particles, basis.system.state):
+                raise BasisFileError(f"{self.path}: not a state of this run (another system, state or basis type "
+                                     "than its checkpoint's)")
             self.written = True
 
     def see(self, expansion) -> None:

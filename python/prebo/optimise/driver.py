@@ -81,7 +81,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         return round(elapsed + time.perf_counter() - t_start, 1)
 
     ex = Expansion(basis, rep, opts.threshold, opts.min_norm, opts.max_overlap)
-    lowest = Lowest(opts.size, out, {"optimiser": opts.to_dict()}, resumed=resume is not None)
+    lowest = Lowest(basis, opts.size, out, {"optimiser": opts.to_dict()}, resumed=resume is not None)
     lowest.see(ex)
     sampler.learn(ex.basis)
     run = Run(ex, sampler, Reporter(opts, progress, len(ex.basis)))
