@@ -86,9 +86,10 @@ class Cursor:
 class Lowest:
     """The lowest state of at most `size` functions a run has passed through (module docstring):
     its `energy` (hartree) and `basis` (with the state's coefficients; None before the first
-    function); `basis` is the run's (its system and kind). With a folder `out`, out/lowest.json holds it whenever the run stands elsewhere,
-    written as a basis file with `extra` (the settings) when the run leaves it; a run that is
-    not `resumed` removes the file an earlier run in the folder left."""
+    function); `basis` is the run's (its system and kind). With a folder `out`, out/lowest.json
+    holds it whenever the run stands elsewhere, written as a basis file with `extra` (the
+    settings) when the run leaves it; a run that is not `resumed` removes the file an earlier run
+    in the folder left, a resumed one reads it back (BasisFileError if it is not of this run)."""
 
     def __init__(self, basis: Basis, size: int, out: Path | None, extra: dict, resumed: bool):
         self.size, self.extra = size, extra
