@@ -1,0 +1,70 @@
+"""Refinement steps on a run's basis, one BLAS thread: the time and gain of `--steps` group
+refinements (refine.refine_group of functions 0, 1, ...), or with `--survey` the groups' standing
+against the linear-dependence guard — per group (every `--stride`-th function with its partners)
+its independence of the rest from the rest's own solve and from the whole basis's eigen-solution
+(Expansion.independence), and the block update's energy at the group's own parameters less the
+refined energy (the offset; min_norm ignored).
+
+    python benchmarks/refine_steps.py runs/he-700 --steps 100
+    python benchmarks/refine_steps.py runs/he-700 --survey --stride 23
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from prebo import eigen
+from prebo.integrals import laboratory
+from prebo.optimise.checkpoint import load_checkpoint, resumed
+from prebo.optimise.expansion import Expansion
+from prebo.optimise.refine import partners, refine_group
+
+
+def survey(ex: Expansion, group: int, stride: int) -> None:
+    """Print each sampled group's independence (rest solve, eigen-solution) and offset."""
+    H, S = ex.m["T_ti"] + ex.m["V"], ex.m["S"]
+    below = []
+    for i in range(0, len(ex.basis), stride):
+        idx = [i] + partners(ex, i, group - 1)
+        keep = np.ones(len(S), bool)
+        keep[idx] = False
+        rest = ex.without(idx)
+        D = S[np.ix_(idx, keep)] @ rest.vectors
+        scale = 1.0 / np.sqrt(np.diag(S)[idx])
+        solved = np.linalg.eigvalsh((S[np.ix_(idx, idx)] - D @ D.T) * np.outer(scale, scale))[0]
+        e = eigen.lowest_with_block(rest.energies, rest.vectors, H[np.ix_(idx, keep)], S[np.ix_(idx, keep)],
+                                    H[np.ix_(idx, idx)], S[np.ix_(idx, idx)], 0.0, near=ex.energy)[0]
+        below.append(solved < ex.min_norm)
+        print(f"{idx}: independence {solved:.3e} (rest solve), {ex.independence(idx):.3e} (eigen-solution); "
+              f"offset {e - ex.energy:+.2e} Eh")
+    print(f"{sum(below)} of {len(below)} groups below min_norm = {ex.min_norm:g}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("checkpoint", help="a run's folder (its basis.json)")
+    ap.add_argument("--group", type=int, default=3, help="functions refined together (refine_group)")
+    ap.add_argument("--evaluations", type=int, default=30, help="energies per refinement")
+    ap.add_argument("--steps", type=int, default=100)
+    ap.add_argument("--survey", action="store_true")
+    ap.add_argument("--stride", type=int, default=23)
+    a = ap.parse_args()
+    d, system, opts = load_checkpoint(a.checkpoint)
+    basis, *_ = resumed(d, opts, np.random.default_rng(0), a.checkpoint)
+    with eigen.lapack_threads(len(basis)):
+        ex = Expansion(basis, laboratory(system), opts.threshold, opts.min_norm, opts.max_overlap)
+        print(f"{a.checkpoint}: {len(basis)} functions, E = {ex.energy!r}, overlap condition "
+              f"{ex.eig.overlap_condition:.2e}")
+        if a.survey:
+            survey(ex, a.group, a.stride)
+            return
+        E0, t0 = ex.energy, time.perf_counter()
+        accepted = sum(refine_group(ex, i % len(ex.basis), a.group, a.evaluations) for i in range(a.steps))
+        print(f"{a.steps} steps in {time.perf_counter() - t0:.2f} s, {accepted} accepted, gain {E0 - ex.energy:.3e} Eh, "
+              f"E = {ex.energy!r}")
+
+
+if __name__ == "__main__":
+    main()
