@@ -65,6 +65,21 @@ def test_he_energy_matches_ecgpack(he, he_energy):
     assert rel(r["energy"], HE_ECGPACK) < 1e-10
 
 
+def test_he_evaluated_as_ecgpack_solves_it(tmp_path, references):
+    """ecgpack keeps every overlap direction; `prebo energy` of its file and of the file's import keeps
+    them too (eigen.RESOLVED) and reproduces the file's energy (1.5e-13 above it), where the default
+    threshold, 1e-13, drops 2 of the 490 directions and 1.7e-10 Eh."""
+    from prebo.cli import load_basis, main
+
+    assert main(["import", str(HE), "--out", str(tmp_path / "he.json")]) == 0
+    for path in (HE, tmp_path / "he.json"):
+        basis, threshold = load_basis(path)
+        r = prebo.evaluate(basis, threshold=threshold)
+        assert threshold == eigen.RESOLVED and r["kept"] == 490
+        assert 0 <= r["energy"] - HE_ECGPACK < 1e-12 and r["energy"] > references["He"]["energy"]
+    assert prebo.evaluate(basis)["energy"] - HE_ECGPACK > 1e-10
+
+
 def test_li_system_keeps_the_files_operator(li):
     sys_ = li.system
     assert sys_.symmetriser.young == "(1+P23)(1-P24)" and "(1+P23)(1-P24)" in repr(sys_)

@@ -141,9 +141,11 @@ def cmd_import(args) -> int:
     from .io.ecgpack import read_inout
     from .optimise.settings import check
 
+    from .eigen import RESOLVED
+
     basis = read_inout(args.file, c_A=check("c_A", args.c_A, "--c-A"))
     out = Path(args.out or str(args.file).removesuffix(".txt").removesuffix(".inout") + ".json")
-    basis.save(out)
+    basis.save(out, {"optimiser": {"threshold": RESOLVED}})  # evaluated as ecgpack solves it (load_basis)
     print(f"wrote {out} ({len(basis)} {basis.family.name} functions, {basis.system.label()})")
     return 0
 
@@ -174,14 +176,15 @@ def cmd_plot(args) -> int:
 
 def load_basis(path) -> tuple:
     """A basis.json, or an ecgpack ``*.inout.txt`` (recognised by its name), and the overlap
-    threshold of the run that wrote it (its "optimiser" block; eigen.THRESHOLD for an ecgpack
-    file or a basis saved without settings)."""
-    from .eigen import THRESHOLD
+    threshold of the code that wrote it: a run's (its "optimiser" block), eigen.RESOLVED for an
+    ecgpack file or its import (ecgpack keeps every direction), eigen.THRESHOLD for a basis saved
+    without settings."""
+    from .eigen import RESOLVED, THRESHOLD
     from .io import basis_json
 
     if str(path).endswith(".inout.txt"):
         from .io.ecgpack import read_inout
-        return read_inout(path), THRESHOLD
+        return read_inout(path), RESOLVED
     d = basis_json.read(path)
     basis = basis_json.from_dict(d, str(path))  # d is a checked mapping from here on
     block = d.get("optimiser")
@@ -266,7 +269,8 @@ def parser() -> argparse.ArgumentParser:
                                                                      for k, op in OPERATORS.items()))
     en.add_argument("--threshold", type=fraction, metavar="T",
                     help="relative overlap eigenvalue below which directions are dropped (default: the "
-                         "threshold of the run that wrote the file, else 1e-13)")
+                         "threshold of the run that wrote the file; 2^-53, every direction, for an ecgpack "
+                         "file or its import, as ecgpack solves it; else 1e-13)")
     en.add_argument("--json", action="store_true", help="print one JSON object")
     en.set_defaults(func=cmd_energy)
     im = sub.add_parser("import", help="convert an ecgpack / ATOM-MOL-nonBO FILE.inout.txt to basis.json")
