@@ -29,6 +29,11 @@ class LinearDependenceError(PreboError):
     """The overlap matrix is numerically singular beyond the chosen threshold."""
 
 
+class CancellationError(PreboError):
+    """A function whose elements double precision cannot give: nearly annihilated by the
+    symmetriser, or with a CM kinetic energy that swamps its internal one."""
+
+
 class ShapeError(PreboError):
     """Arrays whose shapes do not fit together (raised by the Rust core)."""
 

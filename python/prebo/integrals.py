@@ -11,6 +11,15 @@
 
 Each representation returns dict(S, T, T_ti, V) of normalised functions (hartree atomic units)
 from the engine of the basis's family (`Family.engine`, one per family and N).
+
+Cancellation: an element is a sum over the symmetriser's images, each at most 1 for normalised
+functions, and T_ti is T less the CM kinetic energy. A function the symmetriser nearly annihilates
+(S_nn ≪ Σ_P |c_P|: a function symmetric in two electrons of a spin triplet) or whose internal
+kinetic energy is a sliver of its CM one (T_ti,nn ≪ T_nn: two electrons drifting apart) has
+elements that lost the digits of that ratio, and a basis of them gave energies far below the exact
+ones (He ³S at -4.3e9 Eh, e e "bound" at -106 Eh). `plausible` refuses such trials below
+MIN_SYMMETRIC and MIN_INTERNAL (every committed basis lies above 2e-5 and 1e-2), `require_resolved`
+such a basis.
 """
 from __future__ import annotations
 
@@ -19,8 +28,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .coordinates import CoordinateSet, jacobi
-from .errors import SeparabilityError
+from .errors import CancellationError, SeparabilityError
 from .system import System
+
+#: smallest S_nn / Σ_P |c_P| of a function (module docstring, cancellation)
+MIN_SYMMETRIC = 1e-6
+#: smallest T_ti,nn / T_nn of a function in the laboratory frame (module docstring, cancellation)
+MIN_INTERNAL = 1e-5
 
 
 @dataclass(frozen=True)
@@ -91,14 +105,40 @@ class Representation:
 
     def plausible(self, rows: dict, diag: np.ndarray, S_basis: np.ndarray) -> np.ndarray:
         """Per trial, whether its elements pass the bounds exact integrals obey: 0 < S_nn ≤ Σ_P |c_P|,
-        T_nn, T_ti,nn ≥ 0, |S_nj| ≤ (S_nn S_jj)^{1/2} (Cauchy–Schwarz). Integrals of extreme
-        parameters that lost their digits fail them, and would otherwise break the variational bound."""
+        T_nn, T_ti,nn ≥ 0, |S_nj| ≤ (S_nn S_jj)^{1/2} (Cauchy–Schwarz), and whether they kept their
+        digits (`resolved`). Integrals of extreme parameters that lost their digits fail them, and
+        would otherwise break the variational bound."""
         S_nn = diag[:, 0]
-        ok = (S_nn > 0) & (S_nn <= np.abs(self.sym_c).sum() * (1 + 1e-10)) & (diag[:, 1] >= 0) & (diag[:, 2] >= 0)
+        ok = (S_nn <= np.abs(self.sym_c).sum() * (1 + 1e-10)) & (diag[:, 1] >= 0) & (diag[:, 2] >= 0) & self.resolved(diag)
         if rows["S"].shape[1]:
             bound = np.sqrt(np.outer(np.maximum(S_nn, 0), S_basis)) * (1 + 1e-8)
             ok &= np.all(np.abs(rows["S"]) <= bound, axis=1)
         return ok & np.all(np.isfinite(diag), axis=1)
+
+    def resolved(self, diag: np.ndarray) -> np.ndarray:
+        """Per function, from its diagonal [S, T, T_ti, V]: whether its elements kept their digits,
+        S_nn ≥ MIN_SYMMETRIC Σ_P |c_P| and (laboratory frame) T_ti,nn ≥ MIN_INTERNAL T_nn (module
+        docstring, cancellation)."""
+        ok = diag[:, 0] >= MIN_SYMMETRIC * np.abs(self.sym_c).sum()
+        if self.coords is None:
+            ok &= diag[:, 2] >= MIN_INTERNAL * diag[:, 1]
+        return ok
+
+    def require_resolved(self, m: dict) -> None:
+        """Refuse (CancellationError, naming the first such function) matrices `m` of a basis with a
+        function whose elements lost their digits to cancellation (`resolved`)."""
+        diag = np.stack([np.diag(m[k]) for k in ("S", "T", "T_ti", "V")], axis=1)
+        bad = np.flatnonzero(~self.resolved(diag) & np.isfinite(diag).all(axis=1))  # NaN: eigen.solve's error
+        if len(bad):
+            i, total = int(bad[0]), np.abs(self.sym_c).sum()
+            if diag[i, 0] < MIN_SYMMETRIC * total:
+                why = (f"the symmetriser nearly annihilates it (symmetrised norm {diag[i, 0] / total:.2e} of "
+                       f"its norm, below {MIN_SYMMETRIC:g}); is the basis of this state's symmetry?")
+            else:
+                why = (f"its internal kinetic energy is {diag[i, 2] / diag[i, 1]:.2e} of its laboratory-frame "
+                       f"one (below {MIN_INTERNAL:g}), lost to the CM elimination")
+            raise CancellationError(f"basis function {i} of {len(diag)} ({len(bad)} such) lost the digits of its "
+                                    f"matrix elements to cancellation: {why}")
 
     def oriented(self, f) -> bool:
         """Whether `rows(..., position)` reproduces full-build bits for the family of basis `f`."""

@@ -19,7 +19,8 @@ The energy is the lowest eigenvalue of the stored matrices refined in extended p
 deviation that element errors of a few ulp (4 u each, independent) of S, T_TI and V give it,
 ε (2 Σ_ij w_ij − Σ_i w_ii)^½ with w_ij = c_i² c_j² (T_ij² + V_ij² + E² S_ij²) (`eigen.energy_uncertainty`;
 docs/conventions.md compares it with Monte-Carlo perturbations): an ill-conditioned basis resolves
-its energy no better than this. A non-finite element of H or S is an error (`eigen.solve`), never a number.
+its energy no better than this. A basis with a function whose elements lost their digits to
+cancellation (integrals.py), or whose state has no positive kinetic energy, is refused. A non-finite element of H or S is an error (`eigen.solve`), never a number.
 
 `bound` is False when the energy is not below the threshold: the basis describes fragments and free
 particles, not a bound state. The virial coefficient cannot tell: a basis scaled to its variational
@@ -31,7 +32,7 @@ import numpy as np
 
 from . import eigen
 from .basis import Basis
-from .errors import InputError
+from .errors import CancellationError, InputError
 from .expectation import expectation, operator
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
 from .thresholds import candidates, lowest
@@ -51,7 +52,8 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     energy_lab, kinetic, potential, threshold and binding_energy in Eh; bound a bool; virial,
     overlap_condition dimensionless; n2 in ħ²; expectation in each operator's unit — and
     `coefficients`, the S-normalised ground-state vector. InputError for a basis that is not a non-empty `Basis`, an unknown
-    `coordinates` or operator; NonFiniteError and the eigen errors as `eigen.solve` raises them."""
+    `coordinates` or operator; CancellationError for a function whose elements lost their digits
+    (Representation.require_resolved); NonFiniteError and the eigen errors as `eigen.solve` raises them."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"evaluate: basis = {basis!r}: must be a prebo.Basis with at least one function")
     operators = (operators,) if isinstance(operators, str) else tuple(operators)
@@ -61,12 +63,14 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     if coordinates == "lab":
         rep = laboratory(system)
         m = rep.matrices(basis)
+        rep.require_resolved(m)
         lab = eigen.solve(m["T"] + m["V"], m["S"], threshold)
         energy_lab = float(lab.energies[0])
     elif coordinates == "ti":
         c_A = require_shared_c_A(basis.c_A)
         rep = translationally_invariant(system)
         m = rep.matrices(basis)
+        rep.require_resolved(m)
         energy_lab = None  # filled below: CM factor exp(-c_A X^2) common to all functions
     else:
         raise InputError(f"evaluate: coordinates = {coordinates!r}: must be 'lab' or 'ti'")
@@ -75,6 +79,10 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     kinetic, potential = float(c @ m["T_ti"] @ c), float(c @ m["V"] @ c)
     energy = float(ti.energies[0])
     uncertainty = eigen.energy_uncertainty(c, energy, m["S"], m["T_ti"], m["V"])
+    if not kinetic > uncertainty:
+        raise CancellationError(f"the state's internal kinetic energy, {kinetic:.3g} Eh, is not positive beyond the "
+                                f"energy's uncertainty ({uncertainty:.1e} Eh): rounding dominates this basis's matrix "
+                                "elements, and its energy means nothing")
     if energy_lab is None:
         energy_lab = energy + 1.5 * c_A / system.m_total
     extra = {}

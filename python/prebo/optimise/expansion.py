@@ -42,6 +42,14 @@ class Expansion:
         self.sigma = eigen.energy_uncertainty(self.eig.vectors[:, 0], self.energy, self.m["S"], self.m["T_ti"],
                                               self.m["V"])
 
+    def sound(self) -> bool:
+        """Whether the ground state's internal kinetic energy c^T T_ti c is positive beyond the
+        energy's uncertainty, as that of any wave function is: rounding that dominates an
+        ill-conditioned basis's elements (integrals.py, cancellation) can make it negative, and
+        its energy then means nothing (two electrons "bound" at -0.13 Eh)."""
+        c = self.eig.vectors[:, 0]
+        return bool(c @ self.m["T_ti"] @ c > self.sigma)
+
     def gains(self, energy: float) -> bool:
         """Whether `energy` lies below the current energy by more than its uncertainty."""
         return energy < self.energy - self.sigma
@@ -54,7 +62,7 @@ class Expansion:
     def keep_if_lower(self, before: tuple) -> bool:
         """After a change: keep it if the energy fell by more than the uncertainty before and after
         it; otherwise restore the state `before` (`snapshot`). True if kept."""
-        if before[3] == np.inf or self.energy < before[3] - max(self.sigma, before[4]):
+        if self.sound() and (before[3] == np.inf or self.energy < before[3] - max(self.sigma, before[4])):
             return True
         self.basis, self.m, self.eig, self.energy, self.sigma = before
         return False
@@ -120,7 +128,8 @@ class Expansion:
         energies = eigen.lowest_with_added_many(E, C, H[:, keep], S[:, keep], diag[:, 2] + diag[:, 3],
                                                 diag[:, 0], self.min_norm)
         if keep.any():
-            overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(diag[:, 0], np.diag(self.m["S"])[keep]))
+            with np.errstate(invalid="ignore", divide="ignore"):  # S_nn ≤ 0: refused as implausible below
+                overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(diag[:, 0], np.diag(self.m["S"])[keep]))
             energies[overlap.max(axis=1) > self.max_overlap] = np.inf
         energies[~self.rep.plausible({"S": S[:, keep]}, diag, np.diag(self.m["S"])[keep])] = np.inf
         return energies, rows, diag

@@ -35,7 +35,7 @@ import numpy as np
 
 from .. import eigen
 from ..basis import Basis
-from ..errors import StalledError
+from ..errors import StalledError, UnsupportedError
 from .checkpoint import Cursor
 from .expansion import Expansion
 from .polish import polish
@@ -95,6 +95,11 @@ class Grow:
             run.stalled = 0
             return
         run.stalled += 1
+        if run.stalled == STALL_STEPS and len(ex.basis) == 0:
+            raise UnsupportedError(f"optimiser: every trial of {STALL_STEPS} growth steps was refused with no function "
+                                   f"in the basis: {ex.basis.family.name} functions cannot describe this state (its "
+                                   "symmetriser annihilates them, or their integrals lose their digits); choose "
+                                   "another [basis] type")
         if run.stalled == STALL_STEPS:
             raise StalledError(f"optimiser: {stalled(len(ex.basis), run.sampler.opts, ex.eig.overlap_condition)}")
 
