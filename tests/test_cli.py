@@ -143,6 +143,26 @@ def test_plot_draws_the_convergence_of_runs(run_dir, tmp_path):
             assert_clean_error(prebo("plot", run_dir, f"{option}={bad}", "--out", png), option, "not a finite number")
 
 
+def test_plot_file_names_and_references_a_log_axis_cannot_draw(run_dir, tmp_path):
+    """A new user's cases: `--out conv.txt` (a matplotlib traceback), `--out conv` (wrote conv.png,
+    said conv), a reference above the run's energies (an empty log plot, exit 0)."""
+    assert_clean_error(prebo("plot", run_dir, "--out", tmp_path / "conv.txt"), "conv.txt", ".png, .pdf, .svg")
+    r = prebo("plot", run_dir, "--out", tmp_path / "conv")
+    assert r.returncode == 0 and r.stdout.strip() == f"wrote {tmp_path / 'conv.png'}"
+    assert (tmp_path / "conv.png").read_bytes()[:4] == b"\x89PNG"
+    r = prebo("plot", run_dir, "--out", tmp_path / "conv.pdf")
+    assert r.returncode == 0 and (tmp_path / "conv.pdf").read_bytes()[:4] == b"%PDF"
+    assert_clean_error(prebo("plot", run_dir, "--reference", -0.4, "--out", tmp_path / "c.png"),
+                       "--reference -0.4 Eh is not below the energies")
+
+
+def test_an_input_file_given_with_resume_is_refused(run_dir, tmp_path):
+    """`prebo run OTHER.toml --resume DIR` resumed DIR and ignored the input without a word."""
+    h = __import__("conftest").ROOT / "examples" / "h.toml"
+    assert_clean_error(prebo("run", h, "--resume", run_dir), "--resume", "give no input file")
+    assert_clean_error(prebo("run", "--resume", run_dir, "--out", tmp_path / "x"), "give no input file or --out")
+
+
 def test_plot_since_starts_each_run_from_its_state_at_that_moment():
     from prebo.plot import since
     h = [[1, -0.3, "grow", 1.0], [2, -0.4, "grow", 2.0], [2, -0.45, "sweep", 5.0]]

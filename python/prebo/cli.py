@@ -97,6 +97,9 @@ def cmd_run(args) -> int:
     from .optimise.checkpoint import CHECKPOINT, LOWEST
 
     t0 = time.perf_counter()
+    if args.resume and (args.input is not None or args.out is not None):
+        raise InputError(f"--resume {args.resume}: give no input file or --out with it (a resumed run keeps its "
+                         "checkpoint's system, settings and folder; --budget changes its budget)")
     if args.resume:
         out = Path(args.resume)
         title, source = None, str(out / "basis.json")
@@ -166,6 +169,7 @@ def cmd_plot(args) -> int:
     from .plot import convergence
 
     png = args.out or Path(args.runs[0]) / "convergence.png"
+    png = png if png.suffix else png.with_suffix(".png")
     try:
         convergence(args.runs, png, args.reference, args.since)
     except OSError as exc:
@@ -288,7 +292,8 @@ def parser() -> argparse.ArgumentParser:
     pl.add_argument("--reference", type=finite, help="exact energy: plot E - E_ref on a log axis")
     pl.add_argument("--since", type=finite, metavar="SECONDS",
                     help="only the wall time from then on, against time (runs branched from one checkpoint)")
-    pl.add_argument("--out", type=Path, help="PNG file (default FIRST-RUN/convergence.png)")
+    pl.add_argument("--out", type=Path, help="image file, .png (the default suffix), .pdf or .svg "
+                                              "(default FIRST-RUN/convergence.png)")
     pl.set_defaults(func=cmd_plot)
     return p
 

@@ -13,7 +13,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .errors import BasisFileError
+from .errors import BasisFileError, InputError
+
+#: the image formats `convergence` writes, by the file's suffix
+FORMATS = (".png", ".pdf", ".svg")
 
 
 def history(folder: Path) -> list:
@@ -44,7 +47,10 @@ def since(h: list, seconds: float, where: str = "run") -> list:
 def convergence(folders: list[Path], png: Path, reference: float | None = None, start: float | None = None) -> Path:
     """Plot the energies (Eh) of the runs in `folders` against basis size (and wall time, minutes)
     into the PNG file `png`; with `reference` (Eh) E - E_ref on a log axis; with `start` (s) only
-    the wall time from then on (`since`: runs branched from one checkpoint). Returns `png`."""
+    the wall time from then on (`since`: runs branched from one checkpoint). Returns `png`.
+    InputError for a suffix not in FORMATS or a reference not below every energy plotted."""
+    if Path(png).suffix.lower() not in FORMATS:
+        raise InputError(f"{png}: an image file ends in {', '.join(FORMATS)}")
     import matplotlib
 
     matplotlib.use("Agg")
@@ -53,6 +59,10 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None, 
     runs = [(Path(folder).name, history(folder)) for folder in folders]
     if start is not None:
         runs = [(name, since(h, start, str(folder))) for (name, h), folder in zip(runs, folders)]
+    for name, h in runs:
+        if reference is not None and min(row[1] for row in h) <= reference:
+            raise InputError(f"--reference {reference!r} Eh is not below the energies of run {name} (lowest "
+                             f"{min(row[1] for row in h)!r} Eh): E - E_ref is drawn on a logarithmic axis")
     timed = all(len(row) > 3 for _, h in runs for row in h)
     panels = [p for p, shown in (("size", start is None), ("time", timed)) if shown]
     fig, axes = plt.subplots(1, len(panels), figsize=(5.75 * len(panels) + 0.65 * (len(panels) == 1), 4.4),
