@@ -3,10 +3,12 @@ refinements (refine.refine_group of functions 0, 1, ...), or with `--survey` the
 against the linear-dependence guard — per group (every `--stride`-th function with its partners)
 its independence of the rest from the rest's own solve and from the whole basis's eigen-solution
 (Expansion.independence), and the block update's energy at the group's own parameters less the
-refined energy (the offset; min_norm ignored).
+refined energy (the offset; min_norm ignored); or with `--polish N` the time and gain of one joint
+step of at most N L-BFGS iterations over every parameter (polish.polish).
 
     python benchmarks/refine_steps.py runs/he-700 --steps 100
     python benchmarks/refine_steps.py runs/he-700 --survey --stride 23
+    python benchmarks/refine_steps.py runs/he-700 --polish 30
 """
 from __future__ import annotations
 
@@ -19,6 +21,7 @@ from prebo import eigen
 from prebo.integrals import laboratory
 from prebo.optimise.checkpoint import load_checkpoint, resumed
 from prebo.optimise.expansion import Expansion
+from prebo.optimise.polish import polish
 from prebo.optimise.refine import partners, refine_group
 
 
@@ -50,6 +53,7 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=100)
     ap.add_argument("--survey", action="store_true")
     ap.add_argument("--stride", type=int, default=23)
+    ap.add_argument("--polish", type=int, metavar="N", help="one joint step of at most N iterations instead")
     a = ap.parse_args()
     d, system, opts = load_checkpoint(a.checkpoint)
     basis, *_ = resumed(d, opts, np.random.default_rng(0), a.checkpoint)
@@ -61,6 +65,11 @@ def main() -> None:
             survey(ex, a.group, a.stride)
             return
         E0, t0 = ex.energy, time.perf_counter()
+        if a.polish:
+            polish(ex, a.polish)
+            print(f"joint step of at most {a.polish} iterations in {time.perf_counter() - t0:.2f} s, gain "
+                  f"{E0 - ex.energy:.3e} Eh, E = {ex.energy!r}")
+            return
         accepted = sum(refine_group(ex, i % len(ex.basis), a.group, a.evaluations) for i in range(a.steps))
         print(f"{a.steps} steps in {time.perf_counter() - t0:.2f} s, {accepted} accepted, gain {E0 - ex.energy:.3e} Eh, "
               f"E = {ex.energy!r}")
