@@ -206,6 +206,11 @@ def test_energy_json_is_strict_json(bases, capsys):
     (HMINUS_TOML + 'channels = ["hpc:9"]\n', ["channels", "hpc:9", "particle 9 is not one of 0..2"]),
     (HMINUS_TOML + 'channels = ["cmc:-1"]\n', ["channels", "cmc:-1"]),
     ('[system]\nparticles = ' + str(["p", "e"] * 15).replace("'", '"') + '\n', ["2 to 8 particle"]),
+    # a new user's cases: no [basis] ran with 50 functions, K_max of plain ECGs was ignored, a
+    # misspelled top-level key was called a table
+    ('[system]\nparticles = ["p", "e"]\n', ["[basis] needs 'size'"]),
+    (H_TOML.replace("size = 3", 'size = 3\ntype = "pecg"\nK_max = 4'), ["K_max", "pecg functions have no power K"]),
+    ('tittle = "H"\n' + H_TOML, ["unknown top-level keys or tables ['tittle']", "allowed: title"]),
 ])
 def test_bad_toml_values_give_one_line(tmp_path, capsys, text, words):
     toml_error(capsys, tmp_path, text, *words)

@@ -75,6 +75,7 @@ def from_dict(d: dict, where: str = "basis", empty: bool = False) -> Basis:
         system = System.from_dict(d["system"], d.get("symmetry"))
         funcs = d["functions"]
         n = system.n
+        check_fields(funcs, n, kind, ("A", "c_A") + tuple(fam.shapes))
         A = np.array([f["A"] for f in funcs], dtype=float).reshape(len(funcs), n, n)
         c_A = np.array([f["c_A"] for f in funcs], dtype=float)
         channels = [str(f.get("channel", "unknown")) for f in funcs]
@@ -95,6 +96,21 @@ def from_dict(d: dict, where: str = "basis", empty: bool = False) -> Basis:
     except PreboError as exc:
         raise BasisFileError(f"{where}: {exc}") from exc
     return basis
+
+
+def check_fields(funcs, n: int, kind: str, fields: tuple) -> None:
+    """Each function of a `kind` basis of `n` particles has `fields`, and an n x n `A`
+    (BasisFileError naming the first function that has not)."""
+    if not isinstance(funcs, list):
+        raise BasisFileError("functions must be a list")
+    for i, f in enumerate(funcs):
+        missing = [k for k in fields if not isinstance(f, dict) or k not in f]
+        if missing:
+            raise BasisFileError(f"function {i} has no {', '.join(map(repr, missing))} (each {kind} function has "
+                                 f"{', '.join(fields)})")
+        if np.shape(f["A"]) != (n, n):
+            raise BasisFileError(f"function {i}: A must be {n} x {n} for the {n} particles of the system, "
+                                 "not of shape " + "x".join(map(str, np.shape(f["A"]))))
 
 
 def load(path) -> Basis:

@@ -56,7 +56,8 @@ def from_dict(d: dict) -> Job:
     """A Job from the parsed TOML mapping (module docstring); InputError naming the key."""
     unknown = set(d) - {"title", "system", "state", "basis", "optimiser"}
     if unknown:
-        raise InputError(f"unknown tables {sorted(unknown)}")
+        raise InputError(f"unknown top-level keys or tables {sorted(unknown)} (allowed: title, [system], [state], "
+                         "[basis], [optimiser])")
     system_t = _table(d, "system", {"particles"})
     state_t = _table(d, "state", {"N", "parity", "spin", "threshold"})
     basis_t = _table(d, "basis", set(BASIS_KEYS))
@@ -67,9 +68,13 @@ def from_dict(d: dict) -> Job:
     if title is not None and not isinstance(title, str):
         raise InputError(f"title = {title!r}: must be a string")
     system = System(system_t["particles"], State(**state_t))
+    if "size" not in basis_t:
+        raise InputError("[basis] needs 'size', the number of basis functions (e.g. size = 100)")
     settings = {BASIS_KEYS[k]: v for k, v in basis_t.items()} | opt_t
     opts = resolved(Optimiser(**{name: check(name, v, SETTINGS[name].key) for name, v in settings.items()}), system)
     family(opts.kind).check_state(system.state)
+    if "K_max" in basis_t and "K" not in family(opts.kind).shapes:
+        raise InputError(f"[basis] K_max: {opts.kind} functions have no power K (K_max is a setting of ecg-gvr)")
     coordinate_sets(system, opts.channels)
     return Job(title or system.label(), system, opts)
 
