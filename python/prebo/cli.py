@@ -141,10 +141,9 @@ def cmd_run(args) -> int:
 
 def cmd_import(args) -> int:
     """`prebo import FILE.inout.txt [--out X.json] [--c-A C]`: an ecgpack basis as basis.json."""
+    from .eigen import RESOLVED
     from .io.ecgpack import read_inout
     from .optimise.settings import check
-
-    from .eigen import RESOLVED
 
     basis = read_inout(args.file, c_A=check("c_A", args.c_A, "--c-A"))
     out = Path(args.out or str(args.file).removesuffix(".txt").removesuffix(".inout") + ".json")

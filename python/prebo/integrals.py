@@ -109,7 +109,8 @@ class Representation:
         digits (`resolved`). Integrals of extreme parameters that lost their digits fail them, and
         would otherwise break the variational bound."""
         S_nn = diag[:, 0]
-        ok = (S_nn <= np.abs(self.sym_c).sum() * (1 + 1e-10)) & (diag[:, 1] >= 0) & (diag[:, 2] >= 0) & self.resolved(diag)
+        ok = (S_nn <= np.abs(self.sym_c).sum() * (1 + 1e-10)) & (diag[:, 1] >= 0) & (diag[:, 2] >= 0)
+        ok &= self.resolved(diag)
         if rows["S"].shape[1]:
             bound = np.sqrt(np.outer(np.maximum(S_nn, 0), S_basis)) * (1 + 1e-8)
             ok &= np.all(np.abs(rows["S"]) <= bound, axis=1)
