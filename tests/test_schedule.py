@@ -199,6 +199,7 @@ def test_without_a_growth_rate_the_best_rate_at_full_size_is_the_reference():
     {"passes": [["grow", 1, None, None, 0.0, 1.0, 1]], "start": [None, 0.0], "next": {"refine": 0, "sweep": 0}},
     {"passes": [], "start": [None, -1.0], "next": {"refine": 0, "sweep": 0}},
     {"passes": [], "start": [None, 0.0], "next": {"refine": -1, "sweep": 0}},
+    {"passes": [], "start": [None, 0.0], "next": {"refine": 0, "sweep": 0}, "restarts": -1},
     [], "x",
 ])
 def test_a_malformed_schedule_block_is_refused(block):
@@ -288,3 +289,21 @@ def test_the_convergence_report_starts_after_the_last_pruning():
     report = convergence(grown + since, Optimiser(size=3, prune=2, refine=1), "schedule", 11.0)
     assert report["recent"]["steps"] == 6 and report["recent"]["gain"] == pytest.approx(since[0][1] - since[-1][1])
     assert report["extrapolation"]["energy"] == pytest.approx(-1.2, abs=2e-3)
+
+
+def test_growth_starts_afresh_once_when_it_settles_on_a_fragment_and_a_distant_particle():
+    """At min(size, RESTART_AT) functions, just grown and not bound: a fresh start, RESTARTS at most."""
+    s = Adaptive(resolved(Optimiser(size=40), prebo.System(["p", "d", "e"])))
+    assert s.restart(20, -0.4998, -0.4998) and not s.restart(20, -0.5, -0.4998) and not s.restart(19, -0.1, -0.4998)
+    assert not Adaptive(s.opts, restarts=2).restart(20, -0.1, -0.4998)
+    assert Adaptive.check(s.opts, Adaptive(s.opts, restarts=1).to_dict()).restarts == 1
+
+
+def test_hd_plus_from_seed_1_is_bound(tmp_path):
+    """HD+ from defaults and seed 1 grew a D atom with the proton far away (-0.49986 Eh, "not bound")
+    and stayed there; a fresh start finds the molecule (-0.59773 with 37 functions in 30 s)."""
+    hd = prebo.System(["p", "d", "e"])
+    basis = prebo.optimise(hd, Optimiser(size=30, seed=1, budget=20), out=tmp_path, progress=False)
+    r = prebo.evaluate(basis)
+    assert r["bound"] and r["energy"] < -0.59
+    assert json.loads((tmp_path / "basis.json").read_text())["schedule"]["restarts"] == 1

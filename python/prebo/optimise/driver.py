@@ -24,6 +24,7 @@ from ..errors import InputError, StalledError
 from ..integrals import laboratory
 from ..io.basis_json import remove_stale_temporaries
 from ..system import System
+from ..thresholds import lowest as lowest_threshold
 from .checkpoint import CHECKPOINT, LOWEST, Cursor, Lowest, load_checkpoint, resumed
 from .convergence import convergence
 from .defaults import resolved
@@ -81,6 +82,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         return round(elapsed + time.perf_counter() - t_start, 1)
 
     ex = Expansion(basis, rep, opts.threshold, opts.min_norm, opts.max_overlap)
+    threshold = lowest_threshold(system).energy
     lowest = Lowest(basis, opts.size, out, {"optimiser": opts.to_dict()}, resumed=resume is not None)
     lowest.see(ex)
     sampler.learn(ex.basis)
@@ -102,7 +104,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 stopped = "budget"  # the cursor is kept: resumed with a larger budget, the run goes on
                 checkpoint()
                 break
-            stopped, old = None, ex.energy
+            stopped, old, phase = None, ex.energy, cursor.phase
             try:
                 steps[cursor.phase].step(run, cursor)
             except StalledError:
@@ -121,6 +123,12 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 cursor = cursor.advance(len(ex.basis), opts)
             if cursor.phase == "done":
                 stopped = schedule.stopped if opts.adaptive else "schedule"
+            if opts.adaptive and phase == "grow" and schedule.restart(len(ex.basis), ex.energy, threshold - ex.sigma):
+                schedule = Adaptive(opts, restarts=schedule.restarts + 1)  # a fresh start (schedule.py)
+                cursor, stopped = schedule.first(), None
+                ex = run.expansion = Expansion(Basis.empty(system, opts.kind), rep, opts.threshold, opts.min_norm,
+                                               opts.max_overlap)
+                sampler.learn(ex.basis)
             lowest.see(ex)  # first: a run killed between the two writes keeps its lowest state
             checkpoint()
     best = lowest.basis

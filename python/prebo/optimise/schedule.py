@@ -36,6 +36,14 @@ before is None for the first; functions: those the pass visited, every one for g
 joint step), the start of the pass in flight, [E, seconds], where each sweep goes on and the
 size at which growth stalled (None) are kept in the checkpoint, so a resumed run goes on with
 what it had learned (`check` reads them back).
+
+A fresh start: the first functions can settle on a fragment plus a distant particle (HD+ from
+seed 1 grew a D atom with the proton far away, -0.49986 Eh, and never left it), a basin growth
+and refinement do not leave, since no single molecular function gains beside it. So when growth
+first reaches RESTART_AT functions (or the size, if smaller) at an energy that is not below the
+lowest dissociation threshold (thresholds.lowest), the run starts again from no function, the
+random numbers going on, at most RESTARTS times; the number of starts is kept in the checkpoint.
+The run still returns the lowest state it passed through (checkpoint.Lowest).
 """
 from __future__ import annotations
 
@@ -56,6 +64,10 @@ TOLERANCE = 1e-10
 IMPROVE = ("refine", "sweep", "polish", "prune")
 #: the most functions a pruning grows past the size and removes again
 PRUNE = 20
+#: the size at which growth checks that the state is bound (module docstring, a fresh start)
+RESTART_AT = 20
+#: the most fresh starts of one run
+RESTARTS = 2
 
 
 def pruned(size: int) -> int:
@@ -68,8 +80,8 @@ class Adaptive:
     function each sweep goes on with) from a checkpoint."""
 
     def __init__(self, opts: Optimiser, passes: list | None = None, start: list | None = None,
-                 next: dict | None = None, stalled: int | None = None):
-        self.opts, self.stalled, self.stopped = opts, stalled, None
+                 next: dict | None = None, stalled: int | None = None, restarts: int = 0):
+        self.opts, self.stalled, self.stopped, self.restarts = opts, stalled, None, restarts
         self.passes = [list(p) for p in passes or []]
         self.start = list(start) if start is not None else [None, 0.0]  # no energy before the first function
         self.next = dict(next or {"refine": 0, "sweep": 0})
@@ -78,6 +90,12 @@ class Adaptive:
     def size(self) -> int:
         """The size the basis grows to: `size`, or where growth stalled."""
         return self.opts.size if self.stalled is None else min(self.opts.size, self.stalled)
+
+    def restart(self, nb: int, energy: float, threshold: float) -> bool:
+        """Whether a basis of `nb` functions at `energy` (Eh), just grown, should start afresh: at
+        min(size, RESTART_AT) functions not below `threshold` (Eh), with starts left (module
+        docstring)."""
+        return nb == min(self.opts.size, RESTART_AT) and self.restarts < RESTARTS and not energy < threshold
 
     def stall(self, nb: int) -> None:
         """Growth stalled at `nb` functions (methods.Grow): the basis keeps that size."""
@@ -175,7 +193,8 @@ class Adaptive:
 
     def to_dict(self) -> dict:
         """The checkpoint's "schedule" block."""
-        return {"passes": self.passes, "start": self.start, "next": self.next, "stalled": self.stalled}
+        return {"passes": self.passes, "start": self.start, "next": self.next, "stalled": self.stalled,
+                "restarts": self.restarts}
 
     @classmethod
     def check(cls, opts: Optimiser, block) -> "Adaptive":
@@ -200,10 +219,12 @@ class Adaptive:
 
         passes, start, nxt, stalled = ((block.get("passes"), block.get("start"), block.get("next"),
                                         block.get("stalled")) if isinstance(block, dict) else (None,) * 4)
+        restarts = block.get("restarts", 0) if isinstance(block, dict) else 0  # absent before session 21
         if not (isinstance(passes, list) and all(map(one, passes)) and isinstance(start, list) and len(start) == 2
                 and energy(start[0]) and seconds(start[1]) and isinstance(nxt, dict)
                 and set(nxt) == {"refine", "sweep"} and all(map(count, nxt.values()))
-                and (stalled is None or count(stalled))):
+                and (stalled is None or count(stalled)) and count(restarts)):
             raise ValueError("schedule must be {passes: [[kind, n_b, E before, E after, t before, t after, "
-                             "functions], ...], start: [E, t], next: {refine: i, sweep: j}, stalled: n_b or null}")
-        return cls(opts, passes, start, nxt, stalled)
+                             "functions], ...], start: [E, t], next: {refine: i, sweep: j}, stalled: n_b or null, "
+                             "restarts: n}")
+        return cls(opts, passes, start, nxt, stalled, restarts)
