@@ -113,6 +113,8 @@ def test_truncated_and_corrupt_basis_files(run_dir, tmp_path):
     assert_clean_error(prebo("energy", g), "function 0 has no 'u', 'K' (each ecg-gvr function has A, c_A, u, K)")
     g = _edit_basis(run_dir, tmp_path, lambda d: d["functions"][1].update(A=[[1.0]]))  # a numpy message before
     assert_clean_error(prebo("energy", g), "function 1: A must be 2 x 2")
+    g = _edit_basis(run_dir, tmp_path, lambda d: d["functions"][1].update(A=[[-1.0, 0.0], [0.0, -1.0]]))
+    assert_clean_error(prebo("energy", g), "function 1: exponent matrix A is not positive definite")  # not "CM"
     h = _edit_basis(run_dir, tmp_path, lambda d: d.update(format="other"))
     assert_clean_error(prebo("energy", h), "not a prebo basis file")
     assert_clean_error(prebo("energy", tmp_path / "missing.json"), "cannot read")

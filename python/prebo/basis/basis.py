@@ -138,12 +138,12 @@ class Basis:
                 raise InputError(f"function {i}: exponent matrix A is not symmetric")
             if not c > 0:
                 raise NotPositiveDefiniteError(f"function {i}: c_A = {c} must be positive")
-            if np.max(np.abs(A.sum(axis=1) - c * m)) > 1e-9 * max(1.0, np.max(np.abs(A))):
-                raise SeparabilityError(f"function {i}: A^(r) 1 != c_A m/m_tot, the CM does not separate")
             try:
                 np.linalg.cholesky(A)
             except np.linalg.LinAlgError:
                 raise NotPositiveDefiniteError(f"function {i}: exponent matrix A is not positive definite") from None
+            if np.max(np.abs(A.sum(axis=1) - c * m)) > 1e-9 * max(1.0, np.max(np.abs(A))):
+                raise SeparabilityError(f"function {i}: A^(r) 1 != c_A m/m_tot, the CM does not separate")
             fam.check_function(self, i)
 
     # --- basis.json (prebo.io.basis_json; io builds on basis, so it is imported on use) ---
