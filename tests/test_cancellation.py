@@ -68,3 +68,13 @@ def test_a_state_no_function_of_the_family_can_describe_is_an_error():
     ee = prebo.System(["e", "e"], spin={"e": 1})
     with pytest.raises(UnsupportedError, match="pecg functions cannot describe this state"):
         prebo.optimise(ee, prebo.Optimiser(size=5, seed=1), progress=False)
+
+
+def test_light_particles_with_a_heavy_cm_gaussian_stay_above_the_exact_energy():
+    """Two particles of 1e-3 m_e at c_A = 1: the CM Gaussian's kinetic energy (750 Eh) is 3e6 times
+    the binding; with T_ti,nn ≥ 1e-5 T_nn allowed the run reached -7.2e-4 Eh, below the exact
+    -μ/2 = -2.5e-4 (the translation-invariant evaluation of that basis: +2.0e-3)."""
+    light = prebo.System([{"name": "a", "mass": 1e-3, "charge": 1, "spin": 0},
+                          {"name": "b", "mass": 1e-3, "charge": -1, "spin": 0}])
+    basis = prebo.optimise(light, prebo.Optimiser(size=10, seed=3, budget=10), progress=False)
+    assert prebo.evaluate(basis)["energy"] > -0.25e-3

@@ -16,10 +16,13 @@ Cancellation: an element is a sum over the symmetriser's images, each at most 1 
 functions, and T_ti is T less the CM kinetic energy. A function the symmetriser nearly annihilates
 (S_nn ≪ Σ_P |c_P|: a function symmetric in two electrons of a spin triplet) or whose internal
 kinetic energy is a sliver of its CM one (T_ti,nn ≪ T_nn: two electrons drifting apart) has
-elements that lost the digits of that ratio, and a basis of them gave energies far below the exact
-ones (He ³S at -4.3e9 Eh, e e "bound" at -106 Eh). `plausible` refuses such trials below
-MIN_SYMMETRIC and MIN_INTERNAL (every committed basis lies above 2e-5 and 1e-2), `require_resolved`
-such a basis.
+elements that lost the digits of that ratio, and bases of them gave energies far below the exact
+ones (He ³S at -4.3e9 Eh, e e "bound" at -106 Eh). `require_resolved` refuses a basis with a
+function below MIN_SYMMETRIC or MIN_INTERNAL (every committed basis lies above 2e-5 and 1e-2);
+`plausible` refuses trials below MIN_SYMMETRIC or MIN_INTERNAL_TRIAL, stricter because the
+optimiser drives a trial to whatever edge it allows: two particles of 1e-3 m_e at c_A = 1 (their
+CM kinetic energy 3e6 times their binding) reached T_ti,nn = 1.01e-5 T_nn and an energy below
+the exact one.
 """
 from __future__ import annotations
 
@@ -35,6 +38,8 @@ from .system import System
 MIN_SYMMETRIC = 1e-6
 #: smallest T_ti,nn / T_nn of a function in the laboratory frame (module docstring, cancellation)
 MIN_INTERNAL = 1e-5
+#: the same for a trial: the optimiser drives a trial to whatever edge it is allowed
+MIN_INTERNAL_TRIAL = 1e-3
 
 
 @dataclass(frozen=True)
@@ -110,19 +115,19 @@ class Representation:
         would otherwise break the variational bound."""
         S_nn = diag[:, 0]
         ok = (S_nn <= np.abs(self.sym_c).sum() * (1 + 1e-10)) & (diag[:, 1] >= 0) & (diag[:, 2] >= 0)
-        ok &= self.resolved(diag)
+        ok &= self.resolved(diag, MIN_INTERNAL_TRIAL)
         if rows["S"].shape[1]:
             bound = np.sqrt(np.outer(np.maximum(S_nn, 0), S_basis)) * (1 + 1e-8)
             ok &= np.all(np.abs(rows["S"]) <= bound, axis=1)
         return ok & np.all(np.isfinite(diag), axis=1)
 
-    def resolved(self, diag: np.ndarray) -> np.ndarray:
+    def resolved(self, diag: np.ndarray, internal: float = MIN_INTERNAL) -> np.ndarray:
         """Per function, from its diagonal [S, T, T_ti, V]: whether its elements kept their digits,
-        S_nn ≥ MIN_SYMMETRIC Σ_P |c_P| and (laboratory frame) T_ti,nn ≥ MIN_INTERNAL T_nn (module
+        S_nn ≥ MIN_SYMMETRIC Σ_P |c_P| and (laboratory frame) T_ti,nn ≥ `internal` T_nn (module
         docstring, cancellation)."""
         ok = diag[:, 0] >= MIN_SYMMETRIC * np.abs(self.sym_c).sum()
         if self.coords is None:
-            ok &= diag[:, 2] >= MIN_INTERNAL * diag[:, 1]
+            ok &= diag[:, 2] >= internal * diag[:, 1]
         return ok
 
     def require_resolved(self, m: dict) -> None:

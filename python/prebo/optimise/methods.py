@@ -99,7 +99,7 @@ class Grow:
             raise UnsupportedError(f"optimiser: every trial of {STALL_STEPS} growth steps was refused with no function "
                                    f"in the basis: {ex.basis.family.name} functions cannot describe this state (its "
                                    "symmetriser annihilates them, or their integrals lose their digits); choose "
-                                   "another [basis] type")
+                                   f"another [basis] type, or a smaller c_A (now {run.sampler.opts.c_A:g})")
         if run.stalled == STALL_STEPS:
             raise StalledError(f"optimiser: {stalled(len(ex.basis), run.sampler.opts, ex.eig.overlap_condition)}")
 
