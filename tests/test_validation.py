@@ -372,3 +372,21 @@ def test_toml_reader_uses_tomli_before_3_11(monkeypatch):
     finally:
         monkeypatch.undo()
         importlib.reload(inputs)
+
+
+def test_evaluate_refuses_bad_arguments_and_an_unchecked_basis():
+    """A new user's API calls: a non-symmetric A gave another energy than its symmetric part;
+    threshold = "x", 2, NaN and operators = None, 5 raised TypeError or contradictory eigen errors."""
+    h = prebo.System(["p", "e"])
+    cm = h.cm_vector
+    good = prebo.Basis(h, np.array([np.outer(cm, cm) + 0.5 * np.array([[1.0, -1.0], [-1.0, 1.0]])]), np.ones(1))
+    assert np.isfinite(prebo.evaluate(good)["energy"])
+    skew = prebo.Basis(h, good.A + np.array([[[0.0, 0.1], [-0.1, 0.0]]]), np.ones(1))
+    with pytest.raises(prebo.PreboError, match="not symmetric"):
+        prebo.evaluate(skew)
+    for bad in ("x", 2.0, float("nan"), -1.0):
+        with pytest.raises(prebo.PreboError, match="evaluate: threshold"):
+            prebo.evaluate(good, threshold=bad)
+    for bad in (None, 5, [1]):
+        with pytest.raises(prebo.PreboError, match="evaluate: operators"):
+            prebo.evaluate(good, operators=bad)

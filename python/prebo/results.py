@@ -35,6 +35,7 @@ from .basis import Basis
 from .errors import CancellationError, InputError
 from .expectation import expectation, operator
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
+from .optimise.settings import check
 from .thresholds import candidates, lowest
 
 
@@ -56,9 +57,14 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     (Representation.require_resolved); NonFiniteError and the eigen errors as `eigen.solve` raises them."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"evaluate: basis = {basis!r}: must be a prebo.Basis with at least one function")
+    threshold = check("threshold", threshold, "evaluate: threshold")
+    if not (isinstance(operators, str) or (isinstance(operators, (list, tuple))
+                                           and all(isinstance(o, str) for o in operators))):
+        raise InputError(f"evaluate: operators = {operators!r}: must be a name or a list of names")
     operators = (operators,) if isinstance(operators, str) else tuple(operators)
     for name in operators:
         operator(name)
+    basis.validate()  # a Basis built in Python: symmetric, positive definite, CM-separable A
     system = basis.system
     if coordinates == "lab":
         rep = laboratory(system)
