@@ -390,3 +390,10 @@ def test_evaluate_refuses_bad_arguments_and_an_unchecked_basis():
     for bad in (None, 5, [1]):
         with pytest.raises(prebo.PreboError, match="evaluate: operators"):
             prebo.evaluate(good, operators=bad)
+
+
+def test_prebo_energy_of_an_input_file_says_so(tmp_path, capsys):
+    """`prebo energy he.toml` said "corrupt or truncated JSON"."""
+    f = tmp_path / "h.toml"
+    f.write_text(H_TOML)
+    assert "a TOML input, not a basis; optimise it with `prebo run" in cli_error(capsys, "energy", f)

@@ -183,11 +183,14 @@ def load_basis(path) -> tuple:
     ecgpack file or its import (ecgpack keeps every direction), eigen.THRESHOLD for a basis saved
     without settings."""
     from .eigen import RESOLVED, THRESHOLD
+    from .errors import InputError
     from .io import basis_json
 
     if str(path).endswith(".inout.txt"):
         from .io.ecgpack import read_inout
         return read_inout(path), RESOLVED
+    if str(path).endswith(".toml"):
+        raise InputError(f"{path}: a TOML input, not a basis; optimise it with `prebo run {path}`")
     d = basis_json.read(path)
     basis = basis_json.from_dict(d, str(path))  # d is a checked mapping from here on
     block = d.get("optimiser")
