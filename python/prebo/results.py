@@ -20,7 +20,8 @@ deviation that element errors of a few ulp (4 u each, independent) of S, T_TI an
 ε (2 Σ_ij w_ij − Σ_i w_ii)^½ with w_ij = c_i² c_j² (T_ij² + V_ij² + E² S_ij²) (`eigen.energy_uncertainty`;
 docs/conventions.md compares it with Monte-Carlo perturbations): an ill-conditioned basis resolves
 its energy no better than this. A basis with a function whose elements lost their digits to
-cancellation (integrals.py), or whose state has no positive kinetic energy, is refused. A non-finite element of H or S is an error (`eigen.solve`), never a number.
+cancellation (integrals.py), or whose state has no positive kinetic energy, is refused. A
+non-finite element of H or S is an error (`eigen.solve`), never a number.
 
 `bound` is False when the energy is not below the threshold: the basis describes fragments and free
 particles, not a bound state. The virial coefficient cannot tell: a basis scaled to its variational

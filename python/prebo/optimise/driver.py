@@ -81,7 +81,11 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         """Seconds of optimisation so far, over all segments of a resumed run."""
         return round(elapsed + time.perf_counter() - t_start, 1)
 
-    ex = Expansion(basis, rep, opts.threshold, opts.min_norm, opts.max_overlap)
+    def expansion(b: Basis) -> Expansion:
+        """The expansion of basis `b` with the run's representation and linear-dependence settings."""
+        return Expansion(b, rep, opts.threshold, opts.min_norm, opts.max_overlap)
+
+    ex = expansion(basis)
     threshold = lowest_threshold(system).energy
     lowest = Lowest(basis, opts.size, out, {"optimiser": opts.to_dict()}, resumed=resume is not None)
     lowest.see(ex)
@@ -126,8 +130,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
             if opts.adaptive and phase == "grow" and schedule.restart(len(ex.basis), ex.energy, threshold - ex.sigma):
                 schedule = Adaptive(opts, restarts=schedule.restarts + 1)  # a fresh start (schedule.py)
                 cursor, stopped = schedule.first(), None
-                ex = run.expansion = Expansion(Basis.empty(system, opts.kind), rep, opts.threshold, opts.min_norm,
-                                               opts.max_overlap)
+                ex = run.expansion = expansion(Basis.empty(system, opts.kind))
                 sampler.learn(ex.basis)
             lowest.see(ex)  # first: a run killed between the two writes keeps its lowest state
             checkpoint()
