@@ -55,6 +55,8 @@ def main() -> None:
         inp, out = f"examples/auto/{name}.toml", (args.out / name).resolve()
         t = time.perf_counter()
         if not args.reuse:
+            for stale in ("basis.json", "lowest.json"):  # a new run refuses a folder holding a checkpoint
+                (out / stale).unlink(missing_ok=True)
             subprocess.run([sys.executable, "-m", "prebo", "run", inp, "--out", str(out), "--quiet"], check=True,
                            cwd=ROOT)
         r = json.loads((out / "result.json").read_text())

@@ -41,6 +41,35 @@ def test_basis_knows_its_family_and_keeps_its_kind():
     assert b.K.dtype == np.uint32 and set(b.parameters) == {"u", "K"}
 
 
+H = prebo.System(["p", "e"])
+ONE = np.eye(2)[None]  # one 2 x 2 exponent matrix
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: Basis(None, ONE, [1.0]), "Basis: system = None: must be a prebo.System"),
+    (lambda: Basis.empty(None), "Basis.empty: system = None: must be a prebo.System"),
+    (lambda: Basis(["p", "e"], ONE, [1.0]), "Basis: system = ['p', 'e']: must be a prebo.System"),
+    (lambda: Basis(H, None, [1.0]),
+     "Basis: A = None: must be 2 x 2 exponent matrices, one per function (real numbers)"),
+    (lambda: Basis(H, "x", [1.0]), "Basis: A = 'x': must be 2 x 2 exponent matrices"),
+    (lambda: Basis(H, np.eye(3)[None], [1.0]), "Basis: A = an array of shape (1, 3, 3): must be 2 x 2 exponent"),
+    (lambda: Basis(H, ONE, None), "Basis: c_A = None: must be one number per function (real numbers)"),
+    (lambda: Basis(H, ONE, [float("nan")]), "Basis: c_A[0] = nan: must be a finite number"),
+    (lambda: Basis(H, ONE, [float("inf")]), "Basis: c_A[0] = inf: must be a finite number"),
+    (lambda: Basis(H, [[1.0, 0.0], [0.0, float("nan")]], [1.0]), "Basis: A[0, 1, 1] = nan: must be a finite number"),
+    (lambda: Basis(H, ONE, [1.0], channels=5), "Basis: channels = 5: must be a list of coordinate-set names"),
+    (lambda: Basis(H, ONE, [1.0], channels=["hpc:0", "hpc:1"]), "basis: 1 functions but 2 channels"),
+    (lambda: Basis.load(5), "Basis.load: path = 5: must be a file name (a str or path)"),
+    (lambda: Basis.empty(H).save(None), "Basis.save: path = None: must be a file name (a str or path)"),
+])
+def test_wrong_arguments_are_refused_at_construction(call, message):
+    """A new user's calls raised AttributeError, TypeError or ValueError, or took a NaN c_A that
+    failed only when the basis was evaluated."""
+    with pytest.raises(InputError) as exc:
+        call()
+    assert message in str(exc.value)
+
+
 def test_no_module_outside_the_basis_package_tests_the_family_name():
     """Family behaviour is dispatched through the Family object: no comparison with a family's
     name (`kind == "fecg"`, `kind in ("pecg", ...)`) anywhere in prebo outside prebo/basis/."""

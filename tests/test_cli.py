@@ -56,6 +56,24 @@ def test_same_seed_same_basis(run_dir, tmp_path):
     assert a == b
 
 
+def test_a_new_run_refuses_a_folder_holding_a_checkpoint(run_dir, tmp_path):
+    """`prebo run X.toml --out DIR` silently overwrote the run whose checkpoint DIR holds (and let two
+    runs share a folder); a folder with only a result or other files is a run's to write."""
+    toml, before = run_dir.parent / "h.toml", (run_dir / "basis.json").read_bytes()
+    assert_clean_error(prebo("run", toml, "--out", run_dir, "--quiet"),
+                       f"{run_dir}: the output folder holds a run's checkpoint (basis.json): continue that run "
+                       f"with `prebo run --resume {run_dir}`, or give another --out")
+    assert (run_dir / "basis.json").read_bytes() == before
+    (tmp_path / "lowest.json").write_bytes(before)
+    assert_clean_error(prebo("run", toml, "--out", tmp_path, "--quiet"), "checkpoint (lowest.json)")
+    (tmp_path / "lowest.json").unlink()
+    (tmp_path / "result.json").write_bytes((run_dir / "result.json").read_bytes())
+    (tmp_path / "notes.txt").write_text("mine")
+    assert prebo("run", toml, "--out", tmp_path, "--quiet").returncode == 0
+    assert json.loads((tmp_path / "basis.json").read_text())["functions"] == json.loads(before)["functions"]
+    assert (tmp_path / "notes.txt").read_text() == "mine"
+
+
 def assert_clean_error(r, *words):
     assert r.returncode == 2, (r.returncode, r.stdout, r.stderr)
     assert "Traceback" not in r.stderr

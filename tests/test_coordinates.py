@@ -94,6 +94,42 @@ def test_bad_sets_are_refused():
         bad.check(m)
 
 
+@pytest.mark.parametrize("call, message", [
+    (lambda: jacobi(None), "jacobi: masses = None: must be the masses of two or more particles, finite positive "
+                           "numbers in m_e (System.masses)"),
+    (lambda: jacobi(prebo.System(["p", "e"])), "jacobi: masses = System("),
+    (lambda: jacobi([1.0]), "jacobi: masses = [1.0]: must be the masses of two or more particles"),
+    (lambda: jacobi([float("nan"), 1.0]), "jacobi: masses = [nan, 1.0]: must be"),
+    (lambda: heavy_particle_centred([1.0, -1.0], 0), "heavy_particle_centred: masses = [1.0, -1.0]: must be"),
+    (lambda: cm_centred("pe"), "cm_centred: masses = 'pe': must be"),
+    (lambda: all_sets(None), "all_sets: masses = None: must be"),
+    (lambda: jacobi(MASSES[3], 5), "Jacobi order 5 is not a permutation of the particles 0..2"),
+    (lambda: jacobi(MASSES[3], [0, "1", 2]), "Jacobi order [0, '1', 2] is not a permutation of the particles 0..2"),
+    (lambda: jacobi(MASSES[3], [0, 1.0, 2]), "Jacobi order [0, 1.0, 2] is not a permutation"),
+    (lambda: heavy_particle_centred(MASSES[3], "a"), "coordinate set hpc:a: centre particle 'a' is not one of 0..2"),
+    (lambda: heavy_particle_centred(MASSES[3], 1.0), "coordinate set hpc:1.0: centre particle 1.0 is not one of"),
+    (lambda: heavy_particle_centred(MASSES[3], True), "coordinate set hpc:True: centre particle True is not one of"),
+    (lambda: cm_centred(MASSES[3], "0"), "coordinate set cmc:0: dropped particle '0' is not one of 0..2"),
+    (lambda: all_sets(MASSES[3], ["p", "e"]), "all_sets: labels must be one label per particle (3), or None"),
+    (lambda: all_sets(MASSES[3], 5), "all_sets: labels must be one label per particle (3), or None"),
+    (lambda: prebo.CoordinateSet("mine", None), "CoordinateSet mine: U = None: must be a square matrix of finite real"),
+    (lambda: prebo.CoordinateSet("mine", np.ones(3)), "CoordinateSet mine: U = [1.0, 1.0, 1.0]: must be a square"),
+    (lambda: prebo.CoordinateSet(3, np.eye(3)), "CoordinateSet: name = 3: must be a str"),
+])
+def test_wrong_arguments_name_the_argument(call, message):
+    """A new user's calls raised TypeError, IndexError or AttributeError, or built a set of a
+    negative or NaN mass or of particle True."""
+    with pytest.raises(InputError) as exc:
+        call()
+    assert message in str(exc.value)
+
+
+def test_masses_may_be_a_list():
+    m = [1.0, 2.0, 3.0]
+    assert [x.name for x in all_sets(m)] == [x.name for x in all_sets(np.array(m))]
+    assert np.array_equal(jacobi(m, (2, 0, 1)).U, jacobi(np.array(m), (2, 0, 1)).U)
+
+
 @pytest.mark.parametrize("names, jacobi_orders, centres", [
     (["p", "p", "e"], {(0, 1, 2), (0, 2, 1)}, {0, 2}),
     (["p", "e", "e"], {(0, 1, 2), (1, 2, 0)}, {0, 1}),

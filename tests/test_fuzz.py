@@ -296,5 +296,7 @@ def test_killed_run_started_anew_leaves_nothing_behind(tmp_path):
     args = ["run", tmp_path / "h.toml", "--out", out, "--quiet"]
     r = subprocess.run([sys.executable, "-c", KILL_IN_SECOND_WRITE, *map(str, args)], capture_output=True, timeout=120)
     assert r.returncode == -signal.SIGKILL and list(out.glob("basis.json.*.tmp"))
+    assert main(list(map(str, args))) == 2  # the folder holds the killed run's checkpoint
+    (out / "basis.json").unlink()  # given up: start anew
     assert main(list(map(str, args))) == 0
     assert not list(out.glob("*.tmp"))

@@ -352,6 +352,25 @@ def test_a_run_that_stops_above_its_lowest_state_returns_that_state_and_keeps_it
     assert prebo.evaluate(again)["energy"] == pytest.approx(lowest["energy"], rel=1e-14)
 
 
+def test_optimise_refuses_an_out_of_the_wrong_type_and_one_holding_a_checkpoint(tmp_path):
+    """optimise(..., out=5) raised TypeError, and a new run into a folder holding a checkpoint
+    overwrote that run; resuming it is still possible."""
+    from prebo.errors import InputError, OutputError
+    from prebo.optimise import optimise, resume_from
+
+    h, opts = prebo.System(["p", "e"]), Optimiser(size=2, trials=2, seed=1)
+    for bad in (5, 2.5, ["runs"]):
+        with pytest.raises(InputError, match=r"optimise: out = .*: must be a folder \(a str or path\), or None"):
+            optimise(h, opts, out=bad, progress=False)
+    optimise(h, opts, out=tmp_path, progress=False)
+    before = (tmp_path / "basis.json").read_bytes()
+    with pytest.raises(OutputError, match=r"out = '.*' holds a run's checkpoint \(basis.json\): continue that run "
+                                          r"with resume_from\(out\)"):
+        optimise(h, opts, out=str(tmp_path), progress=False)
+    assert (tmp_path / "basis.json").read_bytes() == before
+    assert len(resume_from(tmp_path, progress=False)[0]) == 2
+
+
 def test_lowest_json_is_written_when_the_run_leaves_its_lowest_state_and_removed_when_it_is_back(tmp_path):
     """checkpoint.Lowest: a state above the lowest, or of more than `size` functions, writes the
     lowest to lowest.json; a state as low at the size removes it; a fresh run's tracker removes a
@@ -378,4 +397,4 @@ def test_lowest_json_is_written_when_the_run_leaves_its_lowest_state_and_removed
     assert not path.exists() and len(lowest.basis) == 2
     lowest.see(state(3, -0.2))
     assert path.exists()
-    assert Lowest(basis, 3, tmp_path, {}, resumed=False).energy == np.inf and not path.exists()
+    assert Lowest(basis, 3, tmp_path, {}, resumed=False).energy == np.inf and path.exists()  # a new run's own

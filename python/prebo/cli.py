@@ -88,13 +88,13 @@ def cmd_run(args) -> int:
     wall time of the whole run, resumed parts included, in place of the input's or checkpoint's):
     optimise, then write DIR/result.json (`_result`, energies in Eh) of the lowest state at the
     size the run passed through, beside the checkpoint DIR/basis.json (and DIR/lowest.json if
-    the run stands above that state); warn when the state is not bound in the basis. Returns
-    the exit status 0."""
+    the run stands above that state); warn when the state is not bound in the basis. A new run
+    refuses a DIR that holds a checkpoint (OutputError). Returns the exit status 0."""
     from .io.basis_json import write_json_atomic
     from .errors import InputError, StalledError
     from .io import toml
     from .optimise import optimise, resume_from
-    from .optimise.checkpoint import CHECKPOINT, LOWEST
+    from .optimise.checkpoint import CHECKPOINT, LOWEST, checkpoint_in
 
     t0 = time.perf_counter()
     if args.resume and (args.input is not None or args.out is not None):
@@ -109,6 +109,10 @@ def cmd_run(args) -> int:
         job = toml.load(args.input)
         out = Path(args.out or Path("runs") / Path(args.input).stem)
         title, source = job.title, str(args.input)
+        held = checkpoint_in(out)
+        if held:
+            raise OutputError(f"{out}: the output folder holds a run's checkpoint ({held.name}): continue that run "
+                              f"with `prebo run --resume {out}`, or give another --out")
         try:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
@@ -258,7 +262,8 @@ def parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="optimise a basis for the system of a TOML input")
     run.add_argument("input", nargs="?", help="TOML input file")
-    run.add_argument("--out", help="output folder (default runs/INPUT-STEM)")
+    run.add_argument("--out", help="output folder (default runs/INPUT-STEM); one that holds a run's checkpoint "
+                                   "is refused (--resume it)")
     run.add_argument("--resume", metavar="DIR", help="continue the run whose checkpoint is DIR/basis.json")
     run.add_argument("--budget", type=seconds, metavar="SECONDS",
                      help="wall-time budget of the whole run, resumed parts included; replaces [optimiser] "

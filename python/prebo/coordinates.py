@@ -10,6 +10,7 @@ as A^(x) = U^-T A^(r) U^-1 = blockdiag(𝒜, c_A) and global vectors as u^(x) = 
 from __future__ import annotations
 
 import itertools
+import reprlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,8 +29,18 @@ class CoordinateSet:
     name: str
     U: np.ndarray
 
+    def __post_init__(self):
+        if not isinstance(self.name, str):
+            raise InputError(f"CoordinateSet: name = {reprlib.repr(self.name)}: must be a str")
+        U = _reals(self.U)
+        if U is None or U.ndim != 2 or U.shape[0] != U.shape[1] or not np.all(np.isfinite(U)):
+            got = reprlib.repr(self.U if U is None else U.tolist())
+            raise InputError(f"CoordinateSet {self.name}: U = {got}: must be a square matrix of finite real numbers")
+        object.__setattr__(self, "U", U)
+
     def check(self, masses: np.ndarray, tol: float = 1e-12) -> None:
         """Raise InputError unless U satisfies eqs. (3) and (4) for `masses` (m_e) and is invertible."""
+        masses = _masses(masses, f"{self.name}: check")
         n = len(masses)
         if self.U.shape != (n, n):
             raise InputError(f"{self.name}: U has shape {self.U.shape}, expected {(n, n)}")
@@ -79,10 +90,15 @@ class CoordinateSet:
 def jacobi(masses: np.ndarray, order=None) -> CoordinateSet:
     """Jacobi set (eq. (5)) for a particle `order` (default 0..N_p-1; `masses` in m_e):
     x_i = Σ_{j<=i} m_j r_j / m_{1..i} - r_{i+1}; named ``jacobi:ORDER``."""
+    masses = _masses(masses, "jacobi")
     n = len(masses)
-    order = list(range(n)) if order is None else list(order)
-    if sorted(order) != list(range(n)):
-        raise InputError(f"Jacobi order {order} is not a permutation of 0..{n - 1}")
+    try:
+        indices = list(range(n)) if order is None else list(order)
+    except TypeError:  # not a sequence
+        indices = []
+    if not all(_is_index(k) for k in indices) or sorted(indices) != list(range(n)):
+        raise InputError(f"Jacobi order {reprlib.repr(order)} is not a permutation of the particles 0..{n - 1}")
+    order = [int(k) for k in indices]
     U = np.zeros((n, n))
     for i in range(n - 1):
         cluster = order[: i + 1]
@@ -96,8 +112,9 @@ def jacobi(masses: np.ndarray, order=None) -> CoordinateSet:
 
 def heavy_particle_centred(masses: np.ndarray, centre: int) -> CoordinateSet:
     """Heavy-particle-centred set (eq. (6)): x_i = r_i - r_centre for i != centre; named ``hpc:CENTRE``."""
+    masses = _masses(masses, "heavy_particle_centred")
     n = len(masses)
-    _particle_index(centre, n, "hpc")
+    _particle_index(centre, n, "hpc", "centre")
     U = np.zeros((n, n))
     for row, i in enumerate(k for k in range(n) if k != centre):
         U[row, i], U[row, centre] = 1.0, -1.0
@@ -111,9 +128,10 @@ def cm_centred(masses: np.ndarray, dropped: int | None = None) -> CoordinateSet:
     Named ``cmc:DROPPED``. (Eq. (7) divides by m_{i..N}, which violates eq. (3); this is
     the set the paper's figure 1 describes.)
     """
+    masses = _masses(masses, "cm_centred")
     n = len(masses)
     dropped = n - 1 if dropped is None else dropped
-    _particle_index(dropped, n, "cmc")
+    _particle_index(dropped, n, "cmc", "dropped")
     U = np.zeros((n, n))
     for row, i in enumerate(k for k in range(n) if k != dropped):
         U[row] = -masses / masses.sum()
@@ -122,9 +140,35 @@ def cm_centred(masses: np.ndarray, dropped: int | None = None) -> CoordinateSet:
     return CoordinateSet(f"cmc:{dropped}", U)
 
 
-def _particle_index(i: int, n: int, kind: str) -> None:
-    if not 0 <= i < n:
-        raise InputError(f"coordinate set {kind}:{i}: particle {i} is not one of 0..{n - 1}")
+def _is_index(k) -> bool:
+    """Whether `k` is an integer (not a bool)."""
+    return isinstance(k, (int, np.integer)) and not isinstance(k, bool)
+
+
+def _particle_index(i, n: int, kind: str, arg: str) -> None:
+    """InputError naming argument `arg` of coordinate set `kind` unless `i` is a particle 0..n-1."""
+    if not (_is_index(i) and 0 <= i < n):
+        raise InputError(f"coordinate set {kind}:{i}: {arg} particle {i!r} is not one of 0..{n - 1}")
+
+
+def _reals(value) -> np.ndarray | None:
+    """`value` as a float array if it is real numbers, else None."""
+    try:
+        a = np.asarray(value)
+    except ValueError:  # ragged nesting
+        return None
+    return a.astype(float) if a.dtype.kind in "iuf" else None
+
+
+def _masses(masses, where: str) -> np.ndarray:
+    """`masses` as a float array of two or more finite positive numbers (m_e); InputError naming
+    `where` otherwise."""
+    m = _reals(masses)
+    if m is None or m.ndim != 1 or len(m) < 2 or not np.all((m > 0) & np.isfinite(m)):
+        got = reprlib.repr(masses if m is None else m.tolist())
+        raise InputError(f"{where}: masses = {got}: must be the masses of two or more particles, finite "
+                         "positive numbers in m_e (System.masses)")
+    return m
 
 
 def all_sets(masses: np.ndarray, labels=None) -> list[CoordinateSet]:
@@ -134,8 +178,14 @@ def all_sets(masses: np.ndarray, labels=None) -> list[CoordinateSet]:
     particle names) are counted once, as are Jacobi orders that differ only by swapping the
     first two particles (x_1 changes sign). Without labels every particle is distinct.
     `masses` in m_e; returns the list of `CoordinateSet`s."""
+    masses = _masses(masses, "all_sets")
     n = len(masses)
-    labels = list(range(n)) if labels is None else list(labels)
+    try:
+        labels = list(range(n)) if labels is None else list(labels)
+    except TypeError:
+        labels = None
+    if labels is None or len(labels) != n:
+        raise InputError(f"all_sets: labels must be one label per particle ({n}), or None")
     sets, seen = [], set()
 
     def add(key, make):

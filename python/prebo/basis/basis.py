@@ -9,6 +9,8 @@ it was generated in. Its family (`Basis.family`) adds its own arrays (u and K, o
 """
 from __future__ import annotations
 
+import os
+import reprlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,7 +30,8 @@ class Basis:
     each function was drawn in ("pairs", "jacobi:0-1-2", ...; default "unknown"); coefficients:
     (nb,) linear coefficients of the state, if known; kind: the family's name ("pecg", "ecg-gvr",
     "fecg", the basis.json basis_type); u: (nb, n) global vectors and K: (nb,) powers (ECG-GVR);
-    s: (nb, n, 3) centres in bohr (floating ECGs). InputError for shapes or values that do not fit.
+    s: (nb, n, 3) centres in bohr (floating ECGs). InputError for shapes or values that do not fit
+    (a non-finite A or c_A included).
     """
 
     system: System
@@ -42,9 +45,11 @@ class Basis:
     s: np.ndarray | None = None
 
     def __post_init__(self):
+        if not isinstance(self.system, System):
+            raise InputError(f"Basis: system = {self.system!r}: must be a prebo.System")
         n = self.system.n
-        self.A = np.ascontiguousarray(np.asarray(self.A, dtype=float).reshape(-1, n, n))
-        self.c_A = np.ascontiguousarray(np.asarray(self.c_A, dtype=float).reshape(-1))
+        self.A = _finite("A", self.A, (n, n), f"{n} x {n} exponent matrices, one per function")
+        self.c_A = _finite("c_A", self.c_A, (), "one number per function")
         nb = len(self.A)
         if len(self.c_A) != nb:
             raise InputError(f"basis: {nb} exponent matrices but {len(self.c_A)} values of c_A")
@@ -59,8 +64,11 @@ class Basis:
             if value.size != nb * int(np.prod(dims, dtype=int)):
                 raise InputError(f"basis: {nb} functions but {value.size} values of {name!r}")
             setattr(self, name, np.ascontiguousarray(value.reshape((nb, *dims))))
-        if not self.channels:
-            self.channels = ["unknown"] * nb
+        if not isinstance(self.channels, (list, tuple)) or not all(isinstance(c, str) for c in self.channels):
+            raise InputError(f"Basis: channels = {reprlib.repr(self.channels)}: must be a list of coordinate-set names")
+        self.channels = list(self.channels) or ["unknown"] * nb
+        if len(self.channels) != nb:
+            raise InputError(f"basis: {nb} functions but {len(self.channels)} channels")
 
     @property
     def family(self) -> Family:
@@ -75,6 +83,8 @@ class Basis:
     @classmethod
     def empty(cls, system: System, kind: str = "pecg") -> "Basis":
         """A basis of no functions of family `kind`."""
+        if not isinstance(system, System):
+            raise InputError(f"Basis.empty: system = {system!r}: must be a prebo.System")
         n = system.n
         extra = {name: np.zeros((0, *(n if d == "n" else d for d in shape)))
                  for name, shape in family_of(kind).shapes.items()}
@@ -155,7 +165,7 @@ class Basis:
     def save(self, path, extra: dict | None = None) -> None:
         """Write basis.json atomically: a killed run leaves either the old or the new file."""
         from ..io import basis_json
-        basis_json.save(self, path, extra)
+        basis_json.save(self, _file("Basis.save", path), extra)
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "basis", empty: bool = False) -> "Basis":
@@ -167,4 +177,28 @@ class Basis:
     def load(cls, path) -> "Basis":
         """The basis of a basis.json file; BasisFileError naming the file for anything wrong."""
         from ..io import basis_json
-        return basis_json.load(path)
+        return basis_json.load(_file("Basis.load", path))
+
+
+def _finite(name: str, value, shape: tuple, what: str) -> np.ndarray:
+    """`value` as a C-contiguous float array of shape (nb, *shape); InputError naming argument
+    `name` and `what` it must be unless it is finite real numbers of that shape."""
+    try:
+        a = np.asarray(value)
+        if a.dtype.kind not in "iuf":
+            raise ValueError
+        a = a.astype(float, copy=False).reshape(-1, *shape)
+    except ValueError:
+        got = f"an array of shape {value.shape}" if isinstance(value, np.ndarray) else reprlib.repr(value)
+        raise InputError(f"Basis: {name} = {got}: must be {what} (real numbers)") from None
+    if not np.isfinite(a).all():
+        at = tuple(np.argwhere(~np.isfinite(a))[0])
+        raise InputError(f"Basis: {name}[{', '.join(map(str, at))}] = {a[at]}: must be a finite number")
+    return np.ascontiguousarray(a)
+
+
+def _file(where: str, path):
+    """`path` if it names a file (a str or os.PathLike), else InputError naming `where`."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"{where}: path = {path!r}: must be a file name (a str or path)")
+    return path

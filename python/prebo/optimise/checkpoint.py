@@ -88,16 +88,14 @@ class Lowest:
     its `energy` (hartree) and `basis` (with the state's coefficients; None before the first
     function); `basis` is the run's (its system and kind). With a folder `out`, out/lowest.json
     holds it whenever the run stands elsewhere, written as a basis file with `extra` (the
-    settings) when the run leaves it; a run that is not `resumed` removes the file an earlier run
-    in the folder left, a resumed one reads it back (BasisFileError if it is not of this run)."""
+    settings) when the run leaves it; a `resumed` run reads it back (BasisFileError if it is not
+    of this run; a new run never starts in a folder holding one, driver.optimise)."""
 
     def __init__(self, basis: Basis, size: int, out: Path | None, extra: dict, resumed: bool):
         self.size, self.extra = size, extra
         self.path = None if out is None else Path(out) / LOWEST
         self.energy, self.basis, self.written = np.inf, None, False
-        if self.path is not None and not resumed:
-            self.path.unlink(missing_ok=True)
-        elif self.path is not None and self.path.exists():  # the run stood above it when it stopped
+        if resumed and self.path is not None and self.path.exists():  # the run stood above it when it stopped
             from ..io import basis_json
 
             d = basis_json.read(self.path)
@@ -177,3 +175,9 @@ def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
         raise BasisFileError(f"{path}: {exc}") from exc
     basis, *_ = resumed(d, opts, np.random.default_rng(), str(path))
     return d, basis.system, opts
+
+
+def checkpoint_in(folder) -> Path | None:
+    """The checkpoint (basis.json, else lowest.json) in `folder` that a new run there would
+    overwrite, or None."""
+    return next((p for p in (Path(folder) / CHECKPOINT, Path(folder) / LOWEST) if p.exists()), None)

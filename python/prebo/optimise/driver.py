@@ -12,6 +12,7 @@ state it passed through (checkpoint.Lowest), kept in lowest.json while it stands
 """
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -20,12 +21,12 @@ import numpy as np
 
 from .. import eigen
 from ..basis import Basis
-from ..errors import InputError, StalledError
+from ..errors import InputError, OutputError, StalledError
 from ..integrals import laboratory
 from ..io.basis_json import remove_stale_temporaries
 from ..system import System
 from ..thresholds import lowest as lowest_threshold
-from .checkpoint import CHECKPOINT, LOWEST, Cursor, Lowest, load_checkpoint, resumed
+from .checkpoint import CHECKPOINT, LOWEST, Cursor, Lowest, checkpoint_in, load_checkpoint, resumed
 from .convergence import convergence
 from .defaults import resolved
 from .expansion import Expansion
@@ -50,8 +51,9 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     (defaults.resolved).
 
     out: folder of the checkpoint out/basis.json, written atomically after every step (None: no
-    checkpoint); progress: show a live line; resume: a checkpoint's content
-    (checkpoint.load_checkpoint) to continue exactly where it stopped.
+    checkpoint; OutputError if a new run's folder holds one already); progress: show a live
+    line; resume: a checkpoint's content (checkpoint.load_checkpoint) to continue exactly where
+    it stopped.
     Returns the lowest state of at most `opts.size` functions the run passed through (with a
     fixed schedule's pruning, not always where it stopped; checkpoint.Lowest): its basis with the
     state's coefficients and `convergence`, the report of convergence.py; its energy (hartree)
@@ -63,6 +65,12 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         raise InputError(f"optimise: system = {system!r}: must be a prebo.System")
     if not isinstance(opts, Optimiser):
         raise InputError(f"optimise: opts = {opts!r}: must be a prebo.Optimiser")
+    if out is not None and not isinstance(out, (str, os.PathLike)):
+        raise InputError(f"optimise: out = {out!r}: must be a folder (a str or path), or None")
+    held = None if out is None or resume is not None else checkpoint_in(out)
+    if held:
+        raise OutputError(f"optimise: out = {str(out)!r} holds a run's checkpoint ({held.name}): continue that run "
+                          "with resume_from(out) (from prebo.optimise import resume_from), or give another folder")
     opts = resolved(opts, system)
     rng = np.random.default_rng(opts.seed)
     sampler = Sampler(system, opts, rng)
