@@ -4,11 +4,14 @@ against the linear-dependence guard — per group (every `--stride`-th function 
 its independence of the rest from the rest's own solve and from the whole basis's eigen-solution
 (Expansion.independence), and the block update's energy at the group's own parameters less the
 refined energy (the offset; min_norm ignored); or with `--polish N` the time and gain of one joint
-step of at most N L-BFGS iterations over every parameter (polish.polish).
+step of at most N L-BFGS iterations over every parameter (polish.polish); or with `--near T` the
+time and gain of `--steps` replacement steps whose T trials all perturb the function replaced
+(Sampler.perturbed; the best kept if it lowers the energy, `--refine` to refine it first).
 
     python benchmarks/refine_steps.py runs/he-700 --steps 100
     python benchmarks/refine_steps.py runs/he-700 --survey --stride 23
     python benchmarks/refine_steps.py runs/he-700 --polish 30
+    python benchmarks/refine_steps.py runs/he-700 --near 50 --steps 700
 """
 from __future__ import annotations
 
@@ -18,11 +21,13 @@ import time
 import numpy as np
 
 from prebo import eigen
+from prebo.basis import Basis
 from prebo.integrals import laboratory
 from prebo.optimise.checkpoint import load_checkpoint, resumed
 from prebo.optimise.expansion import Expansion
 from prebo.optimise.polish import polish
-from prebo.optimise.refine import partners, refine_group
+from prebo.optimise.refine import partners, refine_group, regenerate_function
+from prebo.optimise.sampler import Sampler
 
 
 def survey(ex: Expansion, group: int, stride: int) -> None:
@@ -45,6 +50,19 @@ def survey(ex: Expansion, group: int, stride: int) -> None:
     print(f"{sum(below)} of {len(below)} groups below min_norm = {ex.min_norm:g}")
 
 
+def replace_near(ex: Expansion, sampler: Sampler, i: int, a) -> bool:
+    """Function i against `a.near` perturbations of itself in the basis without it (methods.Sweep
+    with every trial near); True if one took its place."""
+    trials = Basis.concat(sampler.perturbed(ex.basis.subset([i]), a.near))
+    rest = ex.without(i)
+    energies, rows, diag = ex.candidates(trials, exclude=i, eig=rest)
+    best = int(np.argmin(energies))
+    if a.refine:
+        return regenerate_function(ex, i, trials.subset([best]), a.evaluations, "gradient", rest)
+    return bool(ex.gains(energies[best])
+                and ex.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best]))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("checkpoint", help="a run's folder (its basis.json)")
@@ -54,6 +72,8 @@ def main() -> None:
     ap.add_argument("--survey", action="store_true")
     ap.add_argument("--stride", type=int, default=23)
     ap.add_argument("--polish", type=int, metavar="N", help="one joint step of at most N iterations instead")
+    ap.add_argument("--near", type=int, metavar="T", help="replacement steps of T perturbations each instead")
+    ap.add_argument("--refine", action="store_true", help="with --near: refine the best trial first")
     a = ap.parse_args()
     d, system, opts = load_checkpoint(a.checkpoint)
     basis, *_ = resumed(d, opts, np.random.default_rng(0), a.checkpoint)
@@ -70,7 +90,11 @@ def main() -> None:
             print(f"joint step of at most {a.polish} iterations in {time.perf_counter() - t0:.2f} s, gain "
                   f"{E0 - ex.energy:.3e} Eh, E = {ex.energy!r}")
             return
-        accepted = sum(refine_group(ex, i % len(ex.basis), a.group, a.evaluations) for i in range(a.steps))
+        if a.near:
+            accepted = sum(replace_near(ex, Sampler(system, opts, np.random.default_rng(i)), i % len(ex.basis), a)
+                           for i in range(a.steps))
+        else:
+            accepted = sum(refine_group(ex, i % len(ex.basis), a.group, a.evaluations) for i in range(a.steps))
         print(f"{a.steps} steps in {time.perf_counter() - t0:.2f} s, {accepted} accepted, gain {E0 - ex.energy:.3e} Eh, "
               f"E = {ex.energy!r}")
 

@@ -30,6 +30,7 @@ ACCEPTANCE = {
     "auto-h2+": ("H2+", "rel:1e-6"),
     "auto-h2": ("H2", "rel:1e-6"),  # 6.2e-7 relative after 600 s with 300 functions (benchmarks/README)
     "auto-he-400": ("He", 9e-10),  # 8.65e-10 above after 206 s (benchmarks/README)
+    "auto-he-700": ("He", 1e-10),  # 5.14e-11 above after 300 s, 1e-10 at 223 s (issue 17; benchmarks/README)
     "auto-li-150": ("Li", 7.5e-5),  # 4.40e-5 above after 81 s; ecgpack's Li-100 accuracy (issue 17)
     "auto-li": ("Li", "rel:1e-6"),  # 6.1e-7 relative after 600 s with 400 functions (benchmarks/README)
 }

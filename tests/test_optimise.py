@@ -237,6 +237,68 @@ def test_a_sweep_tries_the_neighbours_in_K_with_the_peak_of_the_global_vector_co
     assert pecg.neighbours(pecg.fresh()) == []
 
 
+@pytest.mark.parametrize("kind, particles", [("pecg", ["alpha", "e", "e"]),
+                                              ("ecg-gvr", [{"name": "p", "mass": 1836.15}, {"name": "p", "mass": 1836.15}, "e", "e"])])
+def test_a_function_perturbed_at_its_own_scale_keeps_its_channel_and_tail(kind, particles):
+    from prebo.optimise.parametrisation import Parametrisation
+    from prebo.optimise.sampler import PERTURBATION, Sampler
+    system = prebo.System(particles, spin={"e": 0})
+    sampler = Sampler(system, Optimiser(kind=kind, K_max=30, channels="all"), np.random.default_rng(3))
+    f = sampler.fresh()
+    p = Parametrisation.of(f)
+    A_int, _ = p.x.from_lab(f.A[0])
+    L = np.linalg.cholesky(A_int)
+    logs, near = [], [g for g in sampler.perturbed(f, 300) if g.channels == f.channels]
+    assert len(near) > 280  # the rest left the valid region (condition of 𝒜 above 1e8): fresh draws instead
+    for g in near:
+        assert np.array_equal(g.c_A, f.c_A)
+        assert all(np.allclose(g.parameters[k], f.parameters[k]) for k in f.parameters)  # u and K kept
+        g.validate()  # CM-separable, positive definite
+        B_int, _ = p.x.from_lab(g.A[0])
+        T = np.linalg.cholesky(np.linalg.solve(L, np.linalg.solve(L, B_int).T))  # L^-1 𝒜' L^-T = T T^T
+        logs.append(np.log(np.diag(T)))
+    logs = np.array(logs)
+    assert abs(logs.mean()) < 0.15 and logs.std() == pytest.approx(PERTURBATION, rel=0.15)
+
+
+def test_an_adaptive_sweep_tries_moves_of_the_function_it_may_replace():
+    from prebo.integrals import laboratory
+    from prebo.optimise import Expansion
+    from prebo.optimise.methods import Run, Sweep
+    from prebo.optimise.report import Reporter
+    from prebo.optimise.sampler import Sampler
+    basis = prebo.Basis.load(ROOT / "examples" / "bases" / "he" / "basis.json")
+    ex = Expansion(basis, laboratory(basis.system), 1e-13)
+    sampler = Sampler(basis.system, resolved(Optimiser(size=len(basis)), basis.system), np.random.default_rng(2))
+    seen = []
+    perturbed = sampler.perturbed
+    sampler.perturbed = lambda f, k: seen.append((f, k)) or perturbed(f, k)
+    with Reporter(Optimiser(size=len(basis)), False) as report:
+        Sweep(10).step(Run(ex, sampler, report), Cursor("sweep", index=4))
+    (f, k), = seen
+    assert k == 10 and np.array_equal(f.A, basis.subset([4]).A)  # plain ECGs: no neighbours in K
+
+
+def test_a_change_must_gain_a_hundred_times_what_it_adds_to_the_uncertainty():
+    from prebo.integrals import laboratory
+    from prebo.optimise import Expansion
+    from prebo.optimise.expansion import SIGMA_PRICE
+    basis = prebo.Basis.load(ROOT / "examples" / "bases" / "he" / "basis.json")
+    ex = Expansion(basis, laboratory(basis.system), 1e-13)
+    E0, sigma0 = ex.energy, ex.sigma
+    for gain, sigma, kept in [(1e-11, 1e-12, False),  # beats σ, not the price of raising it
+                              (1e-11, 0.5e-13, True), (2 * SIGMA_PRICE * 1e-12, 1e-12, True),
+                              (1e-11, sigma0, True), (1e-13, sigma0, True), (1e-16, sigma0, False)]:
+        sigma = max(sigma, sigma0)  # a price on what is added
+        before = ex.snapshot()
+        ex.energy, ex.sigma = E0 - gain, sigma
+        assert ex.keep_if_lower(before) == kept, (gain, sigma)
+        ex.energy, ex.sigma = E0, sigma0
+    before = ex.snapshot()[:4] + (1e-13,)  # an uncertain basis may still grow by what pays its small additions
+    ex.energy, ex.sigma = E0 - 2e-13, 1.01e-13
+    assert ex.keep_if_lower(before)
+
+
 def test_the_progress_line_starts_at_the_size_of_the_basis_a_run_resumes_from():
     from prebo.optimise.report import Reporter
     with Reporter(Optimiser(size=600), True, 600) as report:

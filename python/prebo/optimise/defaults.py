@@ -18,6 +18,12 @@ None), from the physics of the particles:
   7.2e-7 Eh above with 100 trials against 1.2e-6 and 2.4e-6 with 30; He with 400 in 300 s:
   7.5e-10 and 8.7e-10 against 1.3–2.1e-9 with 20;
   benchmarks/README, "Trials in the adaptive schedule"); in a fixed one 20, or 30 for molecules;
+- near: NEAR of an atom's growth trials in the adaptive schedule perturb functions of the basis
+  at their own scale, and its sweeps try moves of the function replaced only (sampler.py): He
+  with 700 functions in 300 s, 5.1–6.0e-11 Eh above in three runs against 2.7–6.0e-10 with every
+  trial drawn (benchmarks/README, "Trials near the basis"); 0 for molecules (H2⁺ from defaults
+  ended at 5.5e-7 with it, 5.6e-8 without: the perturbations keep u and K) and in a fixed
+  schedule, whose runs are reproduced as they were measured;
 - refine_evaluations: 30 in the adaptive schedule (L-BFGS converges a function in 15–40
   energies, benchmarks/README), 200 in a fixed one;
 - refine_group: GROUP in the adaptive schedule, whose refinement passes then move each function
@@ -42,6 +48,8 @@ from .settings import Optimiser
 GROUP = 3
 #: competitive trials per step of the adaptive schedule (module docstring)
 TRIALS = 100
+#: the share of the adaptive schedule's trials drawn near the basis (module docstring)
+NEAR = 0.5
 #: a particle this many times heavier than the lightest one moves as a nucleus
 HEAVY = 100.0
 
@@ -79,5 +87,6 @@ def resolved(opts: Optimiser, system: System) -> Optimiser:
                     for k, d in (("prune", 0), ("sweeps", 0), ("refine", 0), ("polish", 0), ("cycles", 1))}
     evaluations = opts.refine_evaluations or (30 if opts.adaptive else 200)
     group = opts.refine_group or (GROUP if opts.adaptive else 1)
+    near = opts.near if opts.near is not None else (NEAR if opts.adaptive and bond is None else 0.0)
     return replace(opts, kind=kind, K_max=K_max, channels=channels, trials=trials, refine_evaluations=evaluations,
-                   refine_group=group, **schedule)
+                   refine_group=group, near=near, **schedule)

@@ -15,6 +15,10 @@ from .. import eigen
 from ..basis import Basis
 
 
+#: how many times what a change adds to the uncertainty it must gain (`Expansion.keep_if_lower`)
+SIGMA_PRICE = 100.0
+
+
 class Expansion:
     """The basis `basis` with its matrices `m` (S, T, T_ti, V; hartree), eigen-solution `eig`, ground-state
     `energy` (hartree) and `sigma`, the energy's numerical uncertainty (module docstring).
@@ -61,8 +65,13 @@ class Expansion:
 
     def keep_if_lower(self, before: tuple) -> bool:
         """After a change: keep it if the energy fell by more than the uncertainty before and after
-        it; otherwise restore the state `before` (`snapshot`). True if kept."""
-        if self.sound() and (before[3] == np.inf or self.energy < before[3] - max(self.sigma, before[4])):
+        it and by SIGMA_PRICE times what it added to the uncertainty; otherwise restore the state
+        `before` (`snapshot`). True if kept. Every later change must beat the uncertainty: a
+        near-duplicate pair with large coefficients that gains 1e-11 Eh but raises σ from 1e-15 to
+        1e-11 locks the run (He, 700 functions: 8.5e-12, no change kept for the last 200 s)."""
+        gain = before[3] - self.energy
+        if self.sound() and (before[3] == np.inf or (gain > max(self.sigma, before[4])
+                                                    and gain > SIGMA_PRICE * (self.sigma - before[4]))):
             return True
         self.basis, self.m, self.eig, self.energy, self.sigma = before
         return False

@@ -8,7 +8,8 @@
   appended — with `refine`, refined first.
 - `Sweep`: one step of a replacement sweep: function i competes with `trials` replacements in the
   basis without it — its neighbours in the power K (Sampler.neighbours: K ± 1, K ± 2 with the
-  peak of the global-vector coordinate kept; refinement cannot change K) and random functions;
+  peak of the global-vector coordinate kept; refinement cannot change K), then the function
+  perturbed at its own scale, or random functions with `near` = 0 (Sampler.replacements);
   with `refine`, the winner is refined and kept only if it then beats the incumbent, which is
   refined otherwise (refine.regenerate_function).
 - `Prune`: growth past the size (as `Grow`, each grown function then refined with the functions
@@ -34,7 +35,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import eigen
-from ..basis import Basis
 from ..errors import StalledError, UnsupportedError
 from .checkpoint import Cursor
 from .expansion import Expansion
@@ -81,7 +81,7 @@ class Grow:
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
         ex = run.expansion
-        trials = run.sampler.trials(self.trials)
+        trials = run.sampler.trials(self.trials, ex.basis)
         energies, rows, diag = ex.candidates(trials)
         best = int(np.argmin(energies))
         run.report.trials(len(trials))
@@ -121,8 +121,8 @@ def stalled(nb: int, opts: Optimiser, condition: float = 0.0) -> str:
 @dataclass(frozen=True)
 class Sweep:
     """Replace function `cursor.index` by the best of `trials` functions — its neighbours in K, then
-    random ones — if that lowers the energy; with `refine`, the winner is refined first (module
-    docstring)."""
+    itself perturbed or random ones — if that lowers the energy; with `refine`, the winner is
+    refined first (module docstring)."""
 
     trials: int
     refine: Refinement | None = None
@@ -130,8 +130,7 @@ class Sweep:
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
         ex, i = run.expansion, cursor.index
-        near = run.sampler.neighbours(ex.basis.subset([i]))[:self.trials]
-        trials = Basis.concat(near + [run.sampler.draw() for _ in range(self.trials - len(near))])
+        trials = run.sampler.replacements(ex.basis.subset([i]), self.trials)
         rest = ex.without(i)
         energies, rows, diag = ex.candidates(trials, exclude=i, eig=rest)
         run.report.trials(len(trials))

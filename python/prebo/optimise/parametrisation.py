@@ -71,6 +71,12 @@ class Parametrisation:
             raise IllConditionedError(f"exponent matrix with condition number above {MAX_CONDITION:.0e}")
         return L
 
+    def transformed(self, theta: np.ndarray, T: np.ndarray) -> np.ndarray:
+        """θ of 𝒜 = (L T)(L T)^T for a lower-triangular T with positive diagonal, the tail kept."""
+        LT = self._L(theta) @ T
+        d = len(LT)
+        return np.concatenate([np.log(np.diag(LT)), LT[_entries(d)][d:], theta[self._split:]])
+
     def function(self, theta: np.ndarray, K: int | None = None) -> Basis:
         """The one-function basis of θ (`K`: a power to set instead of the function's own)."""
         f, L = self.f, self._L(theta)

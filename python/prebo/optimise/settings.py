@@ -55,6 +55,9 @@ SETTINGS = {
                          "converged (adaptive schedule)", "[optimiser] tolerance"),
     "learned": Setting(Real(0.0, 1.0, True, True), "share of trials from the learned distributions",
                        "[optimiser] learned"),
+    "near": Setting(Automatic(Real(0.0, 1.0, True, True)), "share of a growth step's trials drawn near the basis: "
+                    "functions of it perturbed at their own scale (> 0: a sweep's trials all move the function "
+                    "replaced)", "[optimiser] near"),
     "learn_after": Setting(Integer(1), "functions of a channel before its distribution is learned",
                            "[optimiser] learn_after"),
     "min_norm": Setting(Real(0.0, 1.0), "smallest part of a trial orthogonal to the basis, relative to its norm",
@@ -90,7 +93,10 @@ class Optimiser:
     "pairs", "all" or a list of coordinate-set names the functions are drawn in; length_range —
     [lo, hi] of the drawn lengths in units of each pair's Bohr radius (sampler.pair_lengths);
     learned — share of trials from the learned per-channel distributions (0..1); learn_after —
-    functions of a channel before its distribution is learned.
+    functions of a channel before its distribution is learned; near — share of a growth step's
+    trials that perturb functions of the basis at their own scale; with near > 0 a replacement
+    sweep's trials all move the function replaced (sampler.py; chosen by the schedule when not
+    given).
     Schedule: with none of prune, sweeps, refine, polish and cycles given, the schedule chooses itself
     (schedule.py: growth, refinement, replacement, joint and pruning passes by the energy each
     gains per second), stopping at `budget` seconds, or when every kind of pass gains less than
@@ -129,6 +135,7 @@ class Optimiser:
     tolerance: float | None = None
     learned: float = 0.5
     learn_after: int = 5
+    near: float | None = None
     min_norm: float = 1e-8
     max_overlap: float = 0.99
     threshold: float = THRESHOLD
