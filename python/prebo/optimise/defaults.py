@@ -48,7 +48,7 @@ from .settings import Optimiser
 GROUP = 3
 #: competitive trials per step of the adaptive schedule (module docstring)
 TRIALS = 100
-#: the share of the adaptive schedule's trials drawn near the basis (module docstring)
+#: the share of an atom's growth trials drawn near the basis in the adaptive schedule (module docstring)
 NEAR = 0.5
 #: a particle this many times heavier than the lightest one moves as a nucleus
 HEAVY = 100.0

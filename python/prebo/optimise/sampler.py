@@ -17,9 +17,9 @@ factor around e^{±1} and the directions mixed, where a fresh draw samples the w
 (the family's u, s and K kept). Growth perturbs functions of the basis chosen at random; with
 `near` > 0 a replacement sweep tries moves of the function it may replace only: its neighbours in
 K (`neighbours`, the only moves in K besides a fresh draw: refinement changes θ only), then
-perturbations of it. On an optimised He basis of 700
-functions, replacements by the best of 50 perturbations gained 3.0e-10 Eh in 140 s, 20× what
-refinement gained per second there (benchmarks/README, "Trials near the basis").
+perturbations of it. On an optimised He basis of 700 functions, replacements by the best of 50
+perturbations gained 3.0e-10 Eh in 140 s, 20× what refinement gained per second there
+(benchmarks/README, "Trials near the basis").
 """
 from __future__ import annotations
 
