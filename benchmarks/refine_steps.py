@@ -5,8 +5,9 @@ its independence of the rest from the rest's own solve and from the whole basis'
 (Expansion.independence), and the block update's energy at the group's own parameters less the
 refined energy (the offset; min_norm ignored); or with `--polish N` the time and gain of one joint
 step of at most N L-BFGS iterations over every parameter (polish.polish); or with `--near T` the
-time and gain of `--steps` replacement steps whose T trials all perturb the function replaced
-(Sampler.perturbed; the best kept if it lowers the energy, `--refine` to refine it first).
+time and gain of `--steps` replacement steps (methods.Sweep with `near` > 0) whose T trials all
+move the function replaced: its neighbours in K, then perturbations of it (Sampler.perturbed); the
+best is kept if it lowers the energy, refined first with `--refine`.
 
     python benchmarks/refine_steps.py runs/he-700 --steps 100
     python benchmarks/refine_steps.py runs/he-700 --survey --stride 23
@@ -17,16 +18,18 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 
 import numpy as np
 
 from prebo import eigen
-from prebo.basis import Basis
 from prebo.integrals import laboratory
-from prebo.optimise.checkpoint import load_checkpoint, resumed
+from prebo.optimise.checkpoint import Cursor, load_checkpoint, resumed
 from prebo.optimise.expansion import Expansion
+from prebo.optimise.methods import Refinement, Run, Sweep
 from prebo.optimise.polish import polish
-from prebo.optimise.refine import partners, refine_group, regenerate_function
+from prebo.optimise.refine import partners, refine_group
+from prebo.optimise.report import Reporter
 from prebo.optimise.sampler import Sampler
 
 
@@ -50,17 +53,13 @@ def survey(ex: Expansion, group: int, stride: int) -> None:
     print(f"{sum(below)} of {len(below)} groups below min_norm = {ex.min_norm:g}")
 
 
-def replace_near(ex: Expansion, sampler: Sampler, i: int, a) -> bool:
-    """Function i against `a.near` perturbations of itself in the basis without it (methods.Sweep
-    with every trial near); True if one took its place."""
-    trials = Basis.concat(sampler.perturbed(ex.basis.subset([i]), a.near))
-    rest = ex.without(i)
-    energies, rows, diag = ex.candidates(trials, exclude=i, eig=rest)
-    best = int(np.argmin(energies))
-    if a.refine:
-        return regenerate_function(ex, i, trials.subset([best]), a.evaluations, "gradient", rest)
-    return bool(ex.gains(energies[best])
-                and ex.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best]))
+def sweep_near(ex: Expansion, run_opts, system, i: int, a, report: Reporter) -> bool:
+    """One replacement step of function i (methods.Sweep) whose `a.near` trials move it only
+    (`near` > 0: its neighbours in K, then perturbations of it); True if the energy fell."""
+    E = ex.energy
+    step = Sweep(a.near, Refinement(a.evaluations, "gradient") if a.refine else None)
+    step.step(Run(ex, Sampler(system, run_opts, np.random.default_rng(i)), report), Cursor("sweep", index=i))
+    return ex.energy < E
 
 
 def main() -> None:
@@ -91,8 +90,9 @@ def main() -> None:
                   f"{E0 - ex.energy:.3e} Eh, E = {ex.energy!r}")
             return
         if a.near:
-            accepted = sum(replace_near(ex, Sampler(system, opts, np.random.default_rng(i)), i % len(ex.basis), a)
-                           for i in range(a.steps))
+            with Reporter(opts, False) as report:
+                accepted = sum(sweep_near(ex, replace(opts, near=1.0), system, i % len(ex.basis), a, report)
+                               for i in range(a.steps))
         else:
             accepted = sum(refine_group(ex, i % len(ex.basis), a.group, a.evaluations) for i in range(a.steps))
         print(f"{a.steps} steps in {time.perf_counter() - t0:.2f} s, {accepted} accepted, gain {E0 - ex.energy:.3e} Eh, "
