@@ -20,7 +20,7 @@ def main() -> None:
     ap.add_argument("src", type=Path, help="run folder with basis.json")
     ap.add_argument("dst", type=Path, help="folder of the branch")
     ap.add_argument("settings", nargs="*", help="optimiser settings, key=JSON value")
-    ap.add_argument("--phase", choices=("sweep", "refine", "polish"), help="start of this phase of the cycle")
+    ap.add_argument("--phase", choices=("prune", "sweep", "refine", "polish"), help="start of this phase of the cycle")
     ap.add_argument("--seconds", type=float, help="budget: the checkpoint's elapsed seconds plus these")
     a = ap.parse_intermixed_args()
     d = json.loads((a.src / "basis.json").read_text())

@@ -7,12 +7,16 @@ refined energy (the offset; min_norm ignored); or with `--polish N` the time and
 step of at most N L-BFGS iterations over every parameter (polish.polish); or with `--near T` the
 time and gain of `--steps` replacement steps (methods.Sweep with `near` > 0) whose T trials all
 move the function replaced: its neighbours in K, then perturbations of it (Sampler.perturbed); the
-best is kept if it lowers the energy, refined first with `--refine`.
+best is kept if it lowers the energy, refined first with `--refine`; or with `--converge I,J,...`
+how far each group's L-BFGS gets from the basis as it stands (nothing kept): the gain of one
+L-BFGS run of `--evaluations` energies, and of Newton steps on a forward-difference Hessian of
+the exact gradient (one step reaches the group's local minimum when refinement is exhausted).
 
     python benchmarks/refine_steps.py runs/he-700 --steps 100
     python benchmarks/refine_steps.py runs/he-700 --survey --stride 23
     python benchmarks/refine_steps.py runs/he-700 --polish 30
     python benchmarks/refine_steps.py runs/he-700 --near 50 --steps 700
+    python benchmarks/refine_steps.py runs/h2 --group 6 --evaluations 200 --converge 59,160,104,10,300
 """
 from __future__ import annotations
 
@@ -28,7 +32,7 @@ from prebo.optimise.checkpoint import Cursor, load_checkpoint, resumed
 from prebo.optimise.expansion import Expansion
 from prebo.optimise.methods import Refinement, Run, Sweep
 from prebo.optimise.polish import polish
-from prebo.optimise.refine import partners, refine_group
+from prebo.optimise.refine import GroupObjective, lbfgs, partners, refine_group
 from prebo.optimise.report import Reporter
 from prebo.optimise.sampler import Sampler
 
@@ -62,6 +66,52 @@ def sweep_near(ex: Expansion, run_opts, system, i: int, a, report: Reporter) -> 
     return ex.energy < E
 
 
+def newton(obj: GroupObjective, steps: int, h: float = 1e-4) -> list[tuple[float, int]]:
+    """`steps` Newton steps on obj from its θ, each on the forward-difference Hessian of the exact
+    gradient (symmetrised), shifted by the first of λ = 0, 1e-8, ..., 1e-4 that lowers the energy
+    (steps longer than 1 in θ shortened); (best energy, energies evaluated) after each step."""
+    count = [0]
+
+    def f(theta):
+        count[0] += 1
+        return obj.energy_and_gradient(theta)
+
+    theta = obj.theta()
+    e, g = f(theta)
+    out = []
+    for _ in range(steps):
+        H = np.empty((len(theta), len(theta)))
+        for k in range(len(theta)):
+            t = theta.copy()
+            t[k] += h
+            H[:, k] = (f(t)[1] - g) / h
+        w, V = np.linalg.eigh(0.5 * (H + H.T))
+        for lam in (0.0, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4):
+            step = -V @ ((V.T @ g) / (np.abs(w) + lam + 1e-12))
+            step /= max(1.0, np.linalg.norm(step))
+            e2, g2 = f(theta + step)
+            if e2 < e:
+                e, theta, g = e2, theta + step, g2
+                break
+        out.append((obj.best_E, count[0]))
+    return out
+
+
+def converge(ex: Expansion, groups: list[int], size: int, evaluations: int) -> None:
+    """Print, per group, the gain of one L-BFGS run of `evaluations` energies and of three Newton
+    steps, each from the basis as it stands (nothing is kept)."""
+    E0 = ex.energy
+    for i in groups:
+        idx = [i] + partners(ex, i, size - 1)
+        t0 = time.perf_counter()
+        obj = GroupObjective(ex, idx)
+        lbfgs(obj.energy_and_gradient, obj.theta(), evaluations)
+        t1 = time.perf_counter()
+        steps = newton(GroupObjective(ex, idx), 3)
+        print(f"group {idx}: L-BFGS ({evaluations} energies) {E0 - obj.best_E:.2e} Eh in {t1 - t0:.1f} s; Newton "
+              + ", ".join(f"{E0 - e:.2e} ({n} energies)" for e, n in steps) + f" in {time.perf_counter() - t1:.1f} s")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("checkpoint", help="a run's folder (its basis.json)")
@@ -73,6 +123,7 @@ def main() -> None:
     ap.add_argument("--polish", type=int, metavar="N", help="one joint step of at most N iterations instead")
     ap.add_argument("--near", type=int, metavar="T", help="replacement steps of T perturbations each instead")
     ap.add_argument("--refine", action="store_true", help="with --near: refine the best trial first")
+    ap.add_argument("--converge", metavar="I,J,...", help="L-BFGS against Newton on these groups (nothing kept)")
     a = ap.parse_args()
     d, system, opts = load_checkpoint(a.checkpoint)
     basis, *_ = resumed(d, opts, np.random.default_rng(0), a.checkpoint)
@@ -82,6 +133,9 @@ def main() -> None:
               f"{ex.eig.overlap_condition:.2e}")
         if a.survey:
             survey(ex, a.group, a.stride)
+            return
+        if a.converge:
+            converge(ex, [int(i) for i in a.converge.split(",")], a.group, a.evaluations)
             return
         E0, t0 = ex.energy, time.perf_counter()
         if a.polish:

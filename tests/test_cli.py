@@ -162,6 +162,10 @@ def test_plot_draws_the_convergence_of_runs(run_dir, tmp_path):
     r = prebo("plot", run_dir, "--since", middle, "--out", png)
     assert r.returncode == 0, r.stderr
     assert_clean_error(prebo("plot", run_dir, "--since", -1.0, "--out", png), "nothing in its history at or before -1 s")
+    logged = tmp_path / "log.png"  # a run of days beside one of minutes: the wall time on a log axis
+    r = prebo("plot", run_dir, "--since", middle, "--log-time", "--out", logged)
+    assert r.returncode == 0, r.stderr
+    assert logged.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and logged.read_bytes() != png.read_bytes()
     for option in ("--reference", "--since"):  # a NaN or infinite number is refused, not drawn
         for bad in ("nan", "inf", "-inf", "x"):
             assert_clean_error(prebo("plot", run_dir, f"{option}={bad}", "--out", png), option, "not a finite number")

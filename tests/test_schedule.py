@@ -244,6 +244,16 @@ def test_an_input_without_optimiser_table_runs_to_an_exhausted_basis_with_a_repo
     assert kinds[0] == "grow" and {"refine", "sweep", "polish", "prune"} <= set(kinds) and d["stopped"] == "exhausted"
     prunings = [p for p in d["schedule"]["passes"] if p[0] == "prune"]
     assert all(p[1] == 24 and p[3] <= p[2] for p in prunings)  # back to the size, never above where it began
+    again = subprocess.run([sys.executable, "-m", "prebo", "run", "--resume", tmp_path / "he", "--quiet"],
+                           capture_output=True, text=True, timeout=600)  # still exhausted: nothing more
+    assert again.returncode == 0 and json.loads((tmp_path / "he" / "basis.json").read_text())["schedule"] == d["schedule"]
+    budget = d["elapsed"] + 1.5  # the user's word: spend 1.5 s more at this size
+    again = subprocess.run([sys.executable, "-m", "prebo", "run", "--resume", tmp_path / "he", "--budget", str(budget),
+                            "--quiet"], capture_output=True, text=True, timeout=600)
+    assert again.returncode == 0, again.stderr
+    more = json.loads((tmp_path / "he" / "basis.json").read_text())
+    assert more["stopped"] in ("budget", "converged") and len(more["schedule"]["passes"]) > len(d["schedule"]["passes"])
+    assert more["elapsed"] >= d["elapsed"] and more["energy"] <= d["energy"]
 
 
 def test_the_budget_stops_a_run_and_a_resumed_adaptive_run_goes_on(tmp_path):

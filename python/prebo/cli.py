@@ -168,13 +168,14 @@ def cmd_export(args) -> int:
 
 
 def cmd_plot(args) -> int:
-    """`prebo plot RUN... [--reference E] [--since S] [--out PNG]`: convergence plot of run checkpoints."""
+    """`prebo plot RUN... [--reference E] [--since S] [--log-time] [--out PNG]`: convergence plot of run
+    checkpoints."""
     from .plot import convergence
 
     png = args.out or Path(args.runs[0]) / "convergence.png"
     png = png if png.suffix else png.with_suffix(".png")
     try:
-        convergence(args.runs, png, args.reference, args.since)
+        convergence(args.runs, png, args.reference, args.since, args.log_time)
     except OSError as exc:
         raise OutputError(f"{png}: cannot write ({exc.strerror})") from exc
     print(f"wrote {png}")
@@ -299,6 +300,7 @@ def parser() -> argparse.ArgumentParser:
     pl.add_argument("--reference", type=finite, help="exact energy: plot E - E_ref on a log axis")
     pl.add_argument("--since", type=finite, metavar="SECONDS",
                     help="only the wall time from then on, against time (runs branched from one checkpoint)")
+    pl.add_argument("--log-time", action="store_true", help="wall time on a logarithmic axis (runs of minutes and days)")
     pl.add_argument("--out", type=Path, help="image file, .png (the default suffix), .pdf or .svg "
                                               "(default FIRST-RUN/convergence.png)")
     pl.set_defaults(func=cmd_plot)

@@ -4,9 +4,10 @@
 The growth phase gives one point per basis size; refinement sweeps at the final size are
 drawn as a vertical run of points there, and spread out in the wall-time panel (histories
 written before wall times were recorded leave that panel out). With a reference energy the
-error E - E_ref is drawn on a logarithmic axis. From a given wall time on (`since`), only the
-time panel is drawn, each run starting from its state at that moment: branches of one checkpoint
-compared from where they parted.
+error E - E_ref is drawn on a logarithmic axis, and with `log_time` the wall time too: runs of
+minutes and of days side by side. From a given wall time on (`since`), only the time panel is
+drawn, each run starting from its state at that moment: branches of one checkpoint compared from
+where they parted.
 """
 from __future__ import annotations
 
@@ -44,10 +45,12 @@ def since(h: list, seconds: float, where: str = "run") -> list:
     return [before[-1][:3] + [seconds]] + [row for row in h if row[3] > seconds]
 
 
-def convergence(folders: list[Path], png: Path, reference: float | None = None, start: float | None = None) -> Path:
+def convergence(folders: list[Path], png: Path, reference: float | None = None, start: float | None = None,
+                log_time: bool = False) -> Path:
     """Plot the energies (Eh) of the runs in `folders` against basis size (and wall time, minutes)
     into the PNG file `png`; with `reference` (Eh) E - E_ref on a log axis; with `start` (s) only
-    the wall time from then on (`since`: runs branched from one checkpoint). Returns `png`.
+    the wall time from then on (`since`: runs branched from one checkpoint); with `log_time` the
+    wall time on a log axis (its rows at time zero left out). Returns `png`.
     InputError for a suffix not in FORMATS or a reference not below every energy plotted."""
     if Path(png).suffix.lower() not in FORMATS:
         raise InputError(f"{png}: an image file ends in {', '.join(FORMATS)}")
@@ -72,10 +75,13 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None, 
         e = [row[1] - reference if reference is not None else row[1] for row in h]
         for ax, panel in zip(axes[0], panels):
             x = [row[0] for row in h] if panel == "size" else [(row[3] - t0) / 60 for row in h]
-            ax.plot(x, e, ".-", ms=3, lw=1, label=name)
+            shown = [k for k, xi in enumerate(x) if xi > 0 or not (panel == "time" and log_time)]
+            ax.plot([x[k] for k in shown], [e[k] for k in shown], ".-", ms=3, lw=1, label=name)
     for ax, panel in zip(axes[0], panels):
         ax.set_xlabel("basis size" if panel == "size" else
                       "wall time / min" if start is None else f"wall time after {start:g} s / min")
+        if panel == "time" and log_time:
+            ax.set_xscale("log")
         if reference is not None:
             ax.set_yscale("log")
             ax.set_ylabel(f"E − E_ref  (E_ref = {reference} Eh)")

@@ -94,6 +94,9 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         return Expansion(b, rep, opts.threshold, opts.min_norm, opts.max_overlap)
 
     ex = expansion(basis)
+    if opts.adaptive and stopped == "exhausted" and opts.budget is not None:  # a budget overrides exhaustion
+        cursor = schedule.reopen(len(ex.basis), ex.energy, elapsed)
+        stopped = schedule.stopped if cursor.phase == "done" else None
     threshold = lowest_threshold(system).energy
     lowest = Lowest(basis, opts.size, out, {"optimiser": opts.to_dict()}, resumed=resume is not None)
     lowest.see(ex)

@@ -22,8 +22,9 @@ last rate would gain less than that in the seconds left. Without a budget it als
 basis is exhausted: the last pass of every kind gains less than RATIO of the reference rate, what
 the last growth pass gained per second (a larger basis would gain faster; where growth took one
 pass, which has no rate, the best rate of a pass at full size). A budget is the user's word on
-how long to spend at this size, so it overrides exhaustion, which the convergence report then
-states as `advantage`, the reference over the best kind's last rate. The budget stops any
+how long to spend at this size, so it overrides exhaustion — also when given to a resumed run
+that ended exhausted (`reopen`) — which the convergence report then states as `advantage`, the
+reference over the best kind's last rate. The budget stops any
 schedule (driver.py).
 
 The choices follow measured seconds, so two runs of one input take different paths and may end
@@ -111,6 +112,13 @@ class Adaptive:
         if kind == "grow":
             return Cursor("grow", sweep=min(self.size, nb + max(GROWTH, nb // 4)), cycle=number)
         return Cursor(kind, index=self.next.get(kind, 0) % max(nb, 1), cycle=number)
+
+    def reopen(self, nb: int, energy: float, now: float) -> Cursor:
+        """The cursor of a run that ended exhausted, resumed with a budget, `nb` functions at
+        `energy` after `now` seconds: the schedule chooses again, the budget overriding exhaustion
+        (module docstring); Cursor("done") if it still ends."""
+        kind = self.choose(nb, energy, now)
+        return Cursor("done") if kind is None else self.begin(kind, nb, len(self.passes))
 
     def tolerance(self, energy: float) -> float:
         """The gain (Eh) of a whole sweep below which the basis counts as converged."""
