@@ -3,11 +3,15 @@ basis size, E, phase, elapsed seconds): per block of consecutive steps of one ph
 window of `--window` seconds, with the distance to a reference energy. With `--target`, a
 power law E − E_ref = a t^(−p) fitted (least squares in logs) to the history from each of the
 `--fit-from` seconds on, and the elapsed time at which it reaches E_target − E_ref: an
-extrapolation, not a measurement.
+extrapolation, not a measurement. With `--reach`, the first elapsed second at which each of the
+given distances to the reference was reached (time to accuracy; at the basis size of the latest
+entry, so a pruning's larger basis does not count).
 
     python benchmarks/run_rates.py benchmarks/checkpoints/h2-cycles/basis.json --reference -1.164025030884 --since 5400
     python benchmarks/run_rates.py benchmarks/checkpoints/h2-cycles/basis.json --reference -1.164025030884 \
         --since 16000 --target -1.164025020 --fit-from 8000,12000,16000
+    python benchmarks/run_rates.py benchmarks/checkpoints/h2-auto/basis.json --reference -1.164025030884 \
+        --reach 1e-6,5e-7,2e-7,1e-7,5e-8
 """
 from __future__ import annotations
 
@@ -25,11 +29,19 @@ def main():
     ap.add_argument("--since", type=float, default=0.0, help="first elapsed second shown")
     ap.add_argument("--target", type=float, default=None, help="target energy (Eh) for the power-law extrapolation")
     ap.add_argument("--fit-from", default="0", help="comma-separated first elapsed seconds of the fits")
+    ap.add_argument("--reach", help="comma-separated distances to the reference (Eh): when each was first reached")
     args = ap.parse_args()
     history = json.loads(open(args.basis).read())["history"]
     t = np.array([h[3] for h in history])
     E = np.array([h[1] for h in history])
     phase = [h[2] for h in history]
+    if args.reach:
+        size = np.array([h[0] for h in history]) == history[-1][0]
+        print("| E − E_ref | first reached after (s) |\n|---|---|")
+        for d in (float(v) for v in args.reach.split(",")):
+            hit = np.flatnonzero(size & (E - args.reference <= d))
+            print(f"| {d:.1e} | {t[hit[0]]:.1f} |" if len(hit) else f"| {d:.1e} | not yet |")
+        return
 
     print("| phase | from (s) | to (s) | gain (Eh) | gain per s | E − E_ref at the end |")
     print("|---|---|---|---|---|---|")
