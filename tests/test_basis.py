@@ -42,7 +42,17 @@ def test_basis_knows_its_family_and_keeps_its_kind():
 
 
 H = prebo.System(["p", "e"])
+P = prebo.System(["p", "e"], N=1, parity=-1)
 ONE = np.eye(2)[None]  # one 2 x 2 exponent matrix
+NAN, INF = float("nan"), float("inf")
+
+
+def gvr(u, K=(2,)):
+    return Basis(P, ONE, [1.0], kind="ecg-gvr", u=u, K=K)
+
+
+def fecg(s):
+    return Basis(H, ONE, [1.0], kind="fecg", s=s)
 
 
 @pytest.mark.parametrize("call, message", [
@@ -61,6 +71,16 @@ ONE = np.eye(2)[None]  # one 2 x 2 exponent matrix
     (lambda: Basis(H, ONE, [1.0], channels=["hpc:0", "hpc:1"]), "basis: 1 functions but 2 channels"),
     (lambda: Basis.load(5), "Basis.load: path = 5: must be a file name (a str or path)"),
     (lambda: Basis.empty(H).save(None), "Basis.save: path = None: must be a file name (a str or path)"),
+    (lambda: gvr("x"), "Basis: u = 'x': must be 2 numbers per function (real numbers)"),
+    (lambda: gvr([["a", "b", "c", "d"]]), "Basis: u = [['a', 'b', 'c', 'd']]: must be 2 numbers per function"),
+    (lambda: gvr([[1.0, NAN]]), "Basis: u[0, 1] = nan: must be a finite number"),
+    (lambda: gvr([[INF, 1.0]]), "Basis: u[0, 0] = inf: must be a finite number"),
+    (lambda: gvr([[1.0, -1.0]], K="x"), "Basis: K = 'x': must be one number per function (real numbers)"),
+    (lambda: fecg([[[0.0, 0.0, NAN], [0.0, 0.0, 0.0]]]), "Basis: s[0, 0, 2] = nan: must be a finite number"),
+    (lambda: fecg([[[0.0, 0.0, 0.0], [-INF, 0.0, 0.0]]]), "Basis: s[0, 1, 0] = -inf: must be a finite number"),
+    (lambda: fecg("x"), "Basis: s = 'x': must be 2 x 3 numbers per function (real numbers)"),
+    (lambda: Basis(H, ONE, [1.0], coefficients=[1.0, 2.0]), "basis: 1 functions but 2 coefficients"),
+    (lambda: Basis(H, ONE, [1.0], coefficients=[NAN]), "Basis: coefficients[0] = nan: must be a finite number"),
 ])
 def test_wrong_arguments_are_refused_at_construction(call, message):
     """A new user's calls raised AttributeError, TypeError or ValueError, or took a NaN c_A that
@@ -68,6 +88,22 @@ def test_wrong_arguments_are_refused_at_construction(call, message):
     with pytest.raises(InputError) as exc:
         call()
     assert message in str(exc.value)
+
+
+def test_coefficients_of_the_wrong_length_are_refused_when_saved(tmp_path):
+    """Coefficients set after construction to a length other than the number of functions were
+    saved and then refused by Basis.load."""
+    w, mu = np.array([1.0, -1.0]), H.cm_vector
+    b = Basis(H, [np.outer(w, w) + np.outer(mu, mu), 2 * np.outer(w, w) + np.outer(mu, mu)], [1.0, 1.0])
+    b.coefficients = np.ones(3)
+    with pytest.raises(InputError, match="Basis.save: 2 functions but 3 coefficients"):
+        b.save(tmp_path / "basis.json")
+    assert not (tmp_path / "basis.json").exists()
+    with pytest.raises(InputError, match="Basis.to_dict: 2 functions but 3 coefficients"):
+        b.to_dict()
+    b.coefficients = [0.6, 0.8]
+    b.save(tmp_path / "basis.json")
+    assert Basis.load(tmp_path / "basis.json").coefficients.tolist() == [0.6, 0.8]
 
 
 def test_no_module_outside_the_basis_package_tests_the_family_name():

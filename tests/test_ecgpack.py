@@ -8,7 +8,7 @@ import pytest
 import prebo
 from prebo import eigen
 from prebo.basis import Basis
-from prebo.errors import BasisFileError
+from prebo.errors import BasisFileError, InputError
 from prebo.integrals import laboratory
 from prebo.io import ecgpack
 from prebo.system.young import young_operator, young_product, young_string
@@ -239,6 +239,24 @@ def test_missing_header_and_not_a_file(tmp_path):
         ecgpack.read_inout(q)
     with pytest.raises(BasisFileError, match="cannot read"):
         ecgpack.read_inout(tmp_path / "missing.inout.txt")
+
+
+@pytest.mark.parametrize("read", [ecgpack.read_inout, ecgpack.parse_inout])
+@pytest.mark.parametrize("bad", [5, None, ""])
+def test_a_path_that_is_not_a_file_name_is_refused(read, bad):
+    """read_inout(5) raised TypeError."""
+    with pytest.raises(InputError, match=rf"{read.__name__}: path = .*must be a file name \(a str or path\)"):
+        read(bad)
+
+
+@pytest.mark.parametrize("bad", [5, None, ""])
+def test_write_inout_refuses_a_path_that_is_not_a_file_name(bad, tmp_path):
+    """write_inout(basis, 5) raised TypeError; write_inout("he.json", path) AttributeError."""
+    he = Basis.empty(prebo.System(["alpha", "e", "e"], spin={"e": 0}))
+    with pytest.raises(InputError, match=r"write_inout: path = .*must be a file name \(a str or path\)"):
+        ecgpack.write_inout(he, bad)
+    with pytest.raises(InputError, match=r"write_inout: basis = 'he.json': must be a prebo Basis"):
+        ecgpack.write_inout("he.json", tmp_path / "he.inout.txt")
 
 
 def test_young_products_and_conventions():

@@ -433,6 +433,20 @@ def test_optimise_refuses_an_out_of_the_wrong_type_and_one_holding_a_checkpoint(
     assert len(resume_from(tmp_path, progress=False)[0]) == 2
 
 
+def test_optimise_refuses_an_empty_out_and_resume_from_a_folder_that_is_not_a_path(tmp_path, monkeypatch):
+    """optimise(..., out="") wrote its checkpoint into the current folder; resume_from(5) raised TypeError."""
+    from prebo.errors import InputError
+    from prebo.optimise import optimise, resume_from
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match=r"optimise: out = '': empty; must be a folder \(a str or path\), or None"):
+        optimise(prebo.System(["p", "e"]), Optimiser(size=2, trials=2, seed=1), out="", progress=False)
+    assert not list(tmp_path.iterdir())
+    for bad in (5, None, ["runs"], ""):
+        with pytest.raises(InputError, match=r"resume_from: folder = .*must be a folder \(a str or path\)"):
+            resume_from(bad, progress=False)
+
+
 def test_lowest_json_is_written_when_the_run_leaves_its_lowest_state_and_removed_when_it_is_back(tmp_path):
     """checkpoint.Lowest: a state above the lowest, or of more than `size` functions, writes the
     lowest to lowest.json; a state as low at the size removes it; a fresh run's tracker removes a

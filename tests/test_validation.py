@@ -216,6 +216,14 @@ def test_bad_toml_values_give_one_line(tmp_path, capsys, text, words):
     toml_error(capsys, tmp_path, text, *words)
 
 
+@pytest.mark.parametrize("bad", [5, None, ""])
+def test_toml_load_refuses_a_path_that_is_not_a_file_name(bad):
+    """toml.load(5) raised TypeError."""
+    from prebo.io import toml
+    with pytest.raises(InputError, match=r"toml.load: path = .*must be a file name \(a str or path\)"):
+        toml.load(bad)
+
+
 def test_basis_file_without_functions(bases, tmp_path, capsys):
     def empty(d):
         d["functions"] = []

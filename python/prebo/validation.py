@@ -7,6 +7,7 @@
 - the rules of one value (`Integer`, `Real`, `Choice`, `Lengths`, `Channels`, and `Automatic`
   for a setting prebo chooses itself when it is absent), with the text of what they allow; the optimiser's table of settings is prebo.optimise.settings.SETTINGS;
 - `number`, `half_integer`: the checks of one real parameter (masses, charges; spins);
+- `path_name`: a file or folder argument;
 - `strict_keywords`: unknown keyword arguments of a settings dataclass as InputError.
 The states a basis family can describe are checked by the family (prebo.basis.Family.check_state).
 
@@ -192,6 +193,16 @@ def number(value, label: str, positive: bool = False) -> float:
     except Refused:
         raise InputError(f"{label} = {value!r}: must be a finite{' positive' if positive else ''} number") from None
     return x
+
+
+def path_name(value, label: str, what: str):
+    """`value` if it is a non-empty str or os.PathLike (an empty path would be the current
+    folder); InputError "`label` = value: must be `what`" otherwise."""
+    if not isinstance(value, (str, os.PathLike)):
+        raise InputError(f"{label} = {value!r}: must be {what}")
+    if not os.fspath(value):
+        raise InputError(f"{label} = {value!r}: empty; must be {what}")
+    return value
 
 
 def half_integer(value, label: str) -> Fraction:

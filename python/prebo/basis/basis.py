@@ -9,7 +9,6 @@ it was generated in. Its family (`Basis.family`) adds its own arrays (u and K, o
 """
 from __future__ import annotations
 
-import os
 import reprlib
 from dataclasses import dataclass, field
 
@@ -17,6 +16,7 @@ import numpy as np
 
 from ..errors import BasisFileError, InputError, NotPositiveDefiniteError, SeparabilityError
 from ..system import System
+from ..validation import path_name
 from .families import family as family_of
 from .family import Family
 
@@ -31,7 +31,7 @@ class Basis:
     (nb,) linear coefficients of the state, if known; kind: the family's name ("pecg", "ecg-gvr",
     "fecg", the basis.json basis_type); u: (nb, n) global vectors and K: (nb,) powers (ECG-GVR);
     s: (nb, n, 3) centres in bohr (floating ECGs). InputError for shapes or values that do not fit
-    (a non-finite A or c_A included).
+    (non-finite A, c_A, u, s or coefficients included; also when saving).
     """
 
     system: System
@@ -59,8 +59,9 @@ class Basis:
             value = getattr(self, name)
             if value is None:
                 raise InputError(f"a {self.kind} basis needs the parameters {name!r}")
-            value = fam.coerce(name, value)
             dims = tuple(n if d == "n" else d for d in shape)
+            what = f"{' x '.join(map(str, dims))} numbers per function" if dims else "one number per function"
+            value = fam.coerce(name, _finite(name, value, dims, what))
             if value.size != nb * int(np.prod(dims, dtype=int)):
                 raise InputError(f"basis: {nb} functions but {value.size} values of {name!r}")
             setattr(self, name, np.ascontiguousarray(value.reshape((nb, *dims))))
@@ -69,6 +70,7 @@ class Basis:
         self.channels = list(self.channels) or ["unknown"] * nb
         if len(self.channels) != nb:
             raise InputError(f"basis: {nb} functions but {len(self.channels)} channels")
+        self.coefficients = _coefficients("basis", self.coefficients, nb)
 
     @property
     def family(self) -> Family:
@@ -160,11 +162,13 @@ class Basis:
     def to_dict(self, extra: dict | None = None) -> dict:
         """The basis.json mapping of this basis (docs/basis-format.md), with `extra` keys added."""
         from ..io import basis_json
+        _coefficients("Basis.to_dict", self.coefficients, len(self))  # set since construction
         return basis_json.to_dict(self, extra)
 
     def save(self, path, extra: dict | None = None) -> None:
         """Write basis.json atomically: a killed run leaves either the old or the new file."""
         from ..io import basis_json
+        _coefficients("Basis.save", self.coefficients, len(self))
         basis_json.save(self, _file("Basis.save", path), extra)
 
     @classmethod
@@ -197,8 +201,16 @@ def _finite(name: str, value, shape: tuple, what: str) -> np.ndarray:
     return np.ascontiguousarray(a)
 
 
+def _coefficients(where: str, value, nb: int) -> np.ndarray | None:
+    """`value` (None: not known) as nb finite floats, one per function; InputError naming `where` otherwise."""
+    if value is None:
+        return None
+    c = _finite("coefficients", value, (), "one number per function")
+    if len(c) != nb:
+        raise InputError(f"{where}: {nb} functions but {len(c)} coefficients")
+    return c
+
+
 def _file(where: str, path):
-    """`path` if it names a file (a str or os.PathLike), else InputError naming `where`."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise InputError(f"{where}: path = {path!r}: must be a file name (a str or path)")
-    return path
+    """`path` if it names a file (a non-empty str or os.PathLike), else InputError naming `where`."""
+    return path_name(path, f"{where}: path", "a file name (a str or path)")

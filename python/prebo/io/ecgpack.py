@@ -80,11 +80,12 @@ import numpy as np
 
 from ..basis import Basis
 from ..coordinates import heavy_particle_centred
-from ..errors import BasisFileError, PreboError, UnsupportedError
+from ..errors import BasisFileError, InputError, PreboError, UnsupportedError
 from ..system import KNOWN, State, System, particle
 from ..system.symmetry import implied_spins
 from ..system.young import young_operator, young_product, young_string
 from ..optimise.settings import check
+from ..validation import path_name
 from .basis_json import read_text, write_atomic
 
 __all__ = ["read_inout", "write_inout", "parse_inout", "InoutFile"]
@@ -173,7 +174,7 @@ def _reals(path, line_no, values, what):
 
 def parse_inout(path) -> InoutFile:
     """Read an ecgpack ``*.inout.txt`` without converting it; BasisFileError names the line."""
-    path = Path(path)
+    path = Path(path_name(path, "parse_inout: path", "a file name (a str or path)"))
     lines = read_text(path, BasisFileError).splitlines()
     seps = [i for i, l in enumerate(lines) if _SEP.match(l)]
     if not seps:
@@ -384,8 +385,8 @@ def read_inout(path, c_A: float = 1.0) -> Basis:
 
     Raises BasisFileError naming the file and line for anything prebo cannot take: complex
     ECGs, L > 0 basis types, a malformed header or basis line, a size mismatch, a symmetry
-    exchanging different particles."""
-    return parse_inout(path).to_basis(c_A)
+    exchanging different particles; InputError for a `path` that is not a file name."""
+    return parse_inout(path_name(path, "read_inout: path", "a file name (a str or path)")).to_basis(c_A)
 
 
 def _fmt(x: float) -> str:
@@ -410,7 +411,10 @@ def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFi
     link is lost and A comes back to rounding, ~1e-16 relative, which moves the energy of
     a nearly linearly dependent basis such as He-490 by ~1e-12 relative.) The header gives
     the masses (m_e) and charges (e) in the basis's particle order and the SYMMETRY string
-    (`prebo.system.young.young_string`)."""
+    (`prebo.system.young.young_string`). InputError for a `basis` or `path` of the wrong type."""
+    if not isinstance(basis, Basis):
+        raise InputError(f"write_inout: basis = {basis!r}: must be a prebo Basis")
+    path_name(path, "write_inout: path", "a file name (a str or path)")
     if basis.family.parameters != ("A", "c_A"):
         raise UnsupportedError(f"ecgpack's RG_0S format holds plain ECGs only, not {basis.family.name}")
     system = basis.system

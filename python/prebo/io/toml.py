@@ -26,6 +26,7 @@ from ..optimise import Optimiser, coordinate_sets
 from ..system import State, System
 from ..optimise.defaults import resolved
 from ..optimise.settings import SETTINGS, check
+from ..validation import path_name
 from .basis_json import read_text
 
 #: [basis] key -> Optimiser setting; [optimiser] takes every other setting
@@ -81,7 +82,7 @@ def from_dict(d: dict) -> Job:
 
 def load(path) -> Job:
     """The Job of a TOML input file; InputError naming the file (and the key) for anything wrong."""
-    path = Path(path)
+    path = Path(path_name(path, "toml.load: path", "a file name (a str or path)"))
     text = read_text(path, InputError)
     try:
         d = tomllib.loads(text)

@@ -12,7 +12,6 @@ state it passed through (checkpoint.Lowest), kept in lowest.json while it stands
 """
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -26,6 +25,7 @@ from ..integrals import laboratory
 from ..io.basis_json import remove_stale_temporaries
 from ..system import System
 from ..thresholds import lowest as lowest_threshold
+from ..validation import path_name
 from .checkpoint import CHECKPOINT, LOWEST, Cursor, Lowest, checkpoint_in, load_checkpoint, resumed
 from .convergence import convergence
 from .defaults import resolved
@@ -65,8 +65,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         raise InputError(f"optimise: system = {system!r}: must be a prebo.System")
     if not isinstance(opts, Optimiser):
         raise InputError(f"optimise: opts = {opts!r}: must be a prebo.Optimiser")
-    if out is not None and not isinstance(out, (str, os.PathLike)):
-        raise InputError(f"optimise: out = {out!r}: must be a folder (a str or path), or None")
+    if out is not None:
+        path_name(out, "optimise: out", "a folder (a str or path), or None")
     held = None if out is None or resume is not None else checkpoint_in(out)
     if held:
         raise OutputError(f"optimise: out = {str(out)!r} holds a run's checkpoint ({held.name}): continue that run "
@@ -158,7 +158,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
 def resume_from(folder: Path, progress: bool = True, budget: float | None = None) -> tuple[Basis, Optimiser]:
     """Continue the run whose checkpoint is folder/basis.json, with `budget` (seconds of the whole
     run) in place of the checkpoint's if given; the finished basis and its settings."""
-    d, system, opts = load_checkpoint(folder)
+    d, system, opts = load_checkpoint(path_name(folder, "resume_from: folder", "a folder (a str or path)"))
     if budget is not None:
         opts = replace(opts, budget=budget)
     return optimise(system, opts, out=Path(folder), progress=progress, resume=d), opts
