@@ -118,7 +118,8 @@ def test_example_ti_evaluation_agrees(name, rel):
     assert energy(f, "--coordinates", "ti")["energy"] == pytest.approx(energy(f)["energy"], rel=rel, abs=0)
 
 
-@pytest.mark.parametrize("name, key, size", [("h2", "H2", 500), ("h2-cycles", "H2", 500), ("h2plus-150", "H2+", 150)])
+@pytest.mark.parametrize("name, key, size", [("h2", "H2", 500), ("h2-cycles", "H2", 500), ("h2-auto", "H2", 500),
+                                             ("h2plus-150", "H2+", 150)])
 def test_run_checkpoints_lie_above_the_reference(name, key, size, references, tmp_path):
     """The H2 and H2+ run checkpoints (benchmarks/checkpoints), and their lowest states (lowest.json)
     where the runs stand above them, re-evaluated: above the literature energy
