@@ -11,12 +11,19 @@ best is kept if it lowers the energy, refined first with `--refine`; or with `--
 how far each group's L-BFGS gets from the basis as it stands (nothing kept): the gain of one
 L-BFGS run of `--evaluations` energies, and of Newton steps on a forward-difference Hessian of
 the exact gradient (one step reaches the group's local minimum when refinement is exhausted).
+Variants of the group steps: `--start I` begins them at function I; `--ranked` takes instead the
+groups with the largest squared energy gradient ‖∂E/∂θ‖² summed over their members (polish.Joint);
+`--k-moves` also refines each group with function i moved to K ± 1 (Sampler.neighbours) and keeps
+the lowest; `--extrapolate OLD` first moves the basis on along its displacement since the basis of
+the checkpoint OLD (momentum.Momentum.move); `--rounds R` repeats [extrapolate, --steps group steps], each
+round's displacement taken from the basis after its extrapolation, or before it with `--momentum`.
 
     python benchmarks/refine_steps.py runs/he-700 --steps 100
     python benchmarks/refine_steps.py runs/he-700 --survey --stride 23
     python benchmarks/refine_steps.py runs/he-700 --polish 30
     python benchmarks/refine_steps.py runs/he-700 --near 50 --steps 700
     python benchmarks/refine_steps.py runs/h2 --group 6 --evaluations 200 --converge 59,160,104,10,300
+    python benchmarks/refine_steps.py runs/h2 --group 6 --steps 200 --rounds 3 --start 418
 """
 from __future__ import annotations
 
@@ -30,8 +37,11 @@ from prebo import eigen
 from prebo.integrals import laboratory
 from prebo.optimise.checkpoint import Cursor, load_checkpoint, resumed
 from prebo.optimise.expansion import Expansion
+from prebo.optimise.momentum import Momentum
 from prebo.optimise.methods import Refinement, Run, Sweep
-from prebo.optimise.polish import polish
+from prebo.basis import Basis
+from prebo.optimise.parametrisation import Parametrisation
+from prebo.optimise.polish import Joint, polish
 from prebo.optimise.refine import GroupObjective, lbfgs, partners, refine_group
 from prebo.optimise.report import Reporter
 from prebo.optimise.sampler import Sampler
@@ -64,6 +74,30 @@ def sweep_near(ex: Expansion, run_opts, system, i: int, a, report: Reporter) -> 
     step = Sweep(a.near, Refinement(a.evaluations, "gradient") if a.refine else None)
     step.step(Run(ex, Sampler(system, run_opts, np.random.default_rng(i)), report), Cursor("sweep", index=i))
     return ex.energy < E
+
+
+def ranked(ex: Expansion, size: int, count: int) -> list[int]:
+    """The `count` functions whose groups (each with its `size` - 1 partners) have the largest
+    ‖∂E/∂θ‖² summed over their members (the whole basis's gradient, polish.Joint)."""
+    joint = Joint(ex)
+    g2 = np.add.reduceat(joint(joint.theta0)[1] ** 2, joint.cut[:-1])
+    score = [g2[[i] + partners(ex, i, size - 1)].sum() for i in range(len(ex.basis))]
+    return [int(i) for i in np.argsort(score)[::-1][:count]]
+
+
+def k_moves(ex: Expansion, i: int, size: int, evaluations: int, sampler: Sampler) -> bool:
+    """Refine function i's group as it stands and with i moved to K ± 1 (its peak kept,
+    Sampler.neighbours); keep the lowest if it gains. True if the energy fell."""
+    idx = [i] + partners(ex, i, size - 1)
+    best_E, best_f = ex.energy, None
+    for f in [None] + [g for g in sampler.neighbours(ex.basis.subset([i])) if abs(int(g.K[0]) - int(ex.basis.K[i])) == 1]:
+        obj = GroupObjective(ex, idx)
+        if f is not None:
+            obj.p[0] = Parametrisation.of(f)
+        lbfgs(obj.energy_and_gradient, obj.theta(), evaluations)
+        if obj.best_f is not None and obj.best_E < best_E:
+            best_E, best_f = obj.best_E, obj.best_f
+    return best_f is not None and ex.gains(best_E) and ex.put_group(idx, best_f)
 
 
 def newton(obj: GroupObjective, steps: int, h: float = 1e-4) -> list[tuple[float, int]]:
@@ -124,6 +158,12 @@ def main() -> None:
     ap.add_argument("--near", type=int, metavar="T", help="replacement steps of T perturbations each instead")
     ap.add_argument("--refine", action="store_true", help="with --near: refine the best trial first")
     ap.add_argument("--converge", metavar="I,J,...", help="L-BFGS against Newton on these groups (nothing kept)")
+    ap.add_argument("--start", type=int, default=0, help="the first function of the group steps")
+    ap.add_argument("--ranked", action="store_true", help="the groups with the largest gradient instead")
+    ap.add_argument("--k-moves", action="store_true", help="each group also with function i at K ± 1")
+    ap.add_argument("--extrapolate", metavar="OLD", help="first extrapolate along the displacement since OLD")
+    ap.add_argument("--rounds", type=int, metavar="R", help="R rounds of [extrapolate, --steps group steps]")
+    ap.add_argument("--momentum", action="store_true", help="with --rounds: displacements from before each extrapolation")
     a = ap.parse_args()
     d, system, opts = load_checkpoint(a.checkpoint)
     basis, *_ = resumed(d, opts, np.random.default_rng(0), a.checkpoint)
@@ -148,9 +188,37 @@ def main() -> None:
                 accepted = sum(sweep_near(ex, replace(opts, near=1.0), system, i % len(ex.basis), a, report)
                                for i in range(a.steps))
         else:
-            accepted = sum(refine_group(ex, i % len(ex.basis), a.group, a.evaluations) for i in range(a.steps))
-        print(f"{a.steps} steps in {time.perf_counter() - t0:.2f} s, {accepted} accepted, gain {E0 - ex.energy:.3e} Eh, "
-              f"E = {ex.energy!r}")
+            accepted = group_steps(ex, a, system, opts, t0)
+        print(f"{a.steps * (a.rounds or 1)} steps in {time.perf_counter() - t0:.2f} s, {accepted} accepted, gain "
+              f"{E0 - ex.energy:.3e} Eh, E = {ex.energy!r}")
+
+
+def group_steps(ex: Expansion, a, system, opts, t0: float) -> int:
+    """The group steps of main and their variants (module docstring); the number accepted."""
+    sampler = Sampler(system, opts, np.random.default_rng(0))
+    momentum = Momentum(load_basis(a.extrapolate, opts) if a.extrapolate else None)
+    accepted, start, E0 = 0, a.start, ex.energy
+    for r in range(a.rounds or 1):
+        before = ex.energy
+        momentum.move(ex)  # the reference is then the basis before the move
+        gain = before - ex.energy
+        if not a.momentum:
+            momentum.reference = ex.basis.subset(slice(None))
+        order = ranked(ex, a.group, a.steps) if a.ranked else [(start + k) % len(ex.basis) for k in range(a.steps)]
+        for i in order:
+            accepted += (k_moves(ex, i, a.group, a.evaluations, sampler) if a.k_moves
+                         else refine_group(ex, i, a.group, a.evaluations))
+        start += a.steps
+        if a.rounds:
+            print(f"round {r}: extrapolation {gain:.3e} Eh, total gain {E0 - ex.energy:.3e} Eh at "
+                  f"{time.perf_counter() - t0:.1f} s", flush=True)
+    return accepted
+
+
+def load_basis(path: str, opts) -> Basis:
+    """The basis of a run's checkpoint folder."""
+    d, _, _ = load_checkpoint(path)
+    return resumed(d, opts, np.random.default_rng(0), path)[0]
 
 
 if __name__ == "__main__":

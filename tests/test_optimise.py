@@ -137,7 +137,7 @@ def test_pruning_removes_the_function_that_costs_least():
 
 def test_each_phase_has_its_method_configured_by_the_settings():
     from prebo.optimise import Grow, Polish, Refine, Refinement, Sweep
-    from prebo.optimise.methods import Prune, methods
+    from prebo.optimise.methods import Extrapolate, Prune, methods
     he = prebo.System(["alpha", "e", "e"])
     plain = methods(resolved(Optimiser(trials=7, polish_iterations=9, sweeps=0), he))
     assert plain == {"grow": Grow(7), "prune": Prune(Grow(7), Refinement(200, "gradient")), "sweep": Sweep(7),
@@ -148,6 +148,7 @@ def test_each_phase_has_its_method_configured_by_the_settings():
     assert grouped["refine"] == Refine(Refinement(40, "gradient", 2)) and grouped["sweep"].refine == Refinement(40, "gradient")
     adaptive = methods(resolved(Optimiser(trials=5), he))  # the adaptive schedule refines every new function
     assert adaptive["grow"] == Grow(5, Refinement(30, "gradient")) and adaptive["sweep"] == Sweep(5, Refinement(30, "gradient"))
+    assert adaptive["momentum"] == Extrapolate() and "momentum" not in plain  # the adaptive schedule's moves
 
 
 def test_refinement_and_learning_lower_the_energy():

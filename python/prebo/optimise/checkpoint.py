@@ -26,7 +26,7 @@ from .settings import Optimiser
 CHECKPOINT = "basis.json"
 LOWEST = "lowest.json"
 
-PHASES = ("grow", "prune", "sweep", "refine", "polish", "done")
+PHASES = ("grow", "prune", "sweep", "refine", "polish", "momentum", "done")
 
 
 @dataclass
@@ -34,7 +34,8 @@ class Cursor:
     """The next unit of work: one competitive step ("grow"); one step of growth past the size
     (`index` 0) or one removal (1) ("prune"), function `index` of replacement sweep / refinement
     sweep `sweep` ("sweep", "refine"), joint-refinement step `sweep` ("polish") of the
-    prune-sweep-refine-polish block `cycle`, or "done"."""
+    prune-sweep-refine-polish block `cycle`, a move along the basis's displacement ("momentum",
+    adaptive schedule only), or "done"."""
 
     phase: str = "grow"
     sweep: int = 0

@@ -31,6 +31,7 @@ from .convergence import convergence
 from .defaults import resolved
 from .expansion import Expansion
 from .methods import Run, methods
+from .momentum import Momentum
 from .report import Reporter
 from .sampler import Sampler
 from .schedule import Adaptive
@@ -101,7 +102,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     lowest = Lowest(basis, opts.size, out, {"optimiser": opts.to_dict()}, resumed=resume is not None)
     lowest.see(ex)
     sampler.learn(ex.basis)
-    run = Run(ex, sampler, Reporter(opts, progress, len(ex.basis)))
+    momentum = Momentum() if resume is None else Momentum.from_dict(resume.get("momentum"), basis, "checkpoint")
+    run = Run(ex, sampler, Reporter(opts, progress, len(ex.basis)), momentum=momentum)
     steps = methods(opts)
 
     def checkpoint():
@@ -111,7 +113,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
             ex.basis.save(Path(out) / CHECKPOINT, {
                 "energy": energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
                 "rng": rng.bit_generator.state, "history": history, "elapsed": wall(),
-                "schedule": schedule.to_dict(), "stopped": stopped})
+                "schedule": schedule.to_dict(), "stopped": stopped, "momentum": run.momentum.to_dict()})
 
     with run.report, eigen.lapack_threads(opts.size):
         while cursor.phase != "done":
@@ -142,6 +144,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
                 schedule = Adaptive(opts, restarts=schedule.restarts + 1)  # a fresh start (schedule.py)
                 cursor, stopped = schedule.first(), None
                 ex = run.expansion = expansion(Basis.empty(system, opts.kind))
+                run.momentum = Momentum()
                 sampler.learn(ex.basis)
             lowest.see(ex)  # first: a run killed between the two writes keeps its lowest state
             checkpoint()

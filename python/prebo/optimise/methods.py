@@ -24,13 +24,15 @@
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed, or with the
   functions it overlaps most (`refine_group`; refine.py).
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
+- `Extrapolate`: the basis moved on along its displacement since the last move (momentum.py;
+  adaptive schedule).
 Replacements and pruning reach new basins, joint refinement converges within one; the
 prune-sweep-refine-polish block is repeated `cycles` times (Optimiser), or the adaptive schedule
 chooses among grow, sweep, refine, polish and prune (schedule.py).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -38,6 +40,7 @@ from .. import eigen
 from ..errors import StalledError, UnsupportedError
 from .checkpoint import Cursor
 from .expansion import Expansion
+from .momentum import Momentum
 from .polish import polish
 from .refine import refine_group, refine_newcomer, regenerate_function
 from .report import Reporter
@@ -51,12 +54,13 @@ STALL_STEPS = 100  # growth steps in a row without an accepted trial before the 
 @dataclass
 class Run:
     """What the methods act on: the expansion, the sampler and the reporter; `stalled` counts the
-    growth steps in a row that added nothing."""
+    growth steps in a row that added nothing; `momentum` holds the reference of the next move."""
 
     expansion: Expansion
     sampler: Sampler
     report: Reporter
     stalled: int = 0
+    momentum: Momentum = field(default_factory=Momentum)
 
 
 @dataclass(frozen=True)
@@ -181,7 +185,8 @@ class Pruning:
             run.stalled = 0
         while len(ex.basis) > nb:
             self.prune.step(run, Cursor("prune", index=1))
-        ex.keep_if_lower(before)
+        if ex.keep_if_lower(before):
+            run.momentum.forget()  # the functions were removed and regrown: no displacement
 
 
 @dataclass(frozen=True)
@@ -207,13 +212,24 @@ class Polish:
         polish(run.expansion, self.iterations)
 
 
+@dataclass(frozen=True)
+class Extrapolate:
+    """Move the basis on along its displacement since the last move (momentum.py)."""
+
+    def step(self, run: Run, cursor: Cursor) -> None:
+        """One unit of work on `run` at `cursor` (class docstring)."""
+        run.momentum.move(run.expansion)
+
+
 def methods(opts: Optimiser) -> dict:
     """The method of each phase of the schedule, configured by `opts` (defaults.resolved): in an
     adaptive schedule, and in a fixed one with `refine`, every grown and replacing function is
-    refined; an adaptive schedule prunes a whole pass in one step."""
+    refined; an adaptive schedule prunes a whole pass in one step and moves the basis on along its
+    displacement (momentum.py)."""
     refinement = Refinement(opts.refine_evaluations, opts.refine_method, opts.refine_group)
     on_change = Refinement(opts.refine_evaluations, opts.refine_method) if opts.adaptive or opts.refine else None  # refine grown and replacing functions too
     prune = Prune(Grow(opts.trials, on_change), refinement)
     return {"grow": Grow(opts.trials, on_change), "prune": Pruning(prune) if opts.adaptive else prune,
             "sweep": Sweep(opts.trials, on_change),
-            "refine": Refine(refinement), "polish": Polish(opts.polish_iterations)}
+            "refine": Refine(refinement), "polish": Polish(opts.polish_iterations)} | (
+                {"momentum": Extrapolate()} if opts.adaptive else {})

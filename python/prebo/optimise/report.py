@@ -49,7 +49,7 @@ class Reporter:
             self.progress.update(self.task, description="growing", completed=len(st.basis), total=self.opts.size,
                                  info=info)
         elif self.opts.adaptive:
-            done, total = (cursor.sweep + 1, min(CHUNK, len(st.basis))) if cursor.phase not in ("polish", "prune") \
+            done, total = (cursor.sweep + 1, min(CHUNK, len(st.basis))) if cursor.phase not in ("polish", "prune", "momentum") \
                 else (1, 1)
             self.progress.update(self.task, description=f"{cursor.phase} (pass {cursor.cycle + 1})", completed=done,
                                  total=total, info=info)

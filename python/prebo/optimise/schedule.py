@@ -9,8 +9,10 @@ refined with its partners, as many removed again, and the basis before it restor
 energy fell (methods.Pruning; with the fixed schedule's pruning He with 500 functions gained
 2.8× as much as with the adaptive schedule in 150 s, benchmarks/README, "Grow and prune").
 After each pass the next one is of the kind whose last pass gained the most energy per second
-of wall time; kinds not yet tried come first. A kind's rate is measured again only when it runs
-again, so the rate it keeps is that of an earlier, richer state: as the running kind's rate
+of wall time — except at full size after every momentum.EVERY refinement passes since the last
+move or pruning, when the basis moves on along its displacement (momentum.py; a pass of kind
+"momentum", seconds long, outside the rates); kinds not yet tried come first. A kind's rate is
+measured again only when it runs again, so the rate it keeps is that of an earlier, richer state: as the running kind's rate
 falls below it, the other kinds are tried again, and each stays in use as long as it pays best.
 Growth is a kind while the basis is smaller than `size` and growth has not stalled (`stall`:
 every trial of STALL_STEPS steps linearly dependent on the basis; the basis then keeps the size
@@ -51,6 +53,7 @@ from __future__ import annotations
 import math
 
 from .checkpoint import Cursor
+from .momentum import EVERY
 from .settings import Optimiser
 
 #: the fewest functions a growth pass adds
@@ -153,6 +156,16 @@ class Adaptive:
         """The best rate among the last passes `last` of the kinds that improve a basis."""
         return max(self.rate(last[k]) for k in IMPROVE)
 
+    def due(self, nb: int) -> bool:
+        """Whether the basis of `nb` functions moves on along its displacement (module docstring):
+        at full size, EVERY refinement passes at that size since the last move or pruning."""
+        count = 0
+        for p in reversed(self.passes):
+            if p[0] in ("momentum", "prune"):
+                break
+            count += p[0] == "refine" and p[1] == nb
+        return nb >= self.size and count >= EVERY
+
     def kinds(self, nb: int) -> tuple:
         """The kinds that improve a basis of `nb` functions: pruning only at full size."""
         return IMPROVE if nb >= self.size else tuple(k for k in IMPROVE if k != "prune")
@@ -197,6 +210,8 @@ class Adaptive:
             self.stopped = self.stop(last, nb, energy, now)
             if self.stopped is not None:
                 return None
+            if self.due(nb):
+                return "momentum"
         return max((("grow",) if growing else ()) + self.kinds(nb), key=lambda k: self.rate(last[k]))
 
     def to_dict(self) -> dict:
@@ -221,7 +236,7 @@ class Adaptive:
             return isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t) and t >= 0
 
         def one(p):
-            return (isinstance(p, list) and len(p) == 7 and p[0] in ("grow",) + IMPROVE and count(p[1])
+            return (isinstance(p, list) and len(p) == 7 and p[0] in ("grow", "momentum") + IMPROVE and count(p[1])
                     and energy(p[2]) and p[3] is not None and energy(p[3]) and seconds(p[4]) and seconds(p[5])
                     and count(p[6]) and p[6] > 0)
 
