@@ -2,8 +2,8 @@
 
 Refinement of groups (refine.py) is coordinate descent. Near the optimum of a large basis it
 moves every function a little along a narrow valley, which it crosses slowly; most of the gain of
-such a move needs all functions together. So, every EVERY refinement passes at full size, the
-basis is moved on to θ + α d, d = θ − θ_ref over all functions, θ_ref the basis before the last
+such a move needs all functions together. So, every EVERY passes at full size that move functions
+(schedule.Adaptive.due), the basis is moved on to θ + α d, d = θ − θ_ref over all functions, θ_ref the basis before the last
 move (heavy-ball momentum: the moves accumulate), α the vertex of the parabola through the
 energies at α = 0, ½, 1 (else the lowest of those), and kept only if the energy falls
 (Expansion.replace_basis). A function whose channel or K differs from its reference, or that
@@ -22,7 +22,7 @@ from ..io import basis_json
 from .expansion import Expansion
 from .parametrisation import Parametrisation
 
-#: refinement passes at full size between two moves (schedule.CHUNK functions each)
+#: passes at full size that move functions between two moves (schedule.Adaptive.due)
 EVERY = 4
 #: a function that moved this far in θ since its reference was replaced: it does not move on
 MAX_STEP = 0.5

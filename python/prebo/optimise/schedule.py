@@ -9,8 +9,8 @@ refined with its partners, as many removed again, and the basis before it restor
 energy fell (methods.Pruning; with the fixed schedule's pruning He with 500 functions gained
 2.8× as much as with the adaptive schedule in 150 s, benchmarks/README, "Grow and prune").
 After each pass the next one is of the kind whose last pass gained the most energy per second
-of wall time — except at full size after every momentum.EVERY refinement passes since the last
-move or pruning, when the basis moves on along its displacement (momentum.py; a pass of kind
+of wall time — except at full size after every momentum.EVERY passes that move functions
+(refinement, replacement, joint) since the last move or pruning, when the basis moves on along its displacement (momentum.py; a pass of kind
 "momentum", seconds long, outside the rates); kinds not yet tried come first. A kind's rate is
 measured again only when it runs again, so the rate it keeps is that of an earlier, richer state: as the running kind's rate
 falls below it, the other kinds are tried again, and each stays in use as long as it pays best.
@@ -158,12 +158,13 @@ class Adaptive:
 
     def due(self, nb: int) -> bool:
         """Whether the basis of `nb` functions moves on along its displacement (module docstring):
-        at full size, EVERY refinement passes at that size since the last move or pruning."""
+        at full size, EVERY passes at that size that moved functions (refinement, replacement,
+        joint) since the last move or pruning."""
         count = 0
         for p in reversed(self.passes):
             if p[0] in ("momentum", "prune"):
                 break
-            count += p[0] == "refine" and p[1] == nb
+            count += p[0] in ("refine", "sweep", "polish") and p[1] == nb
         return nb >= self.size and count >= EVERY
 
     def kinds(self, nb: int) -> tuple:
