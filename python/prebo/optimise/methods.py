@@ -28,7 +28,7 @@
   adaptive schedule).
 Replacements and pruning reach new basins, joint refinement converges within one; the
 prune-sweep-refine-polish block is repeated `cycles` times (Optimiser), or the adaptive schedule
-chooses among grow, sweep, refine, polish and prune (schedule.py).
+chooses among grow, sweep, refine, polish and prune and moves the basis on (schedule.py).
 """
 from __future__ import annotations
 

@@ -2,11 +2,11 @@
 
 Refinement of groups (refine.py) is coordinate descent. Near the optimum of a large basis it
 moves every function a little along a narrow valley, which it crosses slowly; most of the gain of
-such a move needs all functions together. So, every EVERY passes at full size that move functions
-(schedule.Adaptive.due), the basis is moved on to θ + α d, d = θ − θ_ref over all functions, θ_ref the basis before the last
-move (heavy-ball momentum: the moves accumulate), α the vertex of the parabola through the
-energies at α = 0, ½, 1 (else the lowest of those), and kept only if the energy falls
-(Expansion.replace_basis). A function whose channel or K differs from its reference, or that
+such a move needs all functions together. So, every EVERY passes at full size that move
+functions (schedule.Adaptive.due), the basis is moved on to θ + α d, d = θ − θ_ref over all
+functions, θ_ref the basis before the last move (heavy-ball momentum: the moves accumulate), α the
+vertex of the parabola through the energies at α = 0, ½, 1 (else the lowest of those), and kept
+only if the energy falls (Expansion.replace_basis). A function whose channel or K differs from its reference, or that
 moved by MAX_STEP or more in θ (a replacement), stays where it is. H2 with 500 ECG-GVR functions
 at 4.3e-8 Eh above the exact energy: 600 group steps with a move after every 200 gained 1.82× as
 much as without (benchmarks/README, "The fresh run's tail, and momentum over the group
