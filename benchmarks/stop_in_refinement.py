@@ -1,5 +1,5 @@
-"""Stop a resumed run (SIGTERM) while its checkpoint stands in a refinement sweep at the basis
-size, well before the sweep ends — the state to commit: a checkpoint written during a pruning
+"""Stop a resumed run (SIGTERM) while its checkpoint stands in a refinement or replacement sweep at
+the basis size, well before the sweep ends — the state to commit: a checkpoint written during a pruning
 holds more functions than the size (tests/test_examples.py refuses it).
 
     python benchmarks/stop_in_refinement.py benchmarks/checkpoints/h2-cycles
@@ -31,7 +31,7 @@ def main() -> None:
             time.sleep(0.5)
             continue
         p, size, nb = d["progress"], d["optimiser"]["size"], len(d["functions"])
-        if nb == size and p["phase"] == "refine" and p["index"] < size - a.margin:
+        if nb == size and p["phase"] in ("refine", "sweep") and p["index"] < size - a.margin:
             break
         time.sleep(0.5)
     for pid in pids.split():
