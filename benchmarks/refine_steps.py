@@ -15,8 +15,9 @@ Variants of the group steps: `--start I` begins them at function I; `--ranked` t
 groups with the largest squared energy gradient ‖∂E/∂θ‖² summed over their members (polish.Joint);
 `--k-moves` also refines each group with function i moved to K ± 1 (Sampler.neighbours) and keeps
 the lowest; `--extrapolate OLD` first moves the basis on along its displacement since the basis of
-the checkpoint OLD (momentum.Momentum.move); `--rounds R` repeats [extrapolate, --steps group steps], each
-round's displacement taken from the basis after its extrapolation, or before it with `--momentum`.
+the checkpoint OLD (momentum.Momentum.move); `--rounds R` repeats [extrapolate, --steps group
+steps], each round's displacement taken from the basis after its extrapolation, or before it with
+`--momentum`.
 
     python benchmarks/refine_steps.py runs/he-700 --steps 100
     python benchmarks/refine_steps.py runs/he-700 --survey --stride 23
@@ -30,16 +31,17 @@ from __future__ import annotations
 import argparse
 import time
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
 from prebo import eigen
-from prebo.integrals import laboratory
-from prebo.optimise.checkpoint import Cursor, load_checkpoint, resumed
-from prebo.optimise.expansion import Expansion
-from prebo.optimise.momentum import Momentum
-from prebo.optimise.methods import Refinement, Run, Sweep
 from prebo.basis import Basis
+from prebo.integrals import laboratory
+from prebo.optimise.checkpoint import CHECKPOINT, Cursor, load_checkpoint, resumed
+from prebo.optimise.expansion import Expansion
+from prebo.optimise.methods import Refinement, Run, Sweep
+from prebo.optimise.momentum import Momentum
 from prebo.optimise.parametrisation import Parametrisation
 from prebo.optimise.polish import Joint, polish
 from prebo.optimise.refine import GroupObjective, lbfgs, partners, refine_group
@@ -196,7 +198,7 @@ def main() -> None:
 def group_steps(ex: Expansion, a, system, opts, t0: float) -> int:
     """The group steps of main and their variants (module docstring); the number accepted."""
     sampler = Sampler(system, opts, np.random.default_rng(0))
-    momentum = Momentum(load_basis(a.extrapolate, opts) if a.extrapolate else None)
+    momentum = Momentum(Basis.load(Path(a.extrapolate) / CHECKPOINT) if a.extrapolate else None)
     accepted, start, E0 = 0, a.start, ex.energy
     for r in range(a.rounds or 1):
         before = ex.energy
@@ -213,12 +215,6 @@ def group_steps(ex: Expansion, a, system, opts, t0: float) -> int:
             print(f"round {r}: extrapolation {gain:.3e} Eh, total gain {E0 - ex.energy:.3e} Eh at "
                   f"{time.perf_counter() - t0:.1f} s", flush=True)
     return accepted
-
-
-def load_basis(path: str, opts) -> Basis:
-    """The basis of a run's checkpoint folder."""
-    d, _, _ = load_checkpoint(path)
-    return resumed(d, opts, np.random.default_rng(0), path)[0]
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """Stop a resumed run (SIGTERM) while its checkpoint stands in a refinement or replacement sweep at
-the basis size, well before the sweep ends — the state to commit: a checkpoint written during a pruning
-holds more functions than the size (tests/test_examples.py refuses it).
+the basis size, well before the sweep ends — the state to commit: a checkpoint written during a
+pruning holds more functions than the size (tests/test_examples.py refuses it).
 
     python benchmarks/stop_in_refinement.py benchmarks/checkpoints/h2-cycles
 """

@@ -26,7 +26,8 @@ def shifted(basis: Basis, d: list, t: float) -> Basis:
 
 @pytest.fixture(scope="module")
 def optimised():
-    """An optimised H2+ basis of 150 ECG-GVR functions, its expansion and a direction in θ."""
+    """An optimised H2+ basis of 150 ECG-GVR functions, its representation and a direction in θ
+    (1e-3 long for each function)."""
     basis = Basis.load(BASES / "h2plus-150" / "basis.json")
     rng = np.random.default_rng(3)
     d = [rng.normal(size=len(Parametrisation.of(basis.subset([i])).theta())) for i in range(len(basis))]

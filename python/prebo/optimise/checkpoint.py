@@ -105,8 +105,7 @@ class Lowest:
                 self.energy = number(d.get("energy"), "energy")
             except InputError as exc:
                 raise BasisFileError(f"{self.path}: {exc}") from exc
-            mine = (self.basis.kind, self.basis.system.particles, self.basis.system.state)
-            if mine != (basis.kind, basis.system.particles, basis.system.state):
+            if not of_this_run(self.basis, basis):
                 raise BasisFileError(f"{self.path}: not a state of this run (another system, state or basis type "
                                      "than its checkpoint's)")
             self.written = True
@@ -125,6 +124,13 @@ class Lowest:
                 nb > self.size or expansion.energy > self.energy):
             self.basis.save(self.path, {"energy": self.energy} | self.extra)
             self.written = True
+
+
+def of_this_run(other: Basis, basis: Basis) -> bool:
+    """Whether the basis `other` belongs to the run of `basis`: the same particles, state and
+    basis type (a lowest state or a momentum reference read back with a checkpoint)."""
+    return (other.kind, other.system.particles, other.system.state) == (
+        basis.kind, basis.system.particles, basis.system.state)
 
 
 def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> tuple:

@@ -19,6 +19,7 @@ import numpy as np
 from ..basis import Basis
 from ..errors import BasisFileError, PreboError
 from ..io import basis_json
+from .checkpoint import of_this_run
 from .expansion import Expansion
 from .parametrisation import Parametrisation
 
@@ -92,7 +93,6 @@ class Momentum:
         if block is None:
             return cls()
         reference = Basis.from_dict(block, f"{where}: momentum")
-        if (reference.kind, reference.system.particles, reference.system.state) != (
-                basis.kind, basis.system.particles, basis.system.state):
+        if not of_this_run(reference, basis):
             raise BasisFileError(f"{where}: momentum: the reference is not a basis of this run")
         return cls(reference)
