@@ -14,7 +14,7 @@ from prebo.optimise.convergence import convergence
 from prebo.optimise.defaults import GROUP, TRIALS, resolved
 from prebo.optimise.sampler import pair_lengths
 from prebo.optimise.momentum import EVERY
-from prebo.optimise.schedule import CHUNK, PRUNE, RATIO, Adaptive, pruned
+from prebo.optimise.schedule import CHUNK, PRUNE, RATIO, REVISIT, Adaptive, pruned
 
 LI7 = {"name": "li7", "mass": 12786.39227775, "charge": 3, "spin": 1.5}
 
@@ -158,6 +158,20 @@ def test_at_full_size_the_basis_moves_on_after_every_EVERY_passes_that_moved_fun
     assert Adaptive.check(s.opts, json.loads(json.dumps(s.to_dict()))).passes == s.passes
 
 
+def test_a_kind_not_run_for_REVISIT_times_its_last_pass_is_tried_again():
+    """Refinement's last pass took 10 s (a busy machine, say) and gained at a tenth of the
+    replacements' rate: it is tried again once REVISIT × 10 s have passed without it, not before;
+    the joint step and the pruning, whose last passes took 100 s, wait twice as long."""
+    s = Adaptive(resolved(Optimiser(size=100), prebo.System(["alpha", "e", "e"])))
+    E = passes(s, ("grow", 100, None, 1.0), ("polish", 100, 1e-5, 100.0), ("prune", 100, 1e-5, 100.0),
+               ("refine", 100, 1e-4, 10.0))
+    refined = now(s)
+    while (kind := s.choose(100, E, now(s))) in ("sweep", "momentum"):
+        assert now(s) - refined <= REVISIT * 10.0
+        E = passes(s, ("sweep", 100, 1e-4, 1.0) if kind == "sweep" else ("momentum", 100, 1e-6, 0.01))
+    assert kind == "refine" and now(s) - refined > REVISIT * 10.0
+
+
 def test_the_basis_is_exhausted_when_every_kind_gains_less_than_a_tenth_of_growth_or_the_tolerance():
     opts = resolved(Optimiser(size=100), prebo.System(["alpha", "e", "e"]))
     s = Adaptive(opts)
@@ -204,6 +218,8 @@ def test_without_a_growth_rate_the_best_rate_at_full_size_is_the_reference():
                ("prune", 6, 0.5 * RATIO * 1e-2, 1.0))
     assert s.choose(6, E, now(s)) == "refine"
     E = passes(s, ("refine", 6, 0.9 * RATIO * 1e-2, 1.0), ("sweep", 6, 0.5 * RATIO * 1e-2, 1.0))
+    if s.choose(6, E, now(s)) == "momentum":  # after EVERY = 2 passes that moved functions
+        E = passes(s, ("momentum", 6, 0.0, 0.01))
     assert s.choose(6, E, now(s)) == "polish"  # polish's last rate, 1e-3, is above RATIO of the best
     E = passes(s, ("polish", 6, 0.5 * RATIO * 1e-2, 1.0))
     assert 0.5 * RATIO * 1e-2 > s.tolerance(E)

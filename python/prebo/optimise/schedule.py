@@ -14,6 +14,11 @@ of wall time — except at full size after every momentum.EVERY passes that move
 "momentum", seconds long, outside the rates); kinds not yet tried come first. A kind's rate is
 measured again only when it runs again, so the rate it keeps is that of an earlier, richer state: as the running kind's rate
 falls below it, the other kinds are tried again, and each stays in use as long as it pays best.
+A kind not run for REVISIT times the seconds of its last pass is tried again all the same: a rate
+measured while the machine was busy with other work, or before the state changed (a pruning that
+gained nothing once, refinement before momentum), would otherwise keep the kind out for good; the
+cost is at most 1/REVISIT of the time per kind. (On the H2 run with 500 functions, refinement's
+last pass, slowed 4× by probes beside the run, kept it out for 5000 s.)
 Growth is a kind while the basis is smaller than `size` and growth has not stalled (`stall`:
 every trial of STALL_STEPS steps linearly dependent on the basis; the basis then keeps the size
 it reached).
@@ -56,6 +61,8 @@ from .checkpoint import Cursor
 from .momentum import EVERY
 from .settings import Optimiser
 
+#: a kind not run for this many times its last pass's seconds is tried again (module docstring)
+REVISIT = 20
 #: the fewest functions a growth pass adds
 GROWTH = 8
 #: the most functions a refinement or replacement pass visits
@@ -213,6 +220,9 @@ class Adaptive:
                 return None
             if self.due(nb):
                 return "momentum"
+        stale = [k for k in self.kinds(nb) if now - last[k][5] > REVISIT * max(last[k][5] - last[k][4], 1e-3)]
+        if stale:
+            return min(stale, key=lambda k: last[k][5])
         return max((("grow",) if growing else ()) + self.kinds(nb), key=lambda k: self.rate(last[k]))
 
     def to_dict(self) -> dict:
