@@ -158,6 +158,20 @@ def test_at_full_size_the_basis_moves_on_after_every_EVERY_passes_that_moved_fun
     assert Adaptive.check(s.opts, json.loads(json.dumps(s.to_dict()))).passes == s.passes
 
 
+def test_a_move_s_gain_is_shared_among_the_passes_whose_displacement_it_extrapolated():
+    """Refinement gains half as much per second as the replacement sweeps, but the move after two
+    refinement passes gains twice their gain, the one after two sweeps nothing: refinement's rate,
+    three times its own, is the best. Its next pass, before its move, counts with that factor."""
+    s = Adaptive(resolved(Optimiser(size=100), prebo.System(["alpha", "e", "e"])))
+    E = passes(s, ("grow", 100, None, 1.0), ("polish", 100, 1e-6, 10.0), ("prune", 100, 1e-6, 10.0),
+               ("refine", 100, 1e-4, 10.0), ("refine", 100, 1e-4, 10.0), ("momentum", 100, 4e-4, 1.0),
+               ("sweep", 100, 2e-4, 10.0), ("sweep", 100, 2e-4, 10.0), ("momentum", 100, 0.0, 1.0))
+    assert s.rates()["refine"] == pytest.approx(3e-5) and s.rates()["sweep"] == pytest.approx(2e-5)
+    assert s.choose(100, E, now(s)) == "refine"
+    E = passes(s, ("refine", 100, 0.5e-4, 10.0))  # its move not come yet
+    assert s.rates()["refine"] == pytest.approx(1.5e-5) and s.choose(100, E, now(s)) == "sweep"
+
+
 def test_a_kind_not_run_for_REVISIT_times_its_last_pass_is_tried_again():
     """Refinement's last pass took 10 s (a busy machine, say) and gained at a tenth of the
     replacements' rate: it is tried again once REVISIT × 10 s have passed without it, not before;

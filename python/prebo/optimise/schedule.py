@@ -10,8 +10,13 @@ energy fell (methods.Pruning; with the fixed schedule's pruning He with 500 func
 2.8× as much as with the adaptive schedule in 150 s, benchmarks/README, "Grow and prune").
 After each pass the next one is of the kind whose last pass gained the most energy per second
 of wall time — except at full size after every momentum.EVERY passes that move functions
-(refinement, replacement, joint) since the last move or pruning, when the basis moves on along its displacement (momentum.py; a pass of kind
-"momentum", seconds long, outside the rates); kinds not yet tried come first. A kind's rate is
+(refinement, replacement, joint) since the last move or pruning, when the basis moves on along
+its displacement (momentum.py; a pass of kind "momentum", seconds long); kinds not yet tried come
+first. A move extrapolates the displacement of the passes before it, so its gain is theirs: it is
+shared among them in proportion to their own gains (a pass whose move has not come, yet or at
+all, counts with the factor its kind had from its last move). On the H2 run the moves after
+refinement gained 3–10× those after replacement sweeps, which the passes' own rates do not show
+(benchmarks/README, "A stale rate, and momentum every one, two or four passes"). A kind's rate is
 measured again only when it runs again, so the rate it keeps is that of an earlier, richer state: as the running kind's rate
 falls below it, the other kinds are tried again, and each stays in use as long as it pays best.
 A kind not run for REVISIT times the seconds of its last pass is tried again all the same: a rate
@@ -73,6 +78,8 @@ RATIO = 0.02
 TOLERANCE = 1e-10
 #: the kinds of pass that improve a basis of fixed size, in the order they are first tried
 IMPROVE = ("refine", "sweep", "polish", "prune")
+#: the kinds of pass that move functions, whose displacement a move (momentum.py) extrapolates
+MOVES = ("refine", "sweep", "polish")
 #: the most functions a pruning grows past the size and removes again
 PRUNE = 20
 #: the size at which growth checks that the state is bound (module docstring, a fresh start)
@@ -159,9 +166,29 @@ class Adaptive:
         """Energy gained per second by pass `p`."""
         return self.gain(p) / max(p[5] - p[4], 1e-3)
 
-    def best(self, last: dict) -> float:
-        """The best rate among the last passes `last` of the kinds that improve a basis."""
-        return max(self.rate(last[k]) for k in IMPROVE)
+    def rates(self) -> dict:
+        """Each kind's rate (Eh/s), that of its last pass with its share of the move after it
+        (module docstring): the gains of the passes at full size that moved functions since the
+        last move, times 1 + the move's gain over theirs; a pass whose move has not come (yet,
+        or a pruning came first) with the factor of its kind's last move."""
+        rates, share, stretch = {}, {}, []
+        for p in self.passes + [None]:
+            if p is not None and p[0] in MOVES and p[1] >= self.size:
+                stretch.append(p)
+                continue
+            if p is not None and p[0] == "momentum":
+                total = sum(self.gain(q) for q in stretch)
+                share.update((q[0], 1.0 + self.gain(p) / total if total > 0 else 1.0) for q in stretch)
+            for q in stretch:
+                rates[q[0]] = share.get(q[0], 1.0) * self.rate(q)
+            stretch = []
+            if p is not None and p[0] != "momentum":
+                rates[p[0]] = self.rate(p)
+        return rates
+
+    def best(self) -> float:
+        """The best rate (`rates`) of the kinds that improve a basis."""
+        return max(r for k, r in self.rates().items() if k in IMPROVE)
 
     def due(self, nb: int) -> bool:
         """Whether the basis of `nb` functions moves on along its displacement (module docstring):
@@ -171,7 +198,7 @@ class Adaptive:
         for p in reversed(self.passes):
             if p[0] in ("momentum", "prune"):
                 break
-            count += p[0] in ("refine", "sweep", "polish") and p[1] == nb
+            count += p[0] in MOVES and p[1] == nb
         return nb >= self.size and count >= EVERY
 
     def kinds(self, nb: int) -> tuple:
@@ -189,7 +216,7 @@ class Adaptive:
             reference = self.rate(grow)
         else:
             reference = max((self.rate(p) for p in self.passes if p[0] in IMPROVE and p[1] == nb), default=0.0)
-        best = self.best(last)
+        best = self.best()
         return reference / best if best > 0 else None
 
     def stop(self, last: dict, nb: int, energy: float, now: float) -> str | None:
@@ -200,7 +227,7 @@ class Adaptive:
             return "converged"
         if self.opts.budget is not None:
             left = self.opts.budget - now
-            return "converged" if self.best(last) * left < tolerance else None
+            return "converged" if self.best() * left < tolerance else None
         advantage = self.advantage(nb)
         return "exhausted" if advantage is not None and advantage > 1 / RATIO else None
 
@@ -223,7 +250,8 @@ class Adaptive:
         stale = [k for k in self.kinds(nb) if now - last[k][5] > REVISIT * max(last[k][5] - last[k][4], 1e-3)]
         if stale:
             return min(stale, key=lambda k: last[k][5])
-        return max((("grow",) if growing else ()) + self.kinds(nb), key=lambda k: self.rate(last[k]))
+        rates = self.rates()
+        return max((("grow",) if growing else ()) + self.kinds(nb), key=rates.get)
 
     def to_dict(self) -> dict:
         """The checkpoint's "schedule" block."""
