@@ -58,8 +58,19 @@ def test_the_first_move_only_takes_the_reference_and_a_zero_displacement_moves_n
     m = Momentum()
     assert not m.move(ex) and ex.energy == E and np.array_equal(m.reference.A, basis.A)
     assert not m.move(ex) and ex.energy == E  # against itself: d = 0
-    m.forget()
-    assert m.reference is None and m.to_dict() is None
+    assert Momentum().to_dict() is None
+
+
+def test_after_a_pruning_survivors_keep_their_reference_and_grown_functions_take_their_own(optimised):
+    basis, rep, d = optimised
+    reference, current = shifted(basis, d, -2.0), shifted(basis, d, -1.0)
+    pruned = Basis.concat([current.subset(np.arange(3, 150)), basis.subset([0, 1, 2])])  # 0-2 removed, three grown
+    m = Momentum(reference)
+    m.follow(pruned, list(range(3, 150)) + [None] * 3)
+    assert np.array_equal(m.reference.A[:147], reference.A[3:]) and np.array_equal(m.reference.A[147:], basis.A[:3])
+    ex = expansion(pruned, rep)
+    E = ex.energy
+    assert m.move(ex) and ex.energy < E and np.array_equal(ex.basis.A[147:], basis.A[:3])  # grown: in place
 
 
 def test_a_function_replaced_since_the_reference_stays_where_it_is(optimised):

@@ -382,11 +382,17 @@ def test_an_adaptive_pruning_keeps_the_size_and_is_undone_unless_it_gains(monkey
     opts = resolved(Optimiser(size=20, trials=10, seed=5), system)
     assert opts.adaptive and isinstance(m.methods(opts)["prune"], m.Pruning)
     ex = Expansion(basis, laboratory(system), 1e-13)
-    run = m.Run(ex, Sampler(system, opts, np.random.default_rng(5)), Reporter(opts, False, 20))
-    E0, grown = ex.energy, []
-    monkeypatch.setattr(m.Expansion, "remove", lambda st, i, f=m.Expansion.remove: grown.append(len(st.basis)) or f(st, i))
+    run = m.Run(ex, Sampler(system, opts, np.random.default_rng(5)), Reporter(opts, False, 20),
+                momentum=m.Momentum(basis))
+    E0, grown, removed = ex.energy, [], []
+    monkeypatch.setattr(m.Expansion, "remove", lambda st, i, f=m.Expansion.remove: grown.append(len(st.basis))
+                        or removed.append(i) or f(st, i))
     m.methods(opts)["prune"].step(run, Cursor("prune"))
     assert len(ex.basis) == 20 and grown == [22, 21] and ex.energy < E0  # pruned(20) = 2
+    origin = np.delete(np.delete(np.r_[np.arange(20), [-1, -1]], removed[0]), removed[1])  # -1: grown
+    reference = run.momentum.reference  # the momentum's reference follows the survivors (momentum.Momentum.follow)
+    assert len(reference) == 20 and all(np.array_equal(reference.A[k], basis.A[j] if j >= 0 else ex.basis.A[k])
+                                        for k, j in enumerate(origin))
     before, E1 = ex.basis.subset(slice(None)), ex.energy
     monkeypatch.setattr(m.np, "argmin", np.argmax)  # the removals now cost the most
     m.methods(opts)["prune"].step(run, Cursor("prune"))

@@ -163,8 +163,16 @@ class Prune:
             if len(ex.basis) > nb:
                 refine_group(ex, nb, self.refine.group, self.refine.evaluations, self.refine.method)
             return
+        self.remove(run)
+
+    @staticmethod
+    def remove(run: Run) -> int:
+        """Remove the function whose removal raises the energy least; its index."""
+        ex = run.expansion
         run.report.trials(len(ex.basis))
-        ex.remove(int(np.argmin(eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors))))
+        i = int(np.argmin(eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors)))
+        ex.remove(i)
+        return i
 
 
 @dataclass(frozen=True)
@@ -178,15 +186,17 @@ class Pruning:
         """One unit of work on `run` at `cursor` (class docstring)."""
         ex = run.expansion
         before, nb = ex.snapshot(), len(ex.basis)
+        origin = list(range(nb))  # where each function was before the pruning (None: grown)
         try:
             for _ in range(pruned(nb)):
                 self.prune.step(run, Cursor("prune", index=0))
+                origin += [None] * (len(ex.basis) - len(origin))
         except StalledError:
             run.stalled = 0
         while len(ex.basis) > nb:
-            self.prune.step(run, Cursor("prune", index=1))
+            del origin[self.prune.remove(run)]
         if ex.keep_if_lower(before):
-            run.momentum.forget()  # the functions were removed and regrown: no displacement
+            run.momentum.follow(ex.basis, origin)
 
 
 @dataclass(frozen=True)

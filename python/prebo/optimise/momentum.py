@@ -31,20 +31,25 @@ MAX_STEP = 0.5
 
 
 class Momentum:
-    """The reference basis θ_ref of the next move (module docstring); None before the first move
-    and after a change of the basis's functions other than refinement (`forget`)."""
+    """The reference basis θ_ref of the next move (module docstring), None before the first move;
+    renumbered after a pruning (`follow`)."""
 
     def __init__(self, reference: Basis | None = None):
         self.reference = reference
 
-    def forget(self) -> None:
-        """Drop the reference: the functions were regrown or removed (their order changed)."""
-        self.reference = None
+    def follow(self, basis: Basis, origin: list) -> None:
+        """After a pruning that was kept: function k of `basis` was function origin[k] of the basis
+        before it, or was grown (None). A survivor keeps its reference, a grown function takes
+        itself (no displacement): the next move goes on along the survivors' displacement (dropped,
+        the moves on H2 took several rounds to grow back)."""
+        if self.reference is not None:
+            self.reference = Basis.concat([basis.subset([k]) if j is None else self.reference.subset([j])
+                                           for k, j in enumerate(origin)])
 
     def move(self, expansion) -> bool:
         """Move the expansion's basis on along its displacement since the reference (module
         docstring), which then becomes the basis before the move; True if the energy fell. The
-        first move, or one after `forget`, only takes the reference."""
+        first move only takes the reference."""
         basis = expansion.basis.subset(slice(None))
         basis.coefficients = None
         reference, self.reference = self.reference, basis

@@ -17,8 +17,9 @@ shared among them in proportion to their own gains (a pass whose move has not co
 all, counts with the factor its kind had from its last move). On the H2 run the moves after
 refinement gained 3–10× those after replacement sweeps, which the passes' own rates do not show
 (benchmarks/README, "A stale rate, and momentum every one, two or four passes"). A kind's rate is
-measured again only when it runs again, so the rate it keeps is that of an earlier, richer state: as the running kind's rate
-falls below it, the other kinds are tried again, and each stays in use as long as it pays best.
+measured again only when it runs again, so the rate it keeps is that of an earlier, richer
+state: as the running kind's rate falls below it, the other kinds are tried again, and each stays
+in use as long as it pays best.
 A kind not run for REVISIT times the seconds of its last pass is tried again all the same: a rate
 measured while the machine was busy with other work, or before the state changed (a pruning that
 gained nothing once, refinement before momentum), would otherwise keep the kind out for good; the
