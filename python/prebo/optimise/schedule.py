@@ -20,11 +20,13 @@ refinement gained 3–10× those after replacement sweeps, which the passes' own
 measured again only when it runs again, so the rate it keeps is that of an earlier, richer
 state: as the running kind's rate falls below it, the other kinds are tried again, and each stays
 in use as long as it pays best.
-A kind not run for REVISIT times the seconds of its last pass is tried again all the same: a rate
-measured while the machine was busy with other work, or before the state changed (a pruning that
-gained nothing once, refinement before momentum), would otherwise keep the kind out for good; the
-cost is at most 1/REVISIT of the time per kind. (On the H2 run with 500 functions, refinement's
-last pass, slowed 4× by probes beside the run, kept it out for 5000 s.)
+A kind not run for REVISIT times the seconds of its shortest pass of the last three is tried
+again all the same: a rate measured while the machine was busy with other work, or before the
+state changed (a pruning that gained nothing once, refinement before momentum), would otherwise
+keep the kind out for good; the cost is about 1/REVISIT of the time per kind. (On the H2 run with
+500 functions, refinement's last pass, slowed 4× by probes beside the run, kept it out for 5000 s;
+with REVISIT = 20 and the last pass's seconds, the joint steps, pruning and sweeps that lost took
+22 % of the time.)
 Growth is a kind while the basis is smaller than `size` and growth has not stalled (`stall`:
 every trial of STALL_STEPS steps linearly dependent on the basis; the basis then keeps the size
 it reached).
@@ -68,7 +70,7 @@ from .momentum import EVERY
 from .settings import Optimiser
 
 #: a kind not run for this many times its last pass's seconds is tried again (module docstring)
-REVISIT = 20
+REVISIT = 50
 #: the fewest functions a growth pass adds
 GROWTH = 8
 #: the most functions a refinement or replacement pass visits
@@ -191,6 +193,11 @@ class Adaptive:
         """The best rate (`rates`) of the kinds that improve a basis."""
         return max(r for k, r in self.rates().items() if k in IMPROVE)
 
+    def seconds(self, kind: str) -> float:
+        """The seconds of the shortest of the last three passes of `kind` (a pass on a busy machine
+        takes longer)."""
+        return max(min([p[5] - p[4] for p in self.passes if p[0] == kind][-3:]), 1e-3)
+
     def due(self, nb: int) -> bool:
         """Whether the basis of `nb` functions moves on along its displacement (module docstring):
         at full size, EVERY passes at that size that moved functions (refinement, replacement,
@@ -248,7 +255,7 @@ class Adaptive:
                 return None
             if self.due(nb):
                 return "momentum"
-        stale = [k for k in self.kinds(nb) if now - last[k][5] > REVISIT * max(last[k][5] - last[k][4], 1e-3)]
+        stale = [k for k in self.kinds(nb) if now - last[k][5] > REVISIT * self.seconds(k)]
         if stale:
             return min(stale, key=lambda k: last[k][5])
         rates = self.rates()
