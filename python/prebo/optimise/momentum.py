@@ -40,8 +40,8 @@ class Momentum:
     def follow(self, basis: Basis, origin: list) -> None:
         """After a pruning that was kept: function k of `basis` was function origin[k] of the basis
         before it, or was grown (None). A survivor keeps its reference, a grown function takes
-        itself (no displacement): the next move goes on along the survivors' displacement (dropped,
-        the moves on H2 took several rounds to grow back)."""
+        itself (no displacement): the next move goes on along the survivors' displacement (with
+        the reference dropped instead, the moves on H2 took several rounds to grow back)."""
         if self.reference is not None:
             self.reference = Basis.concat([basis.subset([k]) if j is None else self.reference.subset([j])
                                            for k, j in enumerate(origin)])

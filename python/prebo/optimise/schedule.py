@@ -69,7 +69,7 @@ from .checkpoint import Cursor
 from .momentum import EVERY
 from .settings import Optimiser
 
-#: a kind not run for this many times its last pass's seconds is tried again (module docstring)
+#: a kind not run for this many times its shortest pass of the last three is tried again (module docstring)
 REVISIT = 50
 #: the fewest functions a growth pass adds
 GROWTH = 8
