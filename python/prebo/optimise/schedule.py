@@ -5,7 +5,8 @@ A pass is the unit the schedule measures: growth by a quarter of the basis (at l
 functions, at most to `size`; every new function refined), refinement or replacement of the
 next CHUNK functions (a sweep continues where the last pass of its kind stopped), one joint
 L-BFGS step, or, at full size, one pruning: `pruned(size)` functions grown past the size, each
-refined with its partners, as many removed again, and the basis before it restored unless the
+refined with its partners, as many removed again (each removal followed by a refinement of the
+function that overlapped most the one removed), and the basis before it restored unless the
 energy fell (methods.Pruning; with the fixed schedule's pruning He with 500 functions gained
 2.8× as much as with the adaptive schedule in 150 s, benchmarks/README, "Grow and prune").
 After each pass the next one is of the kind whose last pass gained the most energy per second

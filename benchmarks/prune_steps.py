@@ -1,0 +1,59 @@
+"""One pruning of a run's basis, taken apart (benchmarks/README, "Pruning that refines after each
+removal"): `--grow N` growth steps past the size as methods.Prune makes them (the best of the
+run's trials, refined, then refined with its partners), then the removals back to the size, each
+of the function whose removal raises the energy least — as Prune.remove (the function it
+overlapped most then refined with its partners), or with `--plain` removed only (the code before
+session 26). Per seed: the growth's gain, each removal's cost, the net gain and the seconds.
+
+    RAYON_NUM_THREADS=1 python benchmarks/prune_steps.py benchmarks/checkpoints/h2-auto --grow 12 --seeds 11,12,13
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from prebo import eigen
+from prebo.integrals import laboratory
+from prebo.optimise.checkpoint import Cursor, load_checkpoint, resumed
+from prebo.optimise.expansion import Expansion
+from prebo.optimise.methods import Grow, Prune, Refinement, Run
+from prebo.optimise.report import Reporter
+from prebo.optimise.sampler import Sampler
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("checkpoint", help="run folder with basis.json")
+    ap.add_argument("--grow", type=int, default=20, help="functions grown past the size and removed again")
+    ap.add_argument("--seeds", default="11", help="comma-separated seeds of the growth trials, one pruning each")
+    ap.add_argument("--plain", action="store_true", help="remove only, nothing refined after a removal")
+    a = ap.parse_args()
+    d, system, opts = load_checkpoint(a.checkpoint)
+    basis, *_ = resumed(d, opts, np.random.default_rng(0), a.checkpoint)
+    refinement = Refinement(opts.refine_evaluations, opts.refine_method, opts.refine_group)
+    prune = Prune(Grow(opts.trials, refinement), refinement)
+    with eigen.lapack_threads(len(basis)), Reporter(opts, False) as report:
+        for seed in (int(s) for s in a.seeds.split(",")):
+            ex = Expansion(basis.subset(slice(None)), laboratory(system), opts.threshold, opts.min_norm,
+                           opts.max_overlap)
+            run = Run(ex, Sampler(system, opts, np.random.default_rng(seed)), report)
+            E0, nb, t0 = ex.energy, len(basis), time.perf_counter()
+            for _ in range(a.grow):
+                prune.step(run, Cursor("prune", index=0))
+            grown, t1, costs = E0 - ex.energy, time.perf_counter() - t0, []
+            while len(ex.basis) > nb:
+                before = ex.energy
+                if a.plain:
+                    ex.remove(int(np.argmin(eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors))))
+                else:
+                    prune.remove(run)
+                costs.append(ex.energy - before)
+            print(f"seed {seed}: grew {grown:.3e} Eh in {t1:.1f} s; removals cost {sum(costs):.3e} Eh "
+                  f"({', '.join(f'{c:.1e}' for c in costs)}); net {E0 - ex.energy:.3e} Eh in "
+                  f"{time.perf_counter() - t0:.1f} s", flush=True)
+
+
+if __name__ == "__main__":
+    main()
