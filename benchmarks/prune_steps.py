@@ -3,7 +3,9 @@ removal"): `--grow N` growth steps past the size as methods.Prune makes them (th
 run's trials, refined, then refined with its partners), then the removals back to the size, each
 of the function whose removal raises the energy least — as Prune.remove (the function it
 overlapped most then refined with its partners), or with `--plain` removed only (the code before
-session 26). Per seed: the growth's gain, each removal's cost, the net gain and the seconds.
+session 26). First, what removing each function alone would cost (eigen.lowest_without_each);
+then per seed: each growth step's gain and seconds, each removal's cost, the net gain and the
+seconds.
 
     RAYON_NUM_THREADS=1 python benchmarks/prune_steps.py benchmarks/checkpoints/h2-auto --grow 12 --seeds 11,12,13
 """
@@ -38,10 +40,18 @@ def main() -> None:
         for seed in (int(s) for s in a.seeds.split(",")):
             ex = Expansion(basis.subset(slice(None)), laboratory(system), opts.threshold, opts.min_norm,
                            opts.max_overlap)
+            if seed == int(a.seeds.split(",")[0]):
+                alone = eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors) - ex.energy
+                print(f"removing one function alone costs {alone.min():.2e} Eh at least, median "
+                      f"{np.median(alone):.2e}; {int(np.sum(alone < 1e-10))} below 1e-10")
             run = Run(ex, Sampler(system, opts, np.random.default_rng(seed)), report)
             E0, nb, t0 = ex.energy, len(basis), time.perf_counter()
+            steps = []
             for _ in range(a.grow):
+                before, ts = ex.energy, time.perf_counter()
                 prune.step(run, Cursor("prune", index=0))
+                steps.append(f"{before - ex.energy:.1e} ({time.perf_counter() - ts:.1f} s)")
+            print(f"seed {seed}: growth steps {', '.join(steps)}")
             grown, t1, costs = E0 - ex.energy, time.perf_counter() - t0, []
             while len(ex.basis) > nb:
                 before = ex.energy
