@@ -37,10 +37,10 @@ def main() -> None:
     refinement = Refinement(opts.refine_evaluations, opts.refine_method, opts.refine_group)
     prune = Prune(Grow(opts.trials, refinement), refinement)
     with eigen.lapack_threads(len(basis)), Reporter(opts, False) as report:
-        for seed in (int(s) for s in a.seeds.split(",")):
+        for k, seed in enumerate(int(s) for s in a.seeds.split(",")):
             ex = Expansion(basis.subset(slice(None)), laboratory(system), opts.threshold, opts.min_norm,
                            opts.max_overlap)
-            if seed == int(a.seeds.split(",")[0]):
+            if k == 0:
                 alone = eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors) - ex.energy
                 print(f"removing one function alone costs {alone.min():.2e} Eh at least, median "
                       f"{np.median(alone):.2e}; {int(np.sum(alone < 1e-10))} below 1e-10")
