@@ -19,7 +19,7 @@ from prebo.io.toml import tomllib
 ROOT = Path(__file__).resolve().parents[1]
 #: example -> reference key in tests/data/reference_energies.toml
 REFERENCE = {"h": "H", "he": "He", "h-": "H-", "ps-": "Ps-", "li": "Li", "h2+": "H2+", "h2": "H2",
-             "he-400": "He", "he-600": "He", "li-100": "Li", "li-150": "Li"}
+             "he-400": "He", "he-600": "He", "he-700": "He", "li-100": "Li", "li-150": "Li"}
 #: relative error, then errors in Eh, whose first time the table reports (time to accuracy)
 MILESTONES = (1e-6, 1e-8, 1e-9, 1e-10)
 

@@ -31,7 +31,9 @@ def test_check_state_is_the_families_rule():
     family("ecg-gvr").check_state(p_state)
     with pytest.raises(InputError, match="natural parity"):
         family("ecg-gvr").check_state(prebo.System(["p", "e"], N=1, parity=1).state)
-    family("fecg").check_state(prebo.System(["p", "e"], N=1, parity=1).state)
+    family("fecg").check_state(prebo.System(["p", "e"], N=0, parity=-1).state)
+    with pytest.raises(InputError, match="N = 0 only"):  # the core evaluates no other
+        family("fecg").check_state(prebo.System(["p", "e"], N=1, parity=1).state)
 
 
 def test_basis_knows_its_family_and_keeps_its_kind():

@@ -58,20 +58,30 @@ def test_same_seed_same_basis(run_dir, tmp_path):
 
 def test_a_new_run_refuses_a_folder_holding_a_checkpoint(run_dir, tmp_path):
     """`prebo run X.toml --out DIR` silently overwrote the run whose checkpoint DIR holds (and let two
-    runs share a folder); a folder with only a result or other files is a run's to write."""
+    runs share a folder), or its result (issue 37, case 6); a folder with other files only is a run's
+    to write, and --force starts over in one holding an earlier run."""
     toml, before = run_dir.parent / "h.toml", (run_dir / "basis.json").read_bytes()
     assert_clean_error(prebo("run", toml, "--out", run_dir, "--quiet"),
                        f"{run_dir}: the output folder holds a run's checkpoint (basis.json): continue that run "
-                       f"with `prebo run --resume {run_dir}`, or give another --out")
+                       f"with `prebo run --resume {run_dir}`, or give another --out (or --force to start over)")
     assert (run_dir / "basis.json").read_bytes() == before
     (tmp_path / "lowest.json").write_bytes(before)
     assert_clean_error(prebo("run", toml, "--out", tmp_path, "--quiet"), "checkpoint (lowest.json)")
     (tmp_path / "lowest.json").unlink()
-    (tmp_path / "result.json").write_bytes((run_dir / "result.json").read_bytes())
     (tmp_path / "notes.txt").write_text("mine")
     assert prebo("run", toml, "--out", tmp_path, "--quiet").returncode == 0
     assert json.loads((tmp_path / "basis.json").read_text())["functions"] == json.loads(before)["functions"]
     assert (tmp_path / "notes.txt").read_text() == "mine"
+    (tmp_path / "basis.json").unlink()
+    result = (tmp_path / "result.json").read_bytes()
+    assert_clean_error(prebo("run", toml, "--out", tmp_path, "--quiet"),
+                       f"{tmp_path}: the output folder holds a run's result (result.json): give another --out, "
+                       "or --force to replace it")
+    assert (tmp_path / "result.json").read_bytes() == result and not (tmp_path / "basis.json").exists()
+    (tmp_path / "lowest.json").write_bytes(before)  # an earlier run's lowest state: not the new run's
+    assert prebo("run", toml, "--out", tmp_path, "--quiet", "--force").returncode == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["basis.json", "notes.txt", "result.json"]
+    assert json.loads((tmp_path / "result.json").read_text())["wall_seconds"] != json.loads(result)["wall_seconds"]
 
 
 def assert_clean_error(r, *words):
@@ -159,16 +169,16 @@ def test_plot_draws_the_convergence_of_runs(run_dir, tmp_path):
     assert [h[0] for h in history] == sorted(h[0] for h in history)  # basis size never shrinks
     assert all(b[1] <= a[1] for a, b in zip(history, history[1:]))  # energy never rises
     middle = history[len(history) // 2][3]
-    r = prebo("plot", run_dir, "--since", middle, "--out", png)
+    r = prebo("plot", run_dir, "--since", middle, "--out", png, "--force")
     assert r.returncode == 0, r.stderr
-    assert_clean_error(prebo("plot", run_dir, "--since", -1.0, "--out", png), "nothing in its history at or before -1 s")
+    assert_clean_error(prebo("plot", run_dir, "--since", -1.0, "--out", png, "--force"), "nothing in its history at or before -1 s")
     logged = tmp_path / "log.png"  # a run of days beside one of minutes: the wall time on a log axis
     r = prebo("plot", run_dir, "--since", middle, "--log-time", "--out", logged)
     assert r.returncode == 0, r.stderr
     assert logged.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and logged.read_bytes() != png.read_bytes()
     for option in ("--reference", "--since"):  # a NaN or infinite number is refused, not drawn
         for bad in ("nan", "inf", "-inf", "x"):
-            assert_clean_error(prebo("plot", run_dir, f"{option}={bad}", "--out", png), option, "not a finite number")
+            assert_clean_error(prebo("plot", run_dir, f"{option}={bad}", "--out", png, "--force"), option, "not a finite number")
 
 
 def test_plot_file_names_and_references_a_log_axis_cannot_draw(run_dir, tmp_path):
@@ -189,6 +199,7 @@ def test_an_input_file_given_with_resume_is_refused(run_dir, tmp_path):
     h = __import__("conftest").ROOT / "examples" / "h.toml"
     assert_clean_error(prebo("run", h, "--resume", run_dir), "--resume", "give no input file")
     assert_clean_error(prebo("run", "--resume", run_dir, "--out", tmp_path / "x"), "give no input file or --out")
+    assert_clean_error(prebo("run", "--resume", run_dir, "--force"), "nor --force")
 
 
 def test_plot_since_starts_each_run_from_its_state_at_that_moment():

@@ -10,7 +10,7 @@ import pytest
 import scipy.linalg
 
 import prebo
-from prebo import eigen
+from prebo import _core, eigen
 from prebo.basis import Basis
 from prebo.errors import LinearDependenceError, NonFiniteError, NotPositiveDefiniteError
 from prebo.integrals import laboratory
@@ -173,16 +173,109 @@ def test_refinement_is_a_fixed_point(h2plus_pecg):
     assert abs(again.energies[0] - sol.energies[0]) <= 2 * np.spacing(abs(sol.energies[0]))
 
 
-def test_refinement_that_does_not_converge_is_refused(problem):
-    """An eigenbasis too poor to converge from (every other root at E_0 + 1e-12) gives an error
-    naming the overlap condition, never a number."""
+def test_inverse_iteration_agrees_with_the_refinement(h2plus_pecg):
+    """Where the corrections converge, inverse iteration in double-double finds the same energy, to
+    an ulp (twofloat's division rounds the refined quotient, docs/conventions.md)."""
+    m = h2plus_pecg
+    H, S = m["T_ti"] + m["V"], m["S"]
+    lapack = eigen.solve(H, S, roots=0)
+    energy, vector, _, converged = _core.inverse_iteration(H, S, lapack.energies, lapack.vectors)
+    assert converged
+    assert abs(energy - eigen.solve(H, S).energies[0]) <= np.spacing(abs(energy))
+    assert vector @ S @ vector == pytest.approx(1.0, abs=1e-6)
+
+
+def test_poor_eigenbasis_is_resolved_by_inverse_iteration(problem):
+    """An eigenbasis too poor for the corrections (every other root at E_0 + 1e-12) still gives the
+    lowest eigenvalue, by inverse iteration."""
     _, _, _, m = problem
     H, S = m["T_ti"] + m["V"], m["S"]
     sol = eigen.solve(H, S)
     poor = eigen.Eigen(np.full_like(sol.energies, sol.energies[0] + 1e-12), sol.vectors, sol.kept,
                        sol.overlap_condition)
+    assert not _core.refine_eigenpairs(H, S, poor.energies, poor.vectors, 1)[3][0]
+    energy = eigen.refine(H, S, poor).energies[0]
+    assert abs(energy - sol.energies[0]) <= 2 * np.spacing(abs(energy))
+
+
+def test_poor_eigenbasis_with_a_dropped_direction_is_refused(problem):
+    """Inverse iteration solves the whole stored pencil, so it does not stand in where a direction
+    was dropped (an exact duplicate function): an eigenbasis too poor for the corrections gives an
+    error naming the overlap condition, never a number."""
+    _, basis, rep, _ = problem
+    m = rep.matrices(prebo.Basis(basis.system, np.concatenate([basis.A, basis.A[:1]]),
+                                 np.concatenate([basis.c_A, basis.c_A[:1]])))
+    H, S = m["T_ti"] + m["V"], m["S"]
+    sol = eigen.solve(H, S)
+    assert sol.kept == len(S) - 1
+    poor = eigen.Eigen(np.full_like(sol.energies, sol.energies[0] + 1e-12), sol.vectors, sol.kept,
+                       sol.overlap_condition)
     with pytest.raises(LinearDependenceError, match="cannot resolve this basis \\(overlap condition"):
         eigen.refine(H, S, poor)
+
+
+def test_refinement_that_does_not_converge_is_refused():
+    """A lowest root that neither the corrections nor inverse iteration reach (−1e12, below every
+    shift tried from a start at 3 with no gap to size the margin) gives an error naming the overlap
+    condition, never a number."""
+    H, S = np.diag([-1e12, -1.0, 3.0]), np.eye(3)
+    start = eigen.Eigen(np.full(3, 3.0), np.eye(3)[:, ::-1], 3, 1.0)
+    with pytest.raises(LinearDependenceError, match="cannot resolve this basis \\(overlap condition 1.00e\\+00\\)"):
+        eigen.refine(H, S, start)
+
+
+def test_overlap_indefinite_in_double_double_is_refused():
+    """The inverse iteration refuses an overlap without a double-double LDLᵀ factorisation."""
+    start = eigen.Eigen(np.array([0.0, 1e-12]), np.eye(2), 2, 1.0)
+    with pytest.raises(NotPositiveDefiniteError, match="^overlap matrix is not positive definite: pivot 1 of its "
+                                                       "double-double LDLT factorisation is -3.000e0$"):
+        eigen.refine(np.eye(2), np.array([[1.0, 2.0], [2.0, 1.0]]), start)
+
+
+class NearDuplicates:
+    """He, 40 functions of examples/bases/he and copies of functions 3 and 17 scaled by 1 + `scale`:
+    overlap condition 2.6e15 at 1e-7 (where LAPACK's eigenbasis is too poor for the corrections),
+    1.7e15 at 3e-7, 2.6e14 at 1e-6."""
+
+    def basis(self, scale: float) -> Basis:
+        basis = Basis.load(ROOT / "examples" / "bases" / "he" / "basis.json").subset(list(range(40)))
+        copies = [3, 17]
+        A = np.concatenate([basis.A, basis.A[copies] * (1 + scale)])
+        c_A = np.concatenate([basis.c_A, basis.c_A[copies] * (1 + scale)])
+        return Basis(basis.system, A, c_A)
+
+    def __call__(self, scale: float) -> dict:
+        basis = self.basis(scale)
+        return laboratory(basis.system).matrices(basis)
+
+
+@pytest.fixture(scope="module")
+def near_duplicates_at():
+    return NearDuplicates()
+
+
+@pytest.fixture(scope="module")
+def near_duplicates(near_duplicates_at):
+    return near_duplicates_at(1e-7)
+
+
+#: the threshold that keeps every direction of the overlap
+EVERY_DIRECTION = 2.0**-53
+
+
+def test_lowest_root_beyond_double_precision_is_the_exact_eigenvalue(near_duplicates):
+    """Where the corrections do not converge (overlap condition 2.6e15, every direction kept), the
+    energy is a 50-digit eigenvalue of the same matrices to 1e-15, not below it by more than an ulp."""
+    m = near_duplicates
+    H, S = m["T_ti"] + m["V"], m["S"]
+    lapack = eigen.solve(H, S, EVERY_DIRECTION, roots=0)
+    assert 1e15 < lapack.overlap_condition < 1e16 and lapack.kept == len(S)
+    assert not _core.refine_eigenpairs(H, S, lapack.energies, lapack.vectors, 1)[3][0]
+    exact = mp_eigenvalues(H, S, 1)[0]
+    energy = eigen.solve(H, S, EVERY_DIRECTION).energies[0]
+    assert energy == pytest.approx(float(exact), rel=1e-15, abs=0)
+    assert energy >= float(exact) - np.spacing(abs(energy))  # variational, to the rounding of ρ
+    assert abs(lapack.energies[0] - float(exact)) > 1e-6  # double precision alone is off
 
 
 @pytest.mark.parametrize("matrix", ["H", "S"])
@@ -208,11 +301,11 @@ def test_non_finite_energy_is_an_error_of_prebo_energy(tmp_path):
     assert r.stderr.count("\n") == 1 and "Hamiltonian matrix is not finite: H[0, 0] = nan" in r.stderr
 
 
-def test_uncertainty_matches_a_perturbation_experiment(h2plus_pecg):
-    """Every element of S, T_TI and V perturbed by an independent symmetric relative error of
-    ELEMENT_ERROR: the spread of the re-solved energies is the estimate (first-order theory)."""
-    m = h2plus_pecg
-    sol = eigen.solve(m["T_ti"] + m["V"], m["S"])
+def perturbation_experiment(m, threshold=eigen.THRESHOLD):
+    """The estimated uncertainty of the lowest energy and the spread (standard deviation) of the
+    energies re-solved, 60 times, with every element of S, T_TI and V perturbed by an independent
+    symmetric relative error of ELEMENT_ERROR."""
+    sol = eigen.solve(m["T_ti"] + m["V"], m["S"], threshold)
     e0 = sol.energies[0]
     estimate = eigen.energy_uncertainty(sol.vectors[:, 0], e0, m["S"], m["T_ti"], m["V"])
     rng = np.random.default_rng(3)
@@ -225,9 +318,42 @@ def test_uncertainty_matches_a_perturbation_experiment(h2plus_pecg):
     energies = []
     for _ in range(60):
         T, V = noisy(m["T_ti"]), noisy(m["V"])
-        energies.append(eigen.solve(T + V, noisy(m["S"])).energies[0])
-    assert 0.7 < np.std(energies, ddof=1) / estimate < 1.4
+        energies.append(eigen.solve(T + V, noisy(m["S"]), threshold).energies[0])
+    return estimate, np.std(energies, ddof=1)
+
+
+def test_uncertainty_matches_a_perturbation_experiment(h2plus_pecg):
+    """The spread of the perturbed energies is the estimate (first-order theory)."""
+    estimate, spread = perturbation_experiment(h2plus_pecg)
+    assert 0.7 < spread / estimate < 1.4
     assert estimate > 1e-9  # this basis is resolved no better than ~1e-8 relative
+
+
+@pytest.mark.parametrize("scale", [1e-7, 3e-7, 1e-6])
+def test_uncertainty_stays_true_beyond_first_order(near_duplicates_at, scale):
+    """Where first-order theory fails (ELEMENT_ERROR x condition above FIRST_ORDER: the spread is
+    ~4e3 times its estimate at condition 2.6e15), `eigen.uncertainty` is the largest move of DRAWS
+    perturbed solves: at least the spread of this experiment of other draws (for normal moves the
+    largest of 24 is 2-2.5 spreads; these have heavy tails), and not far above it; below, the
+    first-order estimate is the spread."""
+    m = near_duplicates_at(scale)
+    sol = eigen.solve(m["T_ti"] + m["V"], m["S"], EVERY_DIRECTION)
+    reported = eigen.uncertainty(sol, m["S"], m["T_ti"], m["V"], threshold=EVERY_DIRECTION)
+    estimate, spread = perturbation_experiment(m, EVERY_DIRECTION)
+    if scale == 1e-6:
+        assert eigen.first_order(sol) and reported == estimate and 0.7 < spread / reported < 1.4
+    else:
+        assert not eigen.first_order(sol) and (scale == 3e-7 or spread / estimate > 100)
+        assert 0.3 < spread / reported < 1.6
+
+
+def test_the_optimiser_keeps_no_change_beyond_first_order(near_duplicates_at):
+    """The expansion's uncertainty beyond FIRST_ORDER is inf: no change there is ever kept."""
+    from prebo.optimise.expansion import Expansion
+
+    basis = near_duplicates_at.basis(1e-7)
+    ex = Expansion(basis, laboratory(basis.system), EVERY_DIRECTION)
+    assert not eigen.first_order(ex.eig) and ex.sigma == np.inf and not ex.gains(ex.energy - 1.0)
 
 
 def test_optimiser_energy_is_a_fresh_evaluation(tmp_path):

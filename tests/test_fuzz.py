@@ -18,6 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import prebo
+from prebo.basis import FAMILIES
 from prebo.cli import main
 from prebo.errors import PreboError
 from prebo.optimise import SETTINGS
@@ -132,6 +133,82 @@ def test_basis_files_relabelled_to_another_state_or_type(checkpoints, tmp_path, 
     f = tmp_path / "basis.json"
     f.write_text(json.dumps(doc))
     assert_clean(main(["energy", str(f), "--json"]), *capsys.readouterr())
+
+
+#: small stored bases whose states have one-dimensional symmetry (every operator of such a state is
+#: its own up to a factor): an edited one that is taken must give exactly the energy of its label
+LABELLED = ["he", "h2plus-gvr", "h2plus-fecg", "h2-pecg"]
+
+
+@pytest.fixture(scope="module")
+def labelled():
+    """The first 20 functions of each LABELLED basis, with its system, symmetry and basis type."""
+    bases = Path(__file__).resolve().parents[1] / "examples" / "bases"
+    docs = {name: json.loads((bases / name / "basis.json").read_text()) for name in LABELLED}
+    return {name: {k: d[k] for k in BASIS_KEYS if k != "coefficients"} | {"functions": d["functions"][:20]}
+            for name, d in docs.items()}
+
+
+def edit_label(doc, data) -> None:
+    """One edit of what basis file `doc` says it is: a group's spin relabelled, a permutation of the
+    symmetry dropped, replaced or added, a coefficient edited (within rounding too), the basis type
+    relabelled (with the functions' keys rewritten to the new family's, or not), the symmetry
+    replaced by that of the label, or dropped."""
+    sym, n = doc.get("symmetry"), len(doc["system"]["particles"])
+    what = data.draw(st.sampled_from(["spin", "permutations", "coefficients", "kind", "label's symmetry",
+                                      "no symmetry"]))
+    if what == "spin":
+        spins = doc["system"]["state"]["spin"]
+        spins[data.draw(st.sampled_from(sorted(spins)))] = data.draw(st.sampled_from([0, 0.5, 1, 1.5, 2]))
+    elif what == "permutations" and sym:
+        perms, coefs = sym["permutations"], sym["coefficients"]
+        k, other = data.draw(st.integers(0, len(perms) - 1)), data.draw(st.permutations(range(n)))
+        action = data.draw(st.sampled_from(["drop", "replace", "add"]))
+        if action == "drop":
+            del perms[k], coefs[k]
+        elif action == "replace":
+            perms[k] = other
+        else:
+            perms.append(other)
+            coefs.append(data.draw(st.sampled_from([1.0, -1.0, 0.5])))
+    elif what == "coefficients" and sym:
+        coefs = sym["coefficients"]
+        k = data.draw(st.integers(0, len(coefs) - 1))
+        coefs[k] = data.draw(st.sampled_from([-coefs[k], 0.0, 0.5, 2.0, coefs[k] * (1 + 1e-6), coefs[k] * (1 + 1e-13)]))
+    elif what == "kind":
+        kind = doc["basis_type"] = data.draw(st.sampled_from(sorted(FAMILIES)))
+        if data.draw(st.booleans()):
+            new = {"u": [1.0, -1.0] + [0.0] * (n - 2), "K": 0, "s": [[0.0] * 3] * n}
+            doc["functions"] = [{k: v for k, v in f.items() if k in ("A", "c_A", "channel")}
+                                | {k: new[k] for k in FAMILIES[kind].shapes} for f in doc["functions"]]
+    elif what == "label's symmetry":
+        with contextlib.suppress(PreboError):
+            doc["symmetry"] = prebo.System.from_dict(doc["system"]).symmetriser.as_dict()
+    else:
+        doc.pop("symmetry", None)
+
+
+@FUZZ
+@given(name=st.sampled_from(LABELLED), data=st.data())
+def test_edited_labels_are_evaluated_as_they_say_or_refused(labelled, tmp_path, capsys, name, data):
+    """Relabelled spin, edited permutations and coefficients, relabelled basis type: taken only as
+    what the label says (every key of the functions read, the energy of the state's own
+    operator), else refused in one line (issue 37)."""
+    doc = json.loads(json.dumps(labelled[name]))
+    for _ in range(data.draw(st.integers(1, 3))):
+        edit_label(doc, data)
+    f = tmp_path / "edited.json"
+    f.write_text(json.dumps(doc))
+    rc = main(["energy", str(f), "--json"])
+    out, err = capsys.readouterr()
+    assert_clean(rc, out, err)
+    if rc == 0:
+        fields = {"A", "c_A", "channel", *FAMILIES[doc["basis_type"]].shapes}
+        assert all(set(fn) <= fields for fn in doc["functions"]), doc["basis_type"]
+        label = tmp_path / "label.json"
+        label.write_text(json.dumps({k: v for k, v in doc.items() if k != "symmetry"}))
+        assert main(["energy", str(label), "--json"]) == 0
+        assert json.loads(out)["energy"] == json.loads(capsys.readouterr().out)["energy"]
 
 
 @FUZZ

@@ -4,17 +4,22 @@ sampling lengths from each pair's Bohr radius (sampler.pair_lengths), the adapti
 import json
 import subprocess
 import sys
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 import prebo
+from prebo import eigen
+from prebo.basis import Basis
 from prebo.optimise import Cursor, Optimiser, resume_from
 from prebo.optimise.convergence import convergence
 from prebo.optimise.defaults import GROUP, TRIALS, resolved
 from prebo.optimise.sampler import pair_lengths
 from prebo.optimise.momentum import EVERY
 from prebo.optimise.schedule import CHUNK, PRUNE, RATIO, REVISIT, Adaptive, pruned
+
+from conftest import ROOT
 
 LI7 = {"name": "li7", "mass": 12786.39227775, "charge": 3, "spin": 1.5}
 
@@ -29,6 +34,18 @@ def test_a_molecule_gets_ecg_gvr_functions_with_powers_from_its_nuclear_mass():
         assert resolved(Optimiser(refine=1), prebo.System(particles)).trials == 30  # a fixed schedule
         assert opts.K_max == int(np.ceil(np.sqrt(mu)))  # 31 for H2, as the paper's 30; 43 for D2+
     assert resolved(Optimiser(), prebo.System(["p", "p", "e"])).K_max == 31
+
+
+def test_the_default_threshold_keeps_every_direction_a_run_grows_into():
+    """Issue 37, case 14: the He basis of 700 functions the adaptive schedule grew (overlap condition
+    6.1e13, past 1/1e-13, the former default) is evaluated with every direction by default, to the
+    energy the run optimised; 1e-13 dropped two directions worth 7.2e-11 Eh and stopped growth."""
+    folder = ROOT / "examples" / "bases" / "auto-he-700"
+    basis = Basis.load(folder / "basis.json")
+    assert Optimiser().threshold == eigen.THRESHOLD
+    r = prebo.evaluate(basis)
+    assert r["overlap_condition"] > 1e13 and r["kept"] == len(basis) == 700
+    assert r["energy"] == json.loads((folder / "basis.json").read_text())["energy"]
 
 
 def test_an_atom_gets_plain_ecgs_and_a_p_state_ecg_gvr_functions_without_powers():
@@ -210,7 +227,7 @@ def test_the_basis_is_exhausted_when_every_kind_gains_less_than_a_tenth_of_growt
 
 def test_a_budget_overrides_exhaustion_until_the_time_left_would_gain_less_than_the_tolerance():
     """The rates of the exhausted basis above, but with a budget: the run goes on while the best
-    kind's last rate times the seconds left exceeds the tolerance, and then has converged."""
+    kind's last rate times the seconds left exceeds the tolerance, and then ends as its budget does."""
     he = prebo.System(["alpha", "e", "e"])
     rows = (("grow", 80, None, 1.0), ("grow", 100, 1e-3, 1.0), ("refine", 100, 0.5 * RATIO * 1e-3, 1.0),
             ("sweep", 100, 0.5 * RATIO * 1e-3, 1.0), ("polish", 100, 0.9 * RATIO * 1e-3, 1.0),
@@ -221,7 +238,22 @@ def test_a_budget_overrides_exhaustion_until_the_time_left_would_gain_less_than_
     assert s.advantage(100) > 1 / RATIO  # the report still says a larger basis would gain faster
     tolerance = s.tolerance(E)
     end = 600.0 - 0.5 * tolerance / (0.9 * RATIO * 1e-3)  # half the tolerance left to gain
-    assert s.choose(100, E, end) is None and s.stopped == "converged"
+    assert s.choose(100, E, end) is None and s.stopped == "budget"
+    s.opts = replace(s.opts, budget=1200.0)  # resumed with a larger budget (driver.optimise): it goes on
+    assert s.reopen(100, E, end).phase in ("refine", "sweep", "polish", "prune")
+
+
+def test_a_budget_is_used_while_the_passes_still_gain():
+    """Issue 37, case 14: He with 700 functions at 2.2e-10 Eh above the exact energy, 192 s into a
+    300-s budget, every kind's last pass gaining ~3e-11 Eh per sweep of the basis: the run goes on
+    (the old default tolerance, 1e-10 |E| = 2.9e-10 Eh, called it converged)."""
+    he = prebo.System(["alpha", "e", "e"], spin={"e": 0})
+    s = Adaptive(resolved(Optimiser(size=700, budget=300.0), he))
+    s.passes.append(["grow", 700, -2.9033045, -2.9033045575, 0.0, 150.0, 700])
+    E = passes(s, ("refine", 700, 2e-12, 10.0), ("sweep", 700, 2e-12, 12.0), ("polish", 700, 1e-13, 10.0),
+               ("prune", 700, 1e-12, 10.0))
+    assert 700 / CHUNK * 2e-12 < 1e-10 * abs(E) and now(s) == 192.0
+    assert s.choose(700, E, now(s)) in ("refine", "sweep", "momentum") and s.stopped is None
 
 
 def test_without_a_growth_rate_the_best_rate_at_full_size_is_the_reference():

@@ -201,8 +201,8 @@ def test_energy_json_is_strict_json(bases, capsys):
     (HMINUS_TOML + "[state]\nspin = 0\n", ["spin = 0", "must map particle names"]),
     (H_TOML.replace("seed = 3", "seed = -1"), ["[optimiser] seed = -1", "integer ≥ 0"]),
     (H_TOML.replace("seed = 3", 'seed = "x"'), ["[optimiser] seed = 'x'", "integer ≥ 0"]),
-    (H_TOML + "length_range = [1.0]\n", ["length_range = [1.0]", "0 < lo < hi"]),
-    (H_TOML + "length_range = [0.1, inf]\n", ["length_range = [0.1, inf]", "0 < lo < hi"]),
+    (H_TOML + "length_range = [1.0]\n", ["length_range = [1.0]", "0.0001 ≤ lo < hi ≤ 10000"]),
+    (H_TOML + "length_range = [0.1, inf]\n", ["length_range = [0.1, inf]", "0.0001 ≤ lo < hi ≤ 10000"]),
     (HMINUS_TOML + 'channels = ["hpc:9"]\n', ["channels", "hpc:9", "particle 9 is not one of 0..2"]),
     (HMINUS_TOML + 'channels = ["cmc:-1"]\n', ["channels", "cmc:-1"]),
     ('[system]\nparticles = ' + str(["p", "e"] * 15).replace("'", '"') + '\n', ["2 to 8 particle"]),
@@ -236,7 +236,7 @@ def test_import_with_non_positive_c_A(tmp_path, capsys):
     li = ROOT / "tests" / "data" / "ecgpack" / "ecgpack-Li7-100.inout.txt"
     for value in ("0", "-1", "nan"):
         err = cli_error(capsys, "import", li, "--c-A", value, "--out", tmp_path / "li.json")
-        assert "--c-A = " in err and "> 0" in err
+        assert "--c-A = " in err and "0.01 ≤ x ≤ 1000" in err
     from prebo.io.ecgpack import read_inout
     with pytest.raises(InputError, match="c_A = 0"):
         read_inout(li, c_A=0)

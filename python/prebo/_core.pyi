@@ -4,9 +4,10 @@ Conventions (docs/conventions.md): a basis function in n coordinates has the exp
 exp(-r^T (A ⊗ I_3) r) (no factor 1/2); every function is used normalised; energies in hartree
 (E_h), lengths in bohr (a_0), masses in electron masses. Arrays are float64 (K: uint32); any
 array-like numpy can convert is accepted, in any memory layout. Errors: `prebo.errors`
-`NotPositiveDefiniteError` (an exponent matrix without a Cholesky factor), `ShapeError` (arrays
-that do not fit together) and `UnsupportedError` (more than `MAX_DIM` coordinates, an unknown
-family or operator, K out of range).
+`NotPositiveDefiniteError` (an exponent matrix without a Cholesky factor, an overlap without a
+double-double LDLᵀ factorisation in `inverse_iteration`), `ShapeError` (arrays that do not fit
+together) and `UnsupportedError` (more than `MAX_DIM` coordinates, an unknown family or operator,
+K out of range).
 
 Parameter tuples (`params`) per family, for k functions in n coordinates:
 - "pecg" (plain ECGs): (A (k, n, n), c_A (k,))
@@ -101,6 +102,16 @@ def refine_eigenpairs(h: ArrayLike, s: ArrayLike, e: ArrayLike, c: ArrayLike, ro
     double-precision solution: h, s (nb, nb); e (kept,) ascending; c (nb, kept) S-orthonormal.
     Returns the energies (roots,) in E_h, the S-normalised vectors (nb, roots), the iterations
     and whether each root converged."""
+
+
+def inverse_iteration(h: ArrayLike, s: ArrayLike, e: ArrayLike, c: ArrayLike
+                      ) -> tuple[float, NDArray[np.float64], int, bool]:
+    """The lowest eigenpair of H c = E S c by inverse iteration in double-double, for a root
+    `refine_eigenpairs` does not resolve: h, s (nb, nb); e (kept,) ascending, kept >= 1; c (nb,
+    kept) S-orthonormal, from a double-precision solver. Returns the energy in E_h (the Rayleigh
+    quotient at the double-double vector), the S-normalised vector (nb,) rounded to float64, the
+    iterations and whether it converged. NotPositiveDefiniteError if s has no double-double LDLᵀ
+    factorisation."""
 
 
 def num_threads() -> int:

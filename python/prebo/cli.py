@@ -1,7 +1,14 @@
-"""Command line: `prebo run`, `energy`, `import`, `export`, `plot`. Errors print one line and exit 2, never a traceback."""
+"""Command line: `prebo run`, `energy`, `import`, `export`, `plot`. Errors print one line and exit 2, never a traceback.
+
+Outputs never replace inputs, and replace earlier outputs only with `--force` (atomically); a run
+owns its folder while it runs (io/lock.py). A closed or full standard output or error ends the
+command with exit 2 once its work is done and its files are written (`Stream`).
+"""
 from __future__ import annotations
 
 import argparse
+import errno
+import io
 import json
 import math
 import os
@@ -12,6 +19,9 @@ from pathlib import Path
 
 from .errors import NonFiniteError, OutputError, PreboError
 from .expectation import OPERATORS
+from .validation import path_name
+
+RESULT = "result.json"
 
 
 def _result(basis, where, threshold: float, coordinates: str = "lab", operators=()) -> dict:
@@ -75,8 +85,8 @@ def _print_result(r: dict) -> None:
 
 def _warn_if_unbound(r: dict) -> None:
     """One line on stderr when the energy is not below the lowest dissociation threshold (`results`),
-    after the result (a closed output pipe shows before it)."""
-    sys.stdout.flush()
+    after the result (a standard output that could not take it ends the command first: `Stream.check`)."""
+    sys.stdout.check()
     if not r["bound"]:
         print(f"prebo: warning: E = {r['energy']:.12g} Eh is not below the dissociation threshold "
               f"{r['threshold']:.12g} Eh ({r['threshold_fragments']}): the state is not bound in this basis "
@@ -84,58 +94,55 @@ def _warn_if_unbound(r: dict) -> None:
 
 
 def cmd_run(args) -> int:
-    """`prebo run INPUT [--out DIR]` or `prebo run --resume DIR`, either with `--budget SECONDS` (the
-    wall time of the whole run, resumed parts included, in place of the input's or checkpoint's):
-    optimise, then write DIR/result.json (`_result`, energies in Eh) of the lowest state at the
-    size the run passed through, beside the checkpoint DIR/basis.json (and DIR/lowest.json if
-    the run stands above that state); warn when the state is not bound in the basis. A new run
-    refuses a DIR that holds a checkpoint (OutputError). Returns the exit status 0."""
+    """`prebo run INPUT [--out DIR] [--force]` or `prebo run --resume DIR`, either with `--budget
+    SECONDS` (the wall time of the whole run, resumed parts included, in place of the input's or
+    checkpoint's): optimise, then write DIR/result.json (`_result`, energies in Eh) of the lowest
+    state at the size the run passed through, beside the checkpoint DIR/basis.json (and
+    DIR/lowest.json if the run stands above that state); warn when the state is not bound in the
+    basis. The run owns DIR from before it looks into it until it ends (io/lock.py). A new run
+    refuses a DIR that holds an earlier run's outputs unless `--force` (`claim`). Returns the exit
+    status 0."""
     from .io.basis_json import write_json_atomic
     from .errors import InputError, StalledError
     from .io import toml
+    from .io.lock import owned
     from .optimise import optimise, resume_from
-    from .optimise.checkpoint import CHECKPOINT, LOWEST, checkpoint_in
+    from .optimise.checkpoint import CHECKPOINT, LOWEST
 
     t0 = time.perf_counter()
-    if args.resume and (args.input is not None or args.out is not None):
-        raise InputError(f"--resume {args.resume}: give no input file or --out with it (a resumed run keeps its "
-                         "checkpoint's system, settings and folder; --budget changes its budget)")
-    if args.resume:
-        out = Path(args.resume)
-        title, source = None, str(out / "basis.json")
+    if args.resume is not None and (args.input is not None or args.out is not None or args.force):
+        raise InputError(f"--resume {args.resume}: give no input file or --out with it, nor --force (a resumed run "
+                         "keeps its checkpoint's system, settings and folder; --budget changes its budget)")
+    if args.resume is not None:
+        out = Path(path_name(args.resume, "--resume", "a run folder"))
+        title, source = None, str(out / CHECKPOINT)
     else:
         if args.input is None:
             raise InputError("give an input file, or --resume DIR")
         job = toml.load(args.input)
-        out = Path(args.out or Path("runs") / Path(args.input).stem)
+        out = given(args.out, Path("runs") / Path(args.input).stem, "a folder")
         title, source = job.title, str(args.input)
-        held = checkpoint_in(out)
-        if held:
-            raise OutputError(f"{out}: the output folder holds a run's checkpoint ({held.name}): continue that run "
-                              f"with `prebo run --resume {out}`, or give another --out")
+    with owned(out):
         try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise OutputError(f"--out {out}: cannot create the output folder ({exc.strerror})") from exc
-    try:
-        if args.resume:
-            basis, opts = resume_from(out, progress=not args.quiet, budget=args.budget)
-        else:
-            opts = job.optimiser if args.budget is None else replace(job.optimiser, budget=args.budget)
-            basis = optimise(job.system, opts, out=out, progress=not args.quiet)
-    except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
-        raise StalledError(f"{source}: {exc}") from exc
-    title = title or basis.system.label()
-    where = out / LOWEST if (out / LOWEST).exists() else out / CHECKPOINT  # the file of the state returned
-    r = _result(basis, where, opts.threshold)  # the energy the run optimised
-    r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
-          "convergence": basis.convergence}
-    write_json_atomic(out / "result.json", r)
+            if args.resume is not None:
+                basis, opts = resume_from(out, progress=not args.quiet, budget=args.budget)
+            else:
+                claim(out, args.force)
+                opts = job.optimiser if args.budget is None else replace(job.optimiser, budget=args.budget)
+                basis = optimise(job.system, opts, out=out, progress=not args.quiet)
+        except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
+            raise StalledError(f"{source}: {exc}") from exc
+        title = title or basis.system.label()
+        where = out / LOWEST if (out / LOWEST).exists() else out / CHECKPOINT  # the file of the state returned
+        r = _result(basis, where, opts.threshold)  # the energy the run optimised
+        r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
+              "convergence": basis.convergence}
+        write_json_atomic(out / RESULT, r)
     if not args.quiet:
         _print_result(r)
-        print(f"wrote {out / 'result.json'} ({where.name}: the lowest state at the size; "
+        print(f"wrote {out / RESULT} ({where.name}: the lowest state at the size; "
               f"{CHECKPOINT}: where the run stands)" if where.name == LOWEST else
-              f"wrote {out / 'result.json'} and {out / CHECKPOINT}")
+              f"wrote {out / RESULT} and {out / CHECKPOINT}")
     _warn_if_unbound(r)
     if basis.convergence["stalled"]:
         print(f"prebo: warning: growth stalled short of the basis size: {basis.convergence['stalled']['why']}",
@@ -143,37 +150,89 @@ def cmd_run(args) -> int:
     return 0
 
 
+def claim(out: Path, force: bool) -> None:
+    """Make the folder `out` a new run's: OutputError if it holds an earlier run's checkpoint,
+    lowest state or result, unless `force`, which removes them (the new run writes its own)."""
+    from .optimise.checkpoint import CHECKPOINT, LOWEST
+
+    earlier = [out / name for name in (CHECKPOINT, LOWEST, RESULT) if (out / name).exists()]
+    if earlier and not force:
+        if earlier[0].name == RESULT:
+            raise OutputError(f"{out}: the output folder holds a run's result ({RESULT}): give another --out, "
+                              "or --force to replace it")
+        raise OutputError(f"{out}: the output folder holds a run's checkpoint ({earlier[0].name}): continue that run "
+                          f"with `prebo run --resume {out}`, or give another --out (or --force to start over)")
+    for path in earlier:
+        path.unlink()
+
+
+def given(out: str | None, default: Path, what: str) -> Path:
+    """The path of --out `out` (None: not given, `default`); InputError for an empty one."""
+    return default if out is None else Path(path_name(out, "--out", what))
+
+
+def output_file(path: Path, force: bool, inputs=()) -> Path:
+    """`path`, the file a command is to write; OutputError for a folder, for one of the files
+    `inputs` (through a symbolic or hard link too) and, unless `force`, for an existing file."""
+    if path.is_dir():
+        raise OutputError(f"{path}: cannot write (a folder, not a file)")
+    if os.path.lexists(path):
+        source = next((source for source in inputs if same_file(path, source)), None)
+        if source is not None:
+            raise OutputError(f"{path}: the input file {source} itself (an output never replaces its input): "
+                              "give another --out")
+        if not force:
+            raise OutputError(f"{path}: the file exists: give --force to replace it, or another --out")
+    return path
+
+
+def same_file(a, b) -> bool:
+    """Whether the paths `a` and `b` name one file (through symbolic or hard links too)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
 def cmd_import(args) -> int:
-    """`prebo import FILE.inout.txt [--out X.json] [--c-A C]`: an ecgpack basis as basis.json."""
-    from .eigen import RESOLVED
+    """`prebo import FILE.inout.txt [--out X.json] [--force] [--c-A C]`: an ecgpack basis as basis.json."""
+    from .eigen import THRESHOLD
     from .io.ecgpack import read_inout
     from .optimise.settings import check
 
-    basis = read_inout(args.file, c_A=check("c_A", args.c_A, "--c-A"))
-    out = Path(args.out or str(args.file).removesuffix(".txt").removesuffix(".inout") + ".json")
-    basis.save(out, {"optimiser": {"threshold": RESOLVED}})  # evaluated as ecgpack solves it (load_basis)
+    c_A = check("c_A", args.c_A, "--c-A")
+    default = Path(str(args.file).removesuffix(".txt").removesuffix(".inout") + ".json")
+    out = output_file(given(args.out, default, "a file name"), args.force, [args.file])
+    basis = read_inout(args.file, c_A=c_A)
+    basis.save(out, {"optimiser": {"threshold": THRESHOLD}})  # every direction kept, as ecgpack solves it
     print(f"wrote {out} ({len(basis)} {basis.family.name} functions, {basis.system.label()})")
     return 0
 
 
 def cmd_export(args) -> int:
-    """`prebo export BASIS.json --format ecgpack [--out FILE]`: a plain-ECG basis as an ecgpack file."""
+    """`prebo export BASIS.json --format ecgpack [--out FILE] [--force]`: a plain-ECG basis as an ecgpack file."""
     from .io.ecgpack import write_inout
 
+    default = Path(str(args.basis).removesuffix(".json") + ".inout.txt")
+    out = output_file(given(args.out, default, "a file name"), args.force, [args.basis])
     basis, _ = load_basis(args.basis)
-    out = Path(args.out or str(args.basis).removesuffix(".json") + ".inout.txt")
     write_inout(basis, out)
     print(f"wrote {out}")
     return 0
 
 
 def cmd_plot(args) -> int:
-    """`prebo plot RUN... [--reference E] [--since S] [--log-time] [--out PNG]`: convergence plot of run
-    checkpoints."""
+    """`prebo plot RUN... [--reference E] [--since S] [--log-time] [--out PNG|DIR] [--force]`:
+    convergence plot of run checkpoints (into DIR/convergence.png for an existing folder DIR)."""
+    from .optimise.checkpoint import CHECKPOINT
     from .plot import convergence
 
-    png = args.out or Path(args.runs[0]) / "convergence.png"
-    png = png if png.suffix else png.with_suffix(".png")
+    default = Path(args.runs[0]) / "convergence.png"
+    png = given(args.out, default, "an image file or a folder")
+    if png.is_dir() or args.out is not None and args.out.endswith(os.sep):  # "DIR/": a folder, as in `cp`
+        png = png / default.name
+    png = output_file(png if png.suffix else png.with_suffix(".png"), args.force,
+                      [run / CHECKPOINT for run in args.runs])
     try:
         convergence(args.runs, png, args.reference, args.since, args.log_time)
     except OSError as exc:
@@ -184,23 +243,20 @@ def cmd_plot(args) -> int:
 
 def load_basis(path) -> tuple:
     """A basis.json, or an ecgpack ``*.inout.txt`` (recognised by its name), and the overlap
-    threshold of the code that wrote it: a run's (its "optimiser" block), eigen.RESOLVED for an
-    ecgpack file or its import (ecgpack keeps every direction), eigen.THRESHOLD for a basis saved
-    without settings."""
-    from .eigen import RESOLVED, THRESHOLD
+    threshold of the code that wrote it: a run's (its "optimiser" block), else eigen.THRESHOLD
+    (every direction double precision resolves, as ecgpack keeps them)."""
+    from .eigen import THRESHOLD
     from .errors import InputError
     from .io import basis_json
 
     if str(path).endswith(".inout.txt"):
         from .io.ecgpack import read_inout
-        return read_inout(path), RESOLVED
+        return read_inout(path), THRESHOLD
     if str(path).endswith(".toml"):
         raise InputError(f"{path}: a TOML input, not a basis; optimise it with `prebo run {path}`")
     d = basis_json.read(path)
-    basis = basis_json.from_dict(d, str(path))  # d is a checked mapping from here on
-    block = d.get("optimiser")
-    threshold = block.get("threshold") if isinstance(block, dict) else None
-    return basis, threshold if isinstance(threshold, float) and 0.0 < threshold < 1.0 else THRESHOLD
+    basis = basis_json.from_dict(d, str(path))  # d, its settings included, is checked from here on
+    return basis, (d.get("optimiser") or {}).get("threshold", THRESHOLD)
 
 
 def cmd_energy(args) -> int:
@@ -264,7 +320,10 @@ def parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="optimise a basis for the system of a TOML input")
     run.add_argument("input", nargs="?", help="TOML input file")
     run.add_argument("--out", help="output folder (default runs/INPUT-STEM); one that holds a run's checkpoint "
-                                   "is refused (--resume it)")
+                                   "or result is refused (--resume it, or --force)")
+    run.add_argument("--force", action="store_true",
+                     help="start over in an output folder holding an earlier run: its basis.json, lowest.json and "
+                          "result.json are removed as the new run starts")
     run.add_argument("--resume", metavar="DIR", help="continue the run whose checkpoint is DIR/basis.json")
     run.add_argument("--budget", type=seconds, metavar="SECONDS",
                      help="wall-time budget of the whole run, resumed parts included; replaces [optimiser] "
@@ -281,19 +340,21 @@ def parser() -> argparse.ArgumentParser:
                                                                      for k, op in OPERATORS.items()))
     en.add_argument("--threshold", type=fraction, metavar="T",
                     help="relative overlap eigenvalue below which directions are dropped (default: the "
-                         "threshold of the run that wrote the file; 2^-53, every direction, for an ecgpack "
-                         "file or its import, as ecgpack solves it; else 1e-13)")
+                         "threshold of the run that wrote the file; else 2^-53, every direction double "
+                         "precision resolves, as ecgpack solves its files)")
     en.add_argument("--json", action="store_true", help="print one JSON object")
     en.set_defaults(func=cmd_energy)
     im = sub.add_parser("import", help="convert an ecgpack / ATOM-MOL-nonBO FILE.inout.txt to basis.json")
     im.add_argument("file", help="ecgpack FILE.inout.txt (RG_0S: real plain ECGs)")
     im.add_argument("--out", help="basis.json to write (default FILE.json)")
+    im.add_argument("--force", action="store_true", help="replace an existing --out file")
     im.add_argument("--c-A", dest="c_A", type=float, default=1.0, help="CM exponent c_A of the LFCC functions")
     im.set_defaults(func=cmd_import)
     ex = sub.add_parser("export", help="write a plain-ECG basis in another code's format")
     ex.add_argument("basis", help="basis.json")
     ex.add_argument("--format", choices=["ecgpack"], required=True)
     ex.add_argument("--out", help="file to write (default BASIS.inout.txt)")
+    ex.add_argument("--force", action="store_true", help="replace an existing --out file")
     ex.set_defaults(func=cmd_export)
     pl = sub.add_parser("plot", help="energy against basis size of one or more runs (PNG)")
     pl.add_argument("runs", nargs="+", type=Path, help="run folders (with basis.json checkpoints)")
@@ -301,26 +362,105 @@ def parser() -> argparse.ArgumentParser:
     pl.add_argument("--since", type=finite, metavar="SECONDS",
                     help="only the wall time from then on, against time (runs branched from one checkpoint)")
     pl.add_argument("--log-time", action="store_true", help="wall time on a logarithmic axis (runs of minutes and days)")
-    pl.add_argument("--out", type=Path, help="image file, .png (the default suffix), .pdf or .svg "
-                                              "(default FIRST-RUN/convergence.png)")
+    pl.add_argument("--out", help="image file, .png (the default suffix), .pdf or .svg, or a folder for its "
+                                   "convergence.png (default FIRST-RUN/convergence.png)")
+    pl.add_argument("--force", action="store_true", help="replace an existing image file")
     pl.set_defaults(func=cmd_plot)
     return p
 
 
+class Stream:
+    """A standard output or error whose failure breaks nothing else: the first error writing it
+    (closed, full, a pipe whose reader has gone) is kept in `failed`, and its descriptor is
+    pointed at /dev/null, where later writes — a progress display, the flush at exit — go. A run
+    goes on and writes its result; `check` then ends the command."""
+
+    def __init__(self, stream: io.TextIOBase):
+        self.stream, self.failed, self.reported = stream, None, False
+
+    def write(self, text: str) -> int:
+        try:
+            return self.stream.write(text)
+        except OSError as exc:
+            self.fail(exc)
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self.stream.flush()
+        except OSError as exc:
+            self.fail(exc)
+
+    def check(self) -> None:
+        """Flush; OutputError saying why, once, if the stream could not be written."""
+        self.flush()
+        if self.failed and not self.reported:
+            self.reported = True
+            raise OutputError(failure(self.failed))
+
+    def fail(self, exc: OSError) -> None:
+        """Keep the first error `exc`; point the descriptor at /dev/null."""
+        self.failed = self.failed or exc
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, self.stream.fileno())
+        os.close(null)
+
+    def __getattr__(self, name):
+        return getattr(self.stream, name)
+
+
+def standard_streams() -> tuple[Stream, Stream]:
+    """sys.stdout and sys.stderr as `Stream`s. A standard descriptor closed when prebo started is
+    first pointed at /dev/null opened for reading: writing it fails as writing a closed one does,
+    and no file prebo opens takes its number."""
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            os.open(os.devnull, os.O_RDONLY)  # the lowest free descriptor: fd
+    return tuple(Stream(stream or open(fd, "w", closefd=False))
+                 for stream, fd in ((sys.stdout, 1), (sys.stderr, 2)))
+
+
+def failure(exc: OSError) -> str:
+    """What the error `exc` writing the standard output says of it."""
+    return {errno.EBADF: "standard output was closed",
+            errno.EPIPE: "standard output was closed by the command reading it"}.get(
+        exc.errno, f"standard output cannot be written ({exc.strerror or exc})")
+
+
 def main(argv=None) -> int:
     """The `prebo` command (`argv`: its arguments, default sys.argv[1:]). Returns the exit status:
-    0, 2 for every error (one line on stderr, never a traceback), 130 when interrupted."""
+    0, 2 for every error (one line on stderr, never a traceback) — a standard output or error
+    that cannot be written too —, 130 when interrupted."""
+    saved = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = streams = standard_streams()
+    try:
+        return written(command(argv), *streams)
+    except SystemExit as exc:  # argparse's --help (0) or one-line error (2)
+        raise SystemExit(written(exc.code, *streams)) from None
+    finally:
+        sys.stdout, sys.stderr = saved
+
+
+def written(status: int, out: Stream, err: Stream) -> int:
+    """The exit status `status` of a command whose output streams are `out` and `err`, once they
+    are flushed: 2 if either failed (with one line on `err` for `out`, unless said already)."""
+    try:
+        out.check()
+    except OutputError as exc:
+        print(f"prebo: error: {exc}", file=err)
+    err.flush()
+    return 2 if out.failed or err.failed else status
+
+
+def command(argv) -> int:
+    """The exit status of the command `argv` (main); SystemExit from argparse."""
     args = parser().parse_args(argv)
     try:
-        status = args.func(args)
-        sys.stdout.flush()  # a closed pipe shows here, not at exit
-        return status
+        return args.func(args)
     except PreboError as exc:
         print("prebo: error: " + " ".join(str(exc).split("\n")), file=sys.stderr)  # one line, always
-        return 2
-    except BrokenPipeError:
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit
-        print("prebo: error: standard output was closed before the result was written", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("prebo: interrupted (the last accepted step is saved)", file=sys.stderr)

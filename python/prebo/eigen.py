@@ -29,9 +29,14 @@ de = [2 β_m (dh_m - e ds_m)·(C a) + 2 β_m Σ_{o≠m} β_o (dH_mo - e dS_mo) +
 Refinement: LAPACK's eigenvalues of an ill-conditioned basis depend on the BLAS kernel (1e-8
 relative at an overlap condition of 5e12), so `solve` refines the lowest root(s) in the Rust core
 (`prebo_core::eigenpair`): Rayleigh quotient and residual in double-double, corrections from the
-LAPACK eigenbasis (Dongarra, Moler & Wilkinson, SIAM J. Numer. Anal. 20, 23 (1983)). The result
-is the eigenvalue of the stored matrices to about an ulp, the same on every machine; a root that
-does not converge is refused (LinearDependenceError), never returned.
+LAPACK eigenbasis (Dongarra, Moler & Wilkinson, SIAM J. Numer. Anal. 20, 23 (1983)). Where that
+eigenbasis is too poor for the corrections to converge (overlap condition towards 1e15–1e16), the
+lowest root is found by inverse iteration in double-double instead: H − σS factorised below the
+lowest eigenvalue (Sylvester's law of inertia), x ← (H − σS)⁻¹ S x. It solves the whole stored
+pencil, so it stands in only where every direction of S is kept. The result is the eigenvalue of
+the stored matrices to about an ulp, the same on every machine; a root that does not converge is
+refused (LinearDependenceError), never returned, and so is an overlap that is not positive
+definite in double-double (NotPositiveDefiniteError).
 
 Threads: below SERIAL_BELOW functions LAPACK and BLAS run on one thread (`lapack_threads`, in
 `solve` and around a whole optimisation). prebo's own parallelism is the Rust core's (rayon);
@@ -60,12 +65,22 @@ from .errors import LinearDependenceError, NonFiniteError, NotPositiveDefiniteEr
 
 #: relative error assumed for every stored matrix element: 4 unit roundoffs (a few ulp)
 ELEMENT_ERROR = 4 * 2.0**-53
-#: the default relative overlap eigenvalue below which `solve` drops directions
-THRESHOLD = 1e-13
-#: the unit roundoff: the smallest relative overlap eigenvalue double precision resolves. As a
-#: threshold it keeps every direction, as ecgpack's solver does (its He-490 file: 2 of 490 directions
-#: lie below 1e-13 and carry 1.7e-10 Eh, tests/test_ecgpack.py)
-RESOLVED = 2.0**-53
+#: the default relative overlap eigenvalue below which `solve` drops directions: the unit roundoff,
+#: the smallest one double precision resolves, so every resolved direction is kept, as ecgpack's
+#: solver keeps them (its He-490 file: 2 of 490 directions lie below 1e-13 and carry 1.7e-10 Eh,
+#: tests/test_ecgpack.py). The lowest root is refined in extended precision (`refine`) and the
+#: energy's uncertainty σ says what the elements' rounding leaves; the optimiser keeps a change only
+#: if it gains more than σ and 100 times what it adds to σ (optimise/expansion.py). The former
+#: default, 1e-13, stopped He's growth at 598 functions (overlap condition 2.3e13, where a new
+#: function costs a dropped direction) and H2+'s main job never comes near it (condition ≤ 2.5e8)
+THRESHOLD = 2.0**-53
+#: the largest ELEMENT_ERROR × overlap condition at which the first-order uncertainty holds: the
+#: spread of perturbed energies over the estimate was 1.09–1.15 at 0.35, 1.4–2.0 at 0.75 and 3000–5600
+#: at 1.2 (He with near-duplicate functions, tests/test_eigen.py); beyond it `uncertainty` perturbs.
+#: The optimiser's bases stay far below (He with 700 functions: 0.08)
+FIRST_ORDER = 0.3
+#: the perturbed solves of `uncertainty` beyond FIRST_ORDER (the spread to ~15 %)
+DRAWS = 24
 #: bases below this many functions are solved with LAPACK on one thread (module docstring)
 SERIAL_BELOW = 2000
 
@@ -133,12 +148,15 @@ def require_finite(M: np.ndarray, name: str, symbol: str) -> None:
 def refine(H: np.ndarray, S: np.ndarray, eig: Eigen, roots: int = 1) -> Eigen:
     """`eig` with its lowest `roots` eigenpairs refined in double-double (`prebo_core::eigenpair`):
     each energy (hartree) is the Rayleigh quotient of the stored H, S at its vector, converged to
-    an ulp, the same on every machine. Returns a new `Eigen`; LinearDependenceError for a root
-    that does not converge."""
+    an ulp, the same on every machine; where the corrections do not converge and every direction
+    is kept, the lowest by inverse iteration (the quotient at a double-double vector, returned
+    rounded). Returns a new `Eigen`; LinearDependenceError for a root that does not converge,
+    NotPositiveDefiniteError for an overlap without a double-double LDLᵀ factorisation."""
     c = np.ascontiguousarray
-    energies, vectors, _, converged = _core.refine_eigenpairs(c(H, dtype=float), c(S, dtype=float),
-                                                              c(eig.energies, dtype=float), c(eig.vectors, dtype=float),
-                                                              roots)
+    H, S, E0, C0 = c(H, dtype=float), c(S, dtype=float), c(eig.energies, dtype=float), c(eig.vectors, dtype=float)
+    energies, vectors, _, converged = _core.refine_eigenpairs(H, S, E0, C0, roots)
+    if converged[:1] == [False] and eig.kept == len(S):  # the whole pencil, as no direction was dropped
+        energies[0], vectors[:, 0], _, converged[0] = _core.inverse_iteration(H, S, E0, C0)
     if not all(converged):
         raise LinearDependenceError(
             f"eigenvalue {converged.index(False)} does not converge in extended precision: double precision "
@@ -158,6 +176,41 @@ def energy_uncertainty(c: np.ndarray, energy: float, S: np.ndarray, *terms: np.n
     for t in terms:
         W += t**2
     return ELEMENT_ERROR * float(np.sqrt(max(2.0 * c2 @ W @ c2 - c2**2 @ np.diag(W), 0.0)))
+
+
+def first_order(eig: Eigen) -> bool:
+    """Whether the first-order `energy_uncertainty` holds for the solution `eig` (FIRST_ORDER)."""
+    return ELEMENT_ERROR * eig.overlap_condition <= FIRST_ORDER
+
+
+def uncertainty(eig: Eigen, S: np.ndarray, *terms: np.ndarray, threshold: float = THRESHOLD) -> float:
+    """The standard deviation (hartree) of the lowest energy of `eig` from independent relative
+    errors ELEMENT_ERROR of the elements of S and of each term of H = Σ terms: first-order theory
+    (`energy_uncertainty`) where it holds (`first_order`), else the largest move of the lowest
+    energy re-solved (`threshold`) with every element so perturbed, DRAWS times from a fixed seed —
+    the experiment that measures the first-order estimate (docs/conventions.md). There the moves
+    have heavy tails (a few draws fall by 1 Eh where most move 1e-4) and a drift, so their largest
+    is reported, not their standard deviation: the number stays an honest bound where double
+    precision runs out. LinearDependenceError where such rounding leaves no lowest root."""
+    if first_order(eig):
+        return energy_uncertainty(eig.vectors[:, 0], float(eig.energies[0]), S, *terms)
+    rng = np.random.default_rng(0)
+    n = len(S)
+
+    def perturbed(M):
+        Z = np.triu(rng.normal(size=(n, n)))
+        return M * (1.0 + ELEMENT_ERROR * (Z + np.triu(Z, 1).T))
+
+    energies = []
+    for _ in range(DRAWS):
+        H = sum(perturbed(t) for t in terms)
+        try:
+            energies.append(solve(H, perturbed(S), threshold).energies[0])
+        except (LinearDependenceError, NotPositiveDefiniteError) as exc:
+            raise LinearDependenceError(f"double precision cannot resolve this basis (overlap condition "
+                                        f"{eig.overlap_condition:.2e}): rounding its elements by a few ulp leaves "
+                                        f"no lowest root ({exc})") from None
+    return float(np.max(np.abs(np.array(energies) - eig.energies[0])))
 
 
 def lowest_with_added(E, C, h, s, h_nn, s_nn, min_norm: float = 1e-10) -> float:

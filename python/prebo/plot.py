@@ -11,7 +11,7 @@ where they parted.
 """
 from __future__ import annotations
 
-import json
+import io
 from pathlib import Path
 
 from .errors import BasisFileError, InputError
@@ -22,15 +22,19 @@ FORMATS = (".png", ".pdf", ".svg")
 
 def history(folder: Path) -> list:
     """The optimisation history of the run checkpoint folder/basis.json: rows [basis size,
-    energy (Eh), ..., wall time (s) when recorded]; BasisFileError if there is none."""
-    path = Path(folder) / "basis.json"
-    try:
-        d = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
-        raise BasisFileError(f"{path}: cannot read a run checkpoint ({exc})") from exc
-    if "history" not in d:
+    energy (Eh), phase, wall time (s) when recorded]; BasisFileError naming the file (and the
+    row: checkpoint.check_history) if there is none or a row is not one."""
+    from .io.basis_json import read
+    from .optimise.checkpoint import CHECKPOINT, check_history
+
+    path = Path(folder) / CHECKPOINT
+    d = read(path)
+    if not (isinstance(d, dict) and "history" in d):
         raise BasisFileError(f"{path}: no optimisation history (not written by `prebo run`)")
-    return d["history"]
+    try:
+        return check_history(d["history"])
+    except ValueError as exc:
+        raise BasisFileError(f"{path}: {exc}") from None
 
 
 def since(h: list, seconds: float, where: str = "run") -> list:
@@ -58,6 +62,8 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None, 
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from .io.basis_json import write_atomic
 
     runs = [(Path(folder).name, history(folder)) for folder in folders]
     if start is not None:
@@ -90,6 +96,8 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None, 
         ax.grid(alpha=0.3)
         ax.legend()
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
+    image = io.BytesIO()
+    fig.savefig(image, format=Path(png).suffix[1:].lower(), dpi=130)
     plt.close(fig)
+    write_atomic(png, image.getvalue())  # replaced at once: never half an image
     return Path(png)

@@ -29,6 +29,8 @@ optimum satisfies the virial theorem, 2<T> + <V> = 0, whatever it describes (tes
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from . import eigen
@@ -53,9 +55,11 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     Returns a dict with the keys of the module docstring — energy, energy_uncertainty,
     energy_lab, kinetic, potential, threshold and binding_energy in Eh; bound a bool; virial,
     overlap_condition dimensionless; n2 in ħ²; expectation in each operator's unit — and
-    `coefficients`, the S-normalised ground-state vector. InputError for a basis that is not a non-empty `Basis`, an unknown
-    `coordinates` or operator; CancellationError for a function whose elements lost their digits
-    (Representation.require_resolved); NonFiniteError and the eigen errors as `eigen.solve` raises them."""
+    `coefficients`, the S-normalised ground-state vector. InputError for a basis that is not a
+    non-empty `Basis` or does not fit its system (its arrays or system replaced since it was built),
+    an unknown `coordinates` or operator; CancellationError for a function whose elements lost
+    their digits (Representation.require_resolved); NonFiniteError and the eigen errors as
+    `eigen.solve` raises them."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"evaluate: basis = {basis!r}: must be a prebo.Basis with at least one function")
     threshold = check("threshold", threshold, "evaluate: threshold")
@@ -65,6 +69,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     operators = (operators,) if isinstance(operators, str) else tuple(operators)
     for name in operators:
         operator(name)
+    basis = replace(basis)  # built again: the constructor's checks against the system it has now
     basis.validate()  # a Basis built in Python: symmetric, positive definite, CM-separable A
     system = basis.system
     if coordinates == "lab":
@@ -85,7 +90,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     c = ti.vectors[:, 0]
     kinetic, potential = float(c @ m["T_ti"] @ c), float(c @ m["V"] @ c)
     energy = float(ti.energies[0])
-    uncertainty = eigen.energy_uncertainty(c, energy, m["S"], m["T_ti"], m["V"])
+    uncertainty = eigen.uncertainty(ti, m["S"], m["T_ti"], m["V"], threshold=threshold)
     if not kinetic > uncertainty:
         raise CancellationError(f"the state's internal kinetic energy, {kinetic:.3g} Eh, is not positive beyond the "
                                 f"energy's uncertainty ({uncertainty:.1e} Eh): rounding dominates this basis's matrix "

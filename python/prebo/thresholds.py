@@ -13,7 +13,7 @@ particles, whose only "fragment" is the system itself. E.g. H⁻: H + e, −μ_p
 H₂: H + H; Ps⁻: Ps + e, −1/4; Ps₂: Ps + Ps, −1/2; Li: Li²⁺ + e + e, −9μ/2.
 
 Caveats. Real thresholds can be lower: fragments of three or more particles are not counted (Li⁺ + e
-lies far below Li²⁺ + e + e), so the user may give a lower one (`[state] threshold`,
+lies far below Li²⁺ + e + e), so the user may give a lower one (≤ 0: `[state] threshold`,
 `State(threshold=...)`) and `lowest` takes the lower of the two. prebo builds natural-parity states
 (parity (−1)^N), and a ground-state fragment plus a free particle in the partial wave l = N has that
 N and parity whatever the exchange symmetry (the free particle is in no bound orbital), so such a

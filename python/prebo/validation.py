@@ -4,9 +4,11 @@
   basis whose matrices fit in this machine's memory: 16 dense nb x nb float64 matrices (S, T,
   T_ti, V, their copies while a function is appended or replaced, and the eigensolver's
   working matrices), i.e. nb <= sqrt(memory / 128 bytes);
-- the rules of one value (`Integer`, `Real`, `Choice`, `Lengths`, `Channels`, and `Automatic`
-  for a setting prebo chooses itself when it is absent), with the text of what they allow; the optimiser's table of settings is prebo.optimise.settings.SETTINGS;
-- `number`, `half_integer`: the checks of one real parameter (masses, charges; spins);
+- the rules of one value (`Integer`, `Sign`, `Real`, `Magnitude`, `Choice`, `Lengths`, `Channels`,
+  and `Automatic` for a setting prebo chooses itself when it is absent), with the text of what they
+  allow, and `checked`, a value by its rule or an InputError; the optimiser's table of settings is
+  prebo.optimise.settings.SETTINGS, the particles' ranges prebo.system.particles;
+- `number`, `half_integer`: the checks of one real parameter (energies; spins);
 - `path_name`: a file or folder argument;
 - `strict_keywords`: unknown keyword arguments of a settings dataclass as InputError.
 The states a basis family can describe are checked by the family (prebo.basis.Family.check_state).
@@ -50,7 +52,14 @@ MAX_SIZE = math.isqrt(memory_bytes() // (MATRICES * 8))
 
 
 class Refused(Exception):
-    """A value a rule does not accept (turned into an InputError by `check`)."""
+    """A value a rule does not accept (turned into an InputError by `checked`)."""
+
+
+def _integer(v) -> int:
+    """A Python or numpy integer as an int (bools refused)."""
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
+        raise Refused
+    return int(v)
 
 
 def _real(v) -> float:
@@ -60,6 +69,16 @@ def _real(v) -> float:
     if not math.isfinite(v):
         raise Refused
     return v
+
+
+def checked(rule, value, label: str, meaning: str | None = None):
+    """`value` as `rule` normalises it; InputError "`label` = value: must be `rule.allowed`
+    (`meaning`)" if the rule refuses it."""
+    try:
+        return rule(value)
+    except (Refused, TypeError, ValueError):
+        why = f" ({meaning})" if meaning else ""
+        raise InputError(f"{label} = {value!r}: must be {rule.allowed}{why}") from None
 
 
 @dataclass(frozen=True)
@@ -75,11 +94,22 @@ class Integer:
         return f"an integer ≥ {self.lo}" if self.hi is None else f"an integer in {self.lo}..{self.hi}"
 
     def __call__(self, v) -> int:
-        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
-            raise Refused
+        v = _integer(v)
         if v < self.lo or (self.hi is not None and v > self.hi):
             raise Refused
-        return int(v)
+        return v
+
+
+class Sign:
+    """+1 or -1 (an integer, bools refused)."""
+
+    allowed = "+1 or -1"
+
+    def __call__(self, v) -> int:
+        v = _integer(v)
+        if v not in (1, -1):
+            raise Refused
+        return v
 
 
 @dataclass(frozen=True)
@@ -96,12 +126,33 @@ class Real:
         """What the rule allows, for error messages."""
         if self.hi == math.inf:
             return f"a finite number {'≥' if self.lo_closed else '>'} {self.lo:g}"
-        return (f"a number x with {self.lo:g} {'≤' if self.lo_closed else '<'} x "
-                f"{'≤' if self.hi_closed else '<'} {self.hi:g}")
+        if self.lo == -math.inf:
+            return f"a finite number {'≤' if self.hi_closed else '<'} {self.hi:g}"
+        return (f"a finite {'positive ' if self.lo > 0 else ''}number x with {self.lo:g} "
+                f"{'≤' if self.lo_closed else '<'} x {'≤' if self.hi_closed else '<'} {self.hi:g}")
 
     def __call__(self, v) -> float:
         x = _real(v)
         if x < self.lo or (x == self.lo and not self.lo_closed) or x > self.hi or (x == self.hi and not self.hi_closed):
+            raise Refused
+        return x
+
+
+@dataclass(frozen=True)
+class Magnitude:
+    """0, or a finite number x with lo ≤ |x| ≤ hi."""
+
+    lo: float
+    hi: float
+
+    @property
+    def allowed(self) -> str:
+        """What the rule allows, for error messages."""
+        return f"0, or a finite number x with {self.lo:g} ≤ |x| ≤ {self.hi:g}"
+
+    def __call__(self, v) -> float:
+        x = _real(v)
+        if x != 0 and not self.lo <= abs(x) <= self.hi:
             raise Refused
         return x
 
@@ -123,16 +174,23 @@ class Choice:
         return v
 
 
+@dataclass(frozen=True)
 class Lengths:
-    """Two lengths [lo, hi] with 0 < lo < hi (bohr), as a tuple."""
+    """Two lengths [lo, hi] with shortest ≤ lo < hi ≤ longest, as a tuple."""
 
-    allowed = "two finite numbers [lo, hi] with 0 < lo < hi"
+    shortest: float
+    longest: float
+
+    @property
+    def allowed(self) -> str:
+        """What the rule allows, for error messages."""
+        return f"two finite numbers [lo, hi] with {self.shortest:g} ≤ lo < hi ≤ {self.longest:g}"
 
     def __call__(self, v) -> tuple:
         if isinstance(v, (str, bytes, dict)) or not hasattr(v, "__len__") or len(v) != 2:
             raise Refused
         lo, hi = _real(v[0]), _real(v[1])
-        if not 0 < lo < hi:
+        if not self.shortest <= lo < hi <= self.longest:
             raise Refused
         return lo, hi
 

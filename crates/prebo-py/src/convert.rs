@@ -1,9 +1,10 @@
 //! Conversions between Python and the core: array-likes to owned flat arrays (any dtype numpy
-//! can cast safely, any memory layout), core results to numpy arrays, and `CoreError` to the
-//! exceptions of `prebo.errors` (one `From`).
+//! can cast safely, any memory layout), core results to numpy arrays, and `CoreError` (and the
+//! eigenpair refinement's `Indefinite`) to the exceptions of `prebo.errors`.
 use numpy::ndarray::{Array2, Array3};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLikeDyn, PyUntypedArrayMethods};
 use prebo_core::ecg::Element;
+use prebo_core::eigenpair::Indefinite;
 use prebo_core::engine::Kind;
 use prebo_core::family::Params;
 use prebo_core::matrices::Matrices;
@@ -24,6 +25,12 @@ pub enum Error {
 impl From<CoreError> for Error {
     fn from(e: CoreError) -> Self {
         Error::Core(e)
+    }
+}
+
+impl From<Indefinite> for Error {
+    fn from(e: Indefinite) -> Self {
+        Error::Py(NotPositiveDefiniteError::new_err(e.to_string()))
     }
 }
 

@@ -176,6 +176,26 @@ fn lowest_with_added<'py>(
     Ok(numpy::ndarray::Array1::from_vec(out).into_pyarray(py))
 }
 
+/// H, S (nb x nb) and the eigenvalues e (kept) and eigenvectors c (nb x kept) of a
+/// double-precision solution, as flat arrays, and nb.
+#[allow(clippy::type_complexity)]
+fn pencil(
+    h: &Bound<'_, PyAny>,
+    s: &Bound<'_, PyAny>,
+    e: &Bound<'_, PyAny>,
+    c: &Bound<'_, PyAny>,
+) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, usize)> {
+    let ((h, hs), (s, ss)) = (floats_shaped(h, "h")?, floats_shaped(s, "s")?);
+    let ((e, _), (c, cs)) = (floats_shaped(e, "e")?, floats_shaped(c, "c")?);
+    let (nb, kept) = (hs.first().copied().unwrap_or(0), e.len());
+    if hs != [nb, nb] || ss != [nb, nb] || cs != [nb, kept] {
+        return Err(
+            ShapeError::new_err("H, S (nb x nb) and the eigenvectors (nb x kept) do not fit together").into()
+        );
+    }
+    Ok((h, s, e, c, nb))
+}
+
 /// Refined lowest `roots` eigenpairs of H c = E S c (prebo_core::eigenpair): from `e` (kept,
 /// ascending) and `c` (nb x kept, S-orthonormal columns) of a double-precision solver. Returns
 /// the energies (roots), the S-normalised vectors (nb x roots), the iterations and whether
@@ -190,14 +210,7 @@ fn refine_eigenpairs<'py>(
     c: &Bound<'py, PyAny>,
     roots: usize,
 ) -> Result<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Vec<usize>, Vec<bool>)> {
-    let ((h, hs), (s, ss)) = (floats_shaped(h, "h")?, floats_shaped(s, "s")?);
-    let ((e, _), (c, cs)) = (floats_shaped(e, "e")?, floats_shaped(c, "c")?);
-    let (nb, kept) = (hs.first().copied().unwrap_or(0), e.len());
-    if hs != [nb, nb] || ss != [nb, nb] || cs != [nb, kept] {
-        return Err(
-            ShapeError::new_err("H, S (nb x nb) and the eigenvectors (nb x kept) do not fit together").into()
-        );
-    }
+    let (h, s, e, c, nb) = pencil(h, s, e, c)?;
     let out = py.allow_threads(|| prebo_core::eigenpair::refine_lowest(&h, &s, &e, &c, roots));
     let energies = numpy::ndarray::Array1::from_iter(out.iter().map(|r| r.energy)).into_pyarray(py);
     let mut vectors = vec![0.0; nb * out.len()];
@@ -211,6 +224,28 @@ fn refine_eigenpairs<'py>(
     Ok((energies, matrix(py, nb, out.len(), vectors), iterations, converged))
 }
 
+/// The lowest eigenpair of H c = E S c by inverse iteration in double-double
+/// (prebo_core::eigenpair::inverse_iteration), where `refine_eigenpairs` does not converge:
+/// from `e` (kept ≥ 1, ascending) and `c` (nb x kept, S-orthonormal columns). Returns the
+/// energy, the S-normalised vector (nb), the iterations and whether it converged;
+/// NotPositiveDefiniteError for an overlap without a double-double LDLᵀ factorisation.
+#[pyfunction]
+fn inverse_iteration<'py>(
+    py: Python<'py>,
+    h: &Bound<'py, PyAny>,
+    s: &Bound<'py, PyAny>,
+    e: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+) -> Result<(f64, Bound<'py, PyArray1<f64>>, usize, bool)> {
+    let (h, s, e, c, _) = pencil(h, s, e, c)?;
+    if e.is_empty() {
+        return Err(ShapeError::new_err("no eigenpair to start the inverse iteration from (kept = 0)").into());
+    }
+    let r = py.allow_threads(|| prebo_core::eigenpair::inverse_iteration(&h, &s, &e, &c))?;
+    let vector = numpy::ndarray::Array1::from_vec(r.vector).into_pyarray(py);
+    Ok((r.energy, vector, r.iterations, r.converged))
+}
+
 /// Number of rayon worker threads in use.
 #[pyfunction]
 fn num_threads() -> usize {
@@ -222,6 +257,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Engine>()?;
     m.add_function(wrap_pyfunction!(lowest_with_added, m)?)?;
     m.add_function(wrap_pyfunction!(refine_eigenpairs, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse_iteration, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add("MAX_DIM", engine::MAX_DIM)?;
     m.add("OPERATORS", prebo_core::operators::names())?;

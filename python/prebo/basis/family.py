@@ -6,8 +6,8 @@ and c_A, the exponent of the centre-of-mass coordinate (A^(r) 1 = c_A m/m_tot); 
 its own per-function arrays (`extras`: the global vector u and power K of ECG-GVR functions, the
 centres s of floating ECGs) and supplies, for those arrays only:
 
-- validation: their dtype and shape (`coerce`), the states they can describe (`check_state`),
-  the values a function may hold (`check_function`);
+- validation: their dtype and shape (`coerce`; in a basis file: `shapes`, `integers`), the states
+  they can describe (`check_state`), the values a function may hold (`check_function`);
 - the engine calls: the core's parameter tuple of a function set in a representation (`params`,
   the TICC transformation of the extras) and the engine object that builds matrices, rows and
   row gradients from it (`engine`);
@@ -34,6 +34,8 @@ class Family:
     name: str = ""
     #: per-function extra arrays beyond A and c_A: name -> shape after nb ("n": particles)
     shapes: dict = {}
+    #: the extras whose values are integers (the others are real numbers)
+    integers: frozenset = frozenset()
     #: whether the functions are eigenfunctions of the total orbital angular momentum N
     conserves_L: bool = True
 

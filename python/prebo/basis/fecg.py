@@ -1,23 +1,29 @@
 """Floating ECGs ("fecg"): φ(r) = exp(-(r - s)^T (A ⊗ I_3)(r - s)), centres s (n x 3) per function.
 
-Not eigenfunctions of the angular momentum: they take any state label, and the results report
-the translation-free <N²> instead (the engine's `angular`). The sampler and refinement keep the CM
-centre μ^T s at 0, so the functions separate in the CM coordinate.
+Not eigenfunctions of the angular momentum: they take the label N = 0 (the core evaluates no
+other) with either parity, and the results report the translation-free <N²> (the engine's
+`angular`). The sampler and refinement keep the CM centre μ^T s at 0, so the functions separate
+in the CM coordinate.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..errors import BasisFileError, SeparabilityError
+from ..errors import BasisFileError, InputError, SeparabilityError
 from .family import Family
 
 
 class FloatingECG(Family):
-    """Floating ECGs: centres s (n x 3, bohr) per function; any state label, <N²> reported."""
+    """Floating ECGs: centres s (n x 3, bohr) per function; N = 0 labels, <N²> reported."""
 
     name = "fecg"
     shapes = {"s": ("n", 3)}
     conserves_L = False
+
+    def check_state(self, state) -> None:
+        if state.N != 0:
+            raise InputError(f"floating ECGs (fecg) take the label N = 0 only (their <N²> is reported), "
+                             f"not N = {state.N} (use ecg-gvr)")
 
     def check_function(self, basis, i: int) -> None:
         if not np.all(np.isfinite(basis.s[i])):

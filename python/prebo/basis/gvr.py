@@ -14,6 +14,9 @@ from .family import Family
 
 #: the largest power K a function may hold (the bound of the setting K_max)
 K_LIMIT = 60
+#: the range of max |u_k|: a normalised function does not depend on the length of u, the sampler and
+#: the stored bases keep it near 1 (1.0-1.73), and u^T A^-1 u overflows far beyond (1e±100: not finite)
+U_SCALE = (1e-6, 1e6)
 
 
 class GlobalVectorECG(Family):
@@ -21,6 +24,7 @@ class GlobalVectorECG(Family):
 
     name = "ecg-gvr"
     shapes = {"u": ("n",), "K": ()}
+    integers = frozenset({"K"})
     conserves_L = True
 
     def check_state(self, state) -> None:
@@ -39,6 +43,11 @@ class GlobalVectorECG(Family):
     def check_function(self, basis, i: int) -> None:
         if not (np.all(np.isfinite(basis.u[i])) and np.any(basis.u[i] != 0)):
             raise InputError(f"function {i}: the global vector u must be finite and non-zero")
+        scale = float(np.max(np.abs(basis.u[i])))
+        if not U_SCALE[0] <= scale <= U_SCALE[1]:
+            raise InputError(f"function {i}: the global vector u = {basis.u[i].tolist()} has its largest component "
+                             f"{scale:g}, outside {U_SCALE[0]:g}..{U_SCALE[1]:g} (the normalised function does not "
+                             "depend on the length of u; far from 1 its integrals overflow)")
 
     def ticc_extras(self, extras: tuple, coords) -> tuple:
         u, K = extras

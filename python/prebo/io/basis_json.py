@@ -4,20 +4,29 @@ A basis file stores the system, the state, the symmetry, the conventions and, pe
 full A^(r), c_A, the channel and the family's parameters (u and K, or s), plus the linear
 coefficients of the state; a run's checkpoint adds its settings and progress (prebo.optimise).
 Every writer goes through `write_atomic`: a killed writer leaves the old file or the new one.
+
+A file is a claim to be checked, not a source of truth (docs/basis-format.md): `read` takes at
+most MAX_BYTES, integers of at most MAX_DIGITS digits and MAX_DEPTH levels of nesting; `from_dict`
+refuses unknown keys, a function with keys of another family or values of the wrong type (no
+boolean for an integer, no string for a number), more than MAX_SIZE functions, a stored symmetry
+that is not the state's (`System.from_dict`) and settings out of their range.
 """
 from __future__ import annotations
 
 import json
 import os
+import reprlib
 import tempfile
 from glob import escape as glob_escape
 from pathlib import Path
 
 import numpy as np
 
-from ..basis import Basis, family
-from ..errors import BasisFileError, OutputError, PreboError
+from ..basis import FAMILIES, Basis, Family, family
+from ..coordinates import by_name
+from ..errors import BasisFileError, InputError, OutputError, PreboError
 from ..system import System
+from ..validation import MAX_SIZE, number
 
 FORMAT = "prebo-basis"
 VERSION = 1
@@ -27,6 +36,19 @@ CONVENTIONS = {
     "units": "hartree atomic units; masses in electron masses",
     "cm": "A^(r) 1 = c_A m / m_tot (CM-separable); energy has the CM kinetic energy eliminated",
 }
+#: the keys of a basis file: the basis, then the energy, the settings and a run's state (checkpoint.py)
+KEYS = ("format", "version", "conventions", "system", "symmetry", "basis_type", "functions", "coefficients",
+        "energy", "optimiser", "progress", "rng", "history", "elapsed", "schedule", "stopped", "momentum")
+#: every function's arrays beside its family's extras (name -> shape, "n": particles); and a channel
+COMMON = {"A": ("n", "n"), "c_A": ()}
+#: bytes allowed per function (twice a checkpoint's two copies of a function of 8 particles) and
+#: for a run's history (2.8 million rows, 50 days of an adaptive run of H2)
+FUNCTION_BYTES, HISTORY_BYTES = 8 << 10, 128 << 20
+#: the largest file `read_text` reads: MAX_SIZE functions and a history
+MAX_BYTES = MAX_SIZE * FUNCTION_BYTES + HISTORY_BYTES
+#: the most digits of an integer (a random-number state has 39) and levels of nesting (a checkpoint has 6)
+MAX_DIGITS, MAX_DEPTH = 100, 16
+TOO_DEEP = f"nested more than {MAX_DEPTH} levels deep"
 
 
 def to_dict(basis: Basis, extra: dict | None = None) -> dict:
@@ -60,37 +82,47 @@ def save(basis: Basis, path, extra: dict | None = None) -> None:
 
 
 def from_dict(d: dict, where: str = "basis", empty: bool = False) -> Basis:
-    """The basis of a basis.json mapping; BasisFileError naming `where` for anything wrong,
-    including no functions at all (unless `empty`: a checkpoint before the first one)."""
+    """The basis of a basis.json mapping; BasisFileError naming `where` (and the function and key)
+    for anything wrong (module docstring), including no functions at all (unless `empty`: a
+    checkpoint before the first one). A run's state is checked by prebo.optimise.checkpoint."""
     if not isinstance(d, dict) or d.get("format") != FORMAT:
         raise BasisFileError(f"{where}: not a prebo basis file (format must be {FORMAT!r})")
     if d.get("version") != VERSION:
-        raise BasisFileError(f"{where}: unsupported version {d.get('version')!r} (this prebo reads {VERSION})")
+        raise BasisFileError(f"{where}: unsupported version {reprlib.repr(d.get('version'))} "
+                             f"(this prebo reads {VERSION})")
+    unknown = [k for k in d if k not in KEYS]
+    if unknown:
+        raise BasisFileError(f"{where}: unknown keys {reprlib.repr(unknown)} (a basis file holds {', '.join(KEYS)})")
+    conventions = d.get("conventions", CONVENTIONS)
+    if conventions != CONVENTIONS:
+        raise BasisFileError(f"{where}: conventions = {reprlib.repr(conventions)}: not prebo's (docs/conventions.md)")
     kind = d.get("basis_type")
     try:
         fam = family(kind)
     except PreboError:
-        raise BasisFileError(f"{where}: basis type {kind!r} is not supported by this version") from None
+        raise BasisFileError(f"{where}: basis type {reprlib.repr(kind)} is not supported by this version") from None
+    funcs = d.get("functions")
+    if isinstance(funcs, list) and len(funcs) > MAX_SIZE:
+        raise BasisFileError(f"{where}: {len(funcs)} functions, more than the {MAX_SIZE} this machine's memory holds")
     try:
-        system = System.from_dict(d["system"], d.get("symmetry"))
-        funcs = d["functions"]
+        system = System.from_dict(d.get("system"), d.get("symmetry"))
         n = system.n
-        check_fields(funcs, n, kind, ("A", "c_A") + tuple(fam.shapes))
+        check_functions(funcs, system, fam)
+        coef = d.get("coefficients")
+        if coef is not None and not _holds(coef, (len(funcs),), False):
+            raise BasisFileError(f"coefficients must be {len(funcs)} numbers, one per function, or null")
+        check_settings(d.get("optimiser"))
+        if d.get("energy") is not None:
+            number(d["energy"], "energy")
         A = np.array([f["A"] for f in funcs], dtype=float).reshape(len(funcs), n, n)
         c_A = np.array([f["c_A"] for f in funcs], dtype=float)
-        channels = [str(f.get("channel", "unknown")) for f in funcs]
-        coef = d.get("coefficients")
-        coef = None if coef is None else np.asarray(coef, dtype=float)
+        channels = [f.get("channel", "unknown") for f in funcs]
         extra = {name: np.array([f[name] for f in funcs]) for name in fam.shapes}
         basis = Basis(system, A, c_A, channels, coef, kind, **extra)
     except PreboError as exc:
         raise BasisFileError(f"{where}: {exc}") from exc
-    except (KeyError, TypeError, ValueError) as exc:
-        raise BasisFileError(f"{where}: malformed basis data ({type(exc).__name__}: {exc})") from exc
     if not (empty or len(A)):
         raise BasisFileError(f"{where}: the basis has no functions")
-    if coef is not None and (coef.shape != (len(A),) or not np.all(np.isfinite(coef))):
-        raise BasisFileError(f"{where}: coefficients must be {len(A)} finite numbers, one per function")
     try:
         basis.validate()
     except PreboError as exc:
@@ -98,19 +130,68 @@ def from_dict(d: dict, where: str = "basis", empty: bool = False) -> Basis:
     return basis
 
 
-def check_fields(funcs, n: int, kind: str, fields: tuple) -> None:
-    """Each function of a `kind` basis of `n` particles has `fields`, and an n x n `A`
-    (BasisFileError naming the first function that has not)."""
+def check_functions(funcs, system: System, fam: Family) -> None:
+    """Each function of a `fam` basis of `system` holds A (n x n) and c_A, the family's extras
+    (`Family.shapes`; integers where `Family.integers` says, else numbers; no booleans, no
+    strings) and optionally its channel (a string; a coordinate set of the system's particles if
+    it names one), and no other key; BasisFileError naming the first function and key that do not."""
     if not isinstance(funcs, list):
         raise BasisFileError("functions must be a list")
+    fields = COMMON | fam.shapes
     for i, f in enumerate(funcs):
-        missing = [k for k in fields if not isinstance(f, dict) or k not in f]
+        if not isinstance(f, dict):
+            raise BasisFileError(f"function {i} must be a mapping of {', '.join(fields)} and channel")
+        for key in f:
+            if key not in fields and key != "channel":
+                owners = [g.name for g in FAMILIES.values() if key in g.shapes]
+                why = (f"belongs to {' and '.join(owners)} functions, not to the file's basis_type {fam.name!r}"
+                       if owners else f"is unknown (a {fam.name} function has {', '.join(fields)} and channel)")
+                raise BasisFileError(f"function {i}: key {key!r} {why}")
+        missing = [k for k in fields if k not in f]
         if missing:
-            raise BasisFileError(f"function {i} has no {', '.join(map(repr, missing))} (each {kind} function has "
-                                 f"{', '.join(fields)})")
-        if np.shape(f["A"]) != (n, n):
-            raise BasisFileError(f"function {i}: A must be {n} x {n} for the {n} particles of the system, "
-                                 "not of shape " + "x".join(map(str, np.shape(f["A"]))))
+            raise BasisFileError(f"function {i} has no {', '.join(map(repr, missing))} (each {fam.name} function "
+                                 f"has {', '.join(fields)})")
+        for key, shape in fields.items():
+            dims = tuple(system.n if d == "n" else d for d in shape)
+            integer = key in fam.integers
+            if not _holds(f[key], dims, integer):
+                what = ("an integer" if integer else "a number") if not dims else \
+                    f"{' x '.join(map(str, dims))} {'integers' if integer else 'numbers'}"
+                raise BasisFileError(f"function {i}: {key} must be {what}, not {reprlib.repr(f[key])}")
+        if not isinstance(f.get("channel", ""), str):
+            raise BasisFileError(f"function {i}: channel must be a string, not {reprlib.repr(f['channel'])}")
+    for name in {f["channel"] for f in funcs if "channel" in f}:
+        if name.partition(":")[0] in ("jacobi", "hpc", "cmc"):
+            try:
+                by_name(system.masses, name)
+            except InputError as exc:
+                raise BasisFileError(f"channel {name!r}: {exc}") from None
+
+
+def _holds(value, dims: tuple, integer: bool) -> bool:
+    """Whether `value` is nested lists of shape `dims` of integers (`integer`) or numbers, booleans
+    and strings excluded."""
+    if dims:
+        return isinstance(value, list) and len(value) == dims[0] and all(_holds(v, dims[1:], integer) for v in value)
+    return isinstance(value, int if integer else (int, float)) and not isinstance(value, bool)
+
+
+def check_settings(block) -> None:
+    """A basis file's "optimiser" block: settings of prebo.optimise.SETTINGS, each in its range
+    (a run's, or an ecgpack import's threshold), or none; BasisFileError naming the setting."""
+    from ..optimise.settings import SETTINGS, check  # prebo.optimise reads and writes basis files
+
+    if block is None:
+        return
+    if not isinstance(block, dict):
+        raise BasisFileError(f"optimiser must be a mapping of settings, not {reprlib.repr(block)}")
+    for name, value in block.items():
+        if name not in SETTINGS:
+            raise BasisFileError(f"optimiser: unknown setting {reprlib.repr(name)}")
+        try:
+            check(name, value, f"optimiser {name}")
+        except InputError as exc:
+            raise BasisFileError(str(exc)) from None
 
 
 def load(path) -> Basis:
@@ -120,29 +201,61 @@ def load(path) -> Basis:
 
 def read(path):
     """The parsed content of basis.json file `path` (not yet checked: `from_dict`); BasisFileError
-    naming the file when it is unreadable or not JSON."""
+    naming the file when it is unreadable, larger than MAX_BYTES, not JSON, or holds an integer
+    of more than MAX_DIGITS digits or more than MAX_DEPTH levels of nesting."""
     path = Path(path)
     text = read_text(path, BasisFileError)
     try:
-        return json.loads(text)
+        d = json.loads(text, parse_int=_integer)
     except json.JSONDecodeError as exc:
         raise BasisFileError(f"{path}: corrupt or truncated JSON (line {exc.lineno}: {exc.msg})") from exc
+    except RecursionError:  # deeper than Python's recursion limit
+        raise BasisFileError(f"{path}: JSON {TOO_DEEP}") from None
+    except BasisFileError as exc:
+        raise BasisFileError(f"{path}: {exc}") from None
+    nested(d, f"{path}: JSON", BasisFileError)
+    return d
+
+
+def _integer(text: str) -> int:
+    """A JSON integer, if it has at most MAX_DIGITS digits (Python refuses 4300 with a ValueError)."""
+    if len(text.lstrip("-")) > MAX_DIGITS:
+        raise BasisFileError(f"an integer of {len(text.lstrip('-'))} digits (at most {MAX_DIGITS} are read)")
+    return int(text)
+
+
+def nested(obj, where: str, error: type[PreboError]) -> None:
+    """`error` naming `where` if the parsed `obj` nests lists and mappings more than MAX_DEPTH
+    levels deep (where a message's repr of a value could exceed Python's recursion limit)."""
+    level = [obj] if isinstance(obj, (list, dict)) else []
+    for _ in range(MAX_DEPTH):
+        level = [v for x in level for v in (x.values() if isinstance(x, dict) else x) if isinstance(v, (list, dict))]
+        if not level:
+            return
+    raise error(f"{where} {TOO_DEEP}")
 
 
 def read_text(path: Path, error: type[PreboError]) -> str:
-    """A file's text, or `error` naming the file when it is unreadable or not text."""
+    """A file's text, or `error` naming the file when it is unreadable, not UTF-8 text, or larger
+    than MAX_BYTES (reading stops there: /dev/zero is refused, not read until memory runs out)."""
     try:
-        return Path(path).read_text()
+        with open(path, "rb") as f:
+            data = f.read(MAX_BYTES + 1)
     except OSError as exc:
         raise error(f"{path}: cannot read ({exc.strerror})") from exc
+    if len(data) > MAX_BYTES:
+        raise error(f"{path}: larger than {MAX_BYTES} bytes, the most prebo reads (a run's checkpoint of "
+                    f"{MAX_SIZE} functions, the largest basis this machine holds)")
+    try:
+        return data.decode()
     except UnicodeDecodeError as exc:
         raise error(f"{path}: not a text file ({exc.reason})") from exc
 
 
-def write_atomic(path, text: str) -> None:
-    """Write `text` to a temporary file in the same folder (PATH.*.tmp), fsync, then os.replace:
-    a killed writer leaves the old file or the new one, never half of one. OutputError naming
-    the path if it cannot be written."""
+def write_atomic(path, text: str | bytes) -> None:
+    """Write `text` (or bytes: an image) to a temporary file in the same folder (PATH.*.tmp), fsync,
+    then os.replace: a killed writer leaves the old file or the new one, never half of one.
+    OutputError naming the path if it cannot be written."""
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -153,7 +266,7 @@ def write_atomic(path, text: str) -> None:
     os.umask(umask)
     os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 would hide results from other users
     try:
-        with os.fdopen(fd, "w") as f:
+        with os.fdopen(fd, "wb" if isinstance(text, bytes) else "w") as f:
             f.write(text)
             f.flush()
             os.fsync(f.fileno())

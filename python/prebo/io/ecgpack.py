@@ -85,8 +85,8 @@ from ..system import KNOWN, State, System, particle
 from ..system.symmetry import implied_spins
 from ..system.young import young_operator, young_product, young_string
 from ..optimise.settings import check
-from ..validation import path_name
-from .basis_json import read_text, write_atomic
+from ..validation import MAX_PARTICLES, MAX_SIZE, path_name
+from .basis_json import MAX_DIGITS, read_text, write_atomic
 
 __all__ = ["read_inout", "write_inout", "parse_inout", "InoutFile"]
 
@@ -172,6 +172,18 @@ def _reals(path, line_no, values, what):
     return out
 
 
+def _clip(text: str) -> str:
+    """`text`, cut after MAX_DIGITS characters (for messages)."""
+    return text if len(text) <= MAX_DIGITS else text[:MAX_DIGITS] + "..."
+
+
+def _count(values: list) -> int | None:
+    """The one non-negative integer of a header line's `values` (at most MAX_DIGITS digits), or None."""
+    if len(values) != 1 or not values[0].isdigit() or len(values[0]) > MAX_DIGITS:
+        return None
+    return int(values[0])
+
+
 def parse_inout(path) -> InoutFile:
     """Read an ecgpack ``*.inout.txt`` without converting it; BasisFileError names the line."""
     path = Path(path_name(path, "parse_inout: path", "a file name (a str or path)"))
@@ -207,9 +219,9 @@ def parse_inout(path) -> InoutFile:
             _fail(path, ln, f"BASIS_TYPE {btype}: {why}")
 
     ln, vals, _ = header["PARTICLES"]
-    if len(vals) != 1 or not vals[0].isdigit() or int(vals[0]) < 2:
-        _fail(path, ln, f"PARTICLES must be one integer >= 2, got {' '.join(vals)!r}")
-    n = int(vals[0])
+    n = _count(vals)
+    if n is None or not 2 <= n <= MAX_PARTICLES:
+        _fail(path, ln, f"PARTICLES must be one integer in 2..{MAX_PARTICLES}, got {_clip(' '.join(vals))!r}")
     arrays = {}
     for key in ("MASSES", "CHARGES"):
         ln, vals, _ = header[key]
@@ -221,9 +233,10 @@ def parse_inout(path) -> InoutFile:
     if not np.all(arrays["MASSES"] > 0):
         _fail(path, ln, "MASSES must be positive")
     ln, vals, _ = header["BASIS_SIZE"]
-    if len(vals) != 1 or not vals[0].isdigit():
-        _fail(path, ln, f"BASIS_SIZE must be one non-negative integer, got {' '.join(vals)!r}")
-    size = int(vals[0])
+    size = _count(vals)
+    if size is None or size > MAX_SIZE:
+        _fail(path, ln, f"BASIS_SIZE must be one integer in 0..{MAX_SIZE} (what this machine's memory holds), "
+                        f"got {_clip(' '.join(vals))!r}")
     energy = None
     if "CURRENT_ENERGY" in header:
         ln, vals, _ = header["CURRENT_ENERGY"]
@@ -250,9 +263,9 @@ def parse_inout(path) -> InoutFile:
             _fail(path, i + 1, f"more basis lines than BASIS_SIZE {size} (line {header['BASIS_SIZE'][0]})")
         idx = parts[0]
         if not idx.lstrip("-").isdigit():
-            _fail(path, i + 1, f"basis line must start with the function's index, got {idx!r}")
-        if int(idx) != len(L) + 1:
-            _fail(path, i + 1, f"basis function index {idx}, expected {len(L) + 1}")
+            _fail(path, i + 1, f"basis line must start with the function's index, got {_clip(idx)!r}")
+        if _count([idx]) != len(L) + 1:
+            _fail(path, i + 1, f"basis function index {_clip(idx)}, expected {len(L) + 1}")
         vals = parts[1:]
         if len(vals) != m:
             extra = " (twice as many: a complex ECG? only real RG_0S is supported)" if len(vals) == 2 * m else ""

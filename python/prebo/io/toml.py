@@ -11,6 +11,7 @@ sets against the particles before anything runs; errors name the file and the ke
 """
 from __future__ import annotations
 
+import reprlib
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,7 +28,7 @@ from ..system import State, System
 from ..optimise.defaults import resolved
 from ..optimise.settings import SETTINGS, check
 from ..validation import path_name
-from .basis_json import read_text
+from .basis_json import TOO_DEEP, nested, read_text
 
 #: [basis] key -> Optimiser setting; [optimiser] takes every other setting
 BASIS_KEYS = {"type": "kind", "size": "size", "c_A": "c_A", "K_max": "K_max"}
@@ -55,6 +56,9 @@ def _table(d: dict, name: str, allowed: set) -> dict:
 
 def from_dict(d: dict) -> Job:
     """A Job from the parsed TOML mapping (module docstring); InputError naming the key."""
+    if not isinstance(d, dict):
+        raise InputError("an input is a table of title, [system], [state], [basis] and [optimiser], "
+                         f"got {reprlib.repr(d)}")
     unknown = set(d) - {"title", "system", "state", "basis", "optimiser"}
     if unknown:
         raise InputError(f"unknown top-level keys or tables {sorted(unknown)} (allowed: title, [system], [state], "
@@ -86,8 +90,11 @@ def load(path) -> Job:
     text = read_text(path, InputError)
     try:
         d = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
+    except RecursionError:
+        raise InputError(f"{path}: TOML {TOO_DEEP}") from None
+    except ValueError as exc:  # TOMLDecodeError, or an integer of more digits than Python converts
         raise InputError(f"{path}: not valid TOML ({exc})") from exc
+    nested(d, f"{path}: TOML", InputError)
     try:
         return from_dict(d)
     except InputError as exc:

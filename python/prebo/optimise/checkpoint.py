@@ -2,7 +2,8 @@
 `Cursor` (the next unit of work), the random-number state, the history, the seconds spent, the
 adaptive schedule's passes and why the run stopped, written atomically after every step;
 `load_checkpoint` reads it back for `prebo run --resume`, which continues the run (bit for bit
-in a fixed schedule).
+in a fixed schedule), and checks every part of it as a claim (`resumed`, `check_history`,
+`check_rng`): a malformed part is refused in one line naming the file and the key.
 
 A fixed schedule's pruning raises the energy before refinement lowers it again, so the state a
 run stands in need not be the lowest it passed through. `Lowest` keeps that one — the lowest
@@ -11,7 +12,8 @@ elsewhere (the file is removed once the run is back at or below it); the run ret
 """
 from __future__ import annotations
 
-import json
+import math
+import reprlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -145,35 +147,63 @@ def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> t
         raise BasisFileError(f"{where}: a {basis.kind} basis, but the optimiser's kind is {opts.kind}")
     try:
         cursor = Cursor(**d["progress"])
-        rng.bit_generator.state = d["rng"]
-        history, elapsed = d["history"], number(d.get("elapsed", 0.0), "elapsed")
+        rng.bit_generator.state = check_rng(d["rng"])
+        history, elapsed = check_history(d["history"]), number(d.get("elapsed", 0.0), "elapsed")
+        if elapsed < 0:
+            raise ValueError(f"elapsed = {elapsed!r}: must be the seconds of the run so far (≥ 0)")
         schedule, stopped = Adaptive.check(opts, d.get("schedule")), d.get("stopped")
         if stopped not in STOPPED:
-            raise ValueError(f"stopped = {stopped!r}: must be one of {tuple(STOPPED)}")
-    except (KeyError, TypeError, ValueError, OverflowError) as exc:
+            raise ValueError(f"stopped = {reprlib.repr(stopped)}: must be one of {tuple(STOPPED)}")
+    except (KeyError, TypeError, ValueError) as exc:
         raise BasisFileError(f"{where}: malformed run state ({exc})") from exc
-    if not (isinstance(history, list) and all(isinstance(h, list) and len(h) >= 3 for h in history)):
-        raise BasisFileError(f"{where}: history must be a list of [size, energy, phase, seconds] rows")
     nb = len(basis)
     if (cursor.phase != "grow" and nb == 0) or (cursor.phase in ("sweep", "refine") and cursor.index >= nb):
         raise BasisFileError(f"{where}: progress {vars(cursor)} does not fit a basis of {nb} functions")
     return basis, cursor, history, elapsed, schedule, stopped
 
 
+def check_rng(block) -> dict:
+    """A checkpoint's "rng" block: the state of numpy's PCG64 generator, {bit_generator: "PCG64",
+    state: {state, inc}, has_uint32, uinteger} with integers in their ranges (numpy itself takes
+    booleans and truncates floats); ValueError otherwise."""
+    def count(k, bits):
+        return type(k) is int and 0 <= k < 1 << bits
+
+    ok = isinstance(block, dict) and set(block) == {"bit_generator", "state", "has_uint32", "uinteger"}
+    state = block.get("state") if ok else None
+    if not (ok and block["bit_generator"] == "PCG64" and isinstance(state, dict) and set(state) == {"state", "inc"}
+            and count(state["state"], 128) and count(state["inc"], 128) and count(block["has_uint32"], 1)
+            and count(block["uinteger"], 32)):
+        raise ValueError(f"rng = {reprlib.repr(block)}: must be the state of numpy's PCG64 generator")
+    return block
+
+
+def check_history(history) -> list:
+    """A run's history: rows [size, energy (Eh), phase, seconds] (no seconds in checkpoints written
+    before wall times were recorded); ValueError naming the first malformed row."""
+    def finite(x):
+        return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+    if not isinstance(history, list):
+        raise ValueError(f"history = {reprlib.repr(history)}: must be a list of [size, energy, phase, seconds] rows")
+    for k, row in enumerate(history):
+        if not (isinstance(row, list) and len(row) in (3, 4) and type(row[0]) is int and row[0] > 0
+                and finite(row[1]) and row[2] in PHASES and (len(row) == 3 or finite(row[3]) and row[3] >= 0)):
+            raise ValueError(f"history row {k} = {reprlib.repr(row)}: must be [size, energy, phase, seconds] "
+                             f"(a positive integer, a number, one of {', '.join(PHASES)}, seconds ≥ 0)")
+    return history
+
+
 def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
-    """The content of folder/basis.json with its system and settings, checked as a whole
-    (BasisFileError naming the file)."""
+    """The content of folder/basis.json with its system and settings, checked as a whole: the
+    basis, the settings, the run state and the momentum block (BasisFileError naming the file)."""
+    from ..io import basis_json
+    from .momentum import Momentum
+
     path = Path(folder) / CHECKPOINT
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise BasisFileError(f"{path}: no checkpoint to resume ({exc.strerror})") from exc
-    except UnicodeDecodeError as exc:
-        raise BasisFileError(f"{path}: not a text file ({exc.reason})") from exc
-    try:
-        d = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise BasisFileError(f"{path}: corrupt checkpoint (line {exc.lineno}: {exc.msg})") from exc
+    if not path.exists():
+        raise BasisFileError(f"{path}: no checkpoint to resume")
+    d = basis_json.read(path)
     if not (isinstance(d, dict) and {"optimiser", "progress", "rng", "history"} <= set(d)):
         raise BasisFileError(f"{path}: not a run checkpoint (no optimiser state)")
     try:
@@ -181,6 +211,7 @@ def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
     except PreboError as exc:
         raise BasisFileError(f"{path}: {exc}") from exc
     basis, *_ = resumed(d, opts, np.random.default_rng(), str(path))
+    Momentum.from_dict(d.get("momentum"), basis, str(path))
     return d, basis.system, opts
 
 

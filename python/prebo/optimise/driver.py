@@ -13,6 +13,7 @@ state it passed through (checkpoint.Lowest), kept in lowest.json while it stands
 from __future__ import annotations
 
 import time
+from contextlib import nullcontext
 from dataclasses import replace
 from pathlib import Path
 
@@ -23,6 +24,7 @@ from ..basis import Basis
 from ..errors import InputError, OutputError, StalledError
 from ..integrals import laboratory
 from ..io.basis_json import remove_stale_temporaries
+from ..io.lock import owned
 from ..system import System
 from ..thresholds import lowest as lowest_threshold
 from ..validation import path_name
@@ -52,7 +54,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     (defaults.resolved).
 
     out: folder of the checkpoint out/basis.json, written atomically after every step (None: no
-    checkpoint; OutputError if a new run's folder holds one already); progress: show a live
+    checkpoint; OutputError if a new run's folder holds one already), owned by the run while it
+    runs (io/lock.py; OutputError if another run owns it); progress: show a live
     line; resume: a checkpoint's content (checkpoint.load_checkpoint) to continue exactly where
     it stopped.
     Returns the lowest state of at most `opts.size` functions the run passed through (with a
@@ -68,6 +71,12 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         raise InputError(f"optimise: opts = {opts!r}: must be a prebo.Optimiser")
     if out is not None:
         path_name(out, "optimise: out", "a folder (a str or path), or None")
+    with nullcontext() if out is None else owned(out):
+        return _run(system, opts, out, progress, resume)
+
+
+def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resume: dict | None) -> Basis:
+    """The run of `optimise`, in the folder `out` it owns (if any)."""
     held = None if out is None or resume is not None else checkpoint_in(out)
     if held:
         raise OutputError(f"optimise: out = {str(out)!r} holds a run's checkpoint ({held.name}): continue that run "
@@ -95,7 +104,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         return Expansion(b, rep, opts.threshold, opts.min_norm, opts.max_overlap)
 
     ex = expansion(basis)
-    if opts.adaptive and stopped == "exhausted" and opts.budget is not None:  # a budget overrides exhaustion
+    if opts.adaptive and cursor.phase == "done" and stopped in ("exhausted", "budget") and opts.budget is not None:
+        # a (new) budget overrides exhaustion, and the end of the last one
         cursor = schedule.reopen(len(ex.basis), ex.energy, elapsed)
         stopped = schedule.stopped if cursor.phase == "done" else None
     threshold = lowest_threshold(system).energy
@@ -161,7 +171,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
 def resume_from(folder: Path, progress: bool = True, budget: float | None = None) -> tuple[Basis, Optimiser]:
     """Continue the run whose checkpoint is folder/basis.json, with `budget` (seconds of the whole
     run) in place of the checkpoint's if given; the finished basis and its settings."""
-    d, system, opts = load_checkpoint(path_name(folder, "resume_from: folder", "a folder (a str or path)"))
-    if budget is not None:
-        opts = replace(opts, budget=budget)
-    return optimise(system, opts, out=Path(folder), progress=progress, resume=d), opts
+    with owned(path_name(folder, "resume_from: folder", "a folder (a str or path)")):  # before it is read
+        d, system, opts = load_checkpoint(folder)
+        if budget is not None:
+            opts = replace(opts, budget=budget)
+        return optimise(system, opts, out=Path(folder), progress=progress, resume=d), opts

@@ -13,6 +13,7 @@ import numpy as np
 
 from .. import eigen
 from ..basis import Basis
+from ..errors import LinearDependenceError
 
 
 #: how many times what a change adds to the uncertainty it must gain (`Expansion.keep_if_lower`)
@@ -21,7 +22,9 @@ SIGMA_PRICE = 100.0
 
 class Expansion:
     """The basis `basis` with its matrices `m` (S, T, T_ti, V; hartree), eigen-solution `eig`, ground-state
-    `energy` (hartree) and `sigma`, the energy's numerical uncertainty (module docstring).
+    `energy` (hartree) and `sigma`, the energy's numerical uncertainty (module docstring; inf
+    beyond eigen.FIRST_ORDER, where no change is kept: the optimiser does not take the basis where
+    its first-order uncertainty fails).
 
     rep: the integrals' Representation (integrals.laboratory); threshold: eigen.solve's relative
     overlap eigenvalue below which directions are dropped; min_norm, max_overlap: the
@@ -43,8 +46,8 @@ class Expansion:
             return
         self.eig = eigen.solve(self.m["T_ti"] + self.m["V"], self.m["S"], self.threshold)
         self.energy = float(self.eig.energies[0])
-        self.sigma = eigen.energy_uncertainty(self.eig.vectors[:, 0], self.energy, self.m["S"], self.m["T_ti"],
-                                              self.m["V"])
+        self.sigma = (eigen.energy_uncertainty(self.eig.vectors[:, 0], self.energy, self.m["S"], self.m["T_ti"],
+                                               self.m["V"]) if eigen.first_order(self.eig) else np.inf)
 
     def sound(self) -> bool:
         """Whether the ground state's internal kinetic energy c^T T_ti c is positive beyond the
@@ -76,13 +79,23 @@ class Expansion:
         self.basis, self.m, self.eig, self.energy, self.sigma = before
         return False
 
+    def solve_and_keep_if_lower(self, before: tuple) -> bool:
+        """Solve after a change and `keep_if_lower`; a change whose lowest root the extended-precision
+        refinement cannot resolve (eigen.refine: LinearDependenceError, at an overlap condition
+        where double precision runs out) is undone like one that does not gain."""
+        try:
+            self.solve()
+        except LinearDependenceError:
+            self.basis, self.m, self.eig, self.energy, self.sigma = before
+            return False
+        return self.keep_if_lower(before)
+
     def replace_basis(self, basis: Basis) -> bool:
         """Take a whole new basis (matrices rebuilt) if it lowers the energy beyond the uncertainty."""
         before = self.snapshot()
         self.basis = basis
         self.m = self.rep.matrices(basis)
-        self.solve()
-        return self.keep_if_lower(before)
+        return self.solve_and_keep_if_lower(before)
 
     def without(self, i):
         """The eigen-solution of the basis without function i, or without the functions of the
@@ -150,8 +163,7 @@ class Expansion:
         the state is a function of the basis alone and a resumed run continues bit for bit."""
         before = self.snapshot()
         self._place(i, f, row, d)
-        self.solve()
-        return self.keep_if_lower(before)
+        return self.solve_and_keep_if_lower(before)
 
     def put_group(self, idx: list[int], fs: list[Basis]) -> bool:
         """Replace the functions `idx` by `fs` (one-function bases) at once if that lowers the
@@ -161,8 +173,7 @@ class Expansion:
         for i, f in zip(idx, fs):
             rows, diag = self.rep.rows(f, self.basis, i)
             self._place(i, f, {k: v[0] for k, v in rows.items()}, diag[0])
-        self.solve()
-        return self.keep_if_lower(before)
+        return self.solve_and_keep_if_lower(before)
 
     def _place(self, i: int, f: Basis, row: dict | None, d) -> None:
         """Append (i == len) or replace function i by `f`, the matrices patched from its row and

@@ -11,10 +11,20 @@ from ..basis import FAMILIES
 from ..basis.gvr import K_LIMIT
 from ..eigen import THRESHOLD
 from ..errors import InputError
-from ..validation import (MATRICES, MAX_SIZE, Automatic, Channels, Choice, Integer, Lengths, Real, Refused,
+from ..validation import (MATRICES, MAX_SIZE, Automatic, Channels, Choice, Integer, Lengths, Real, checked,
                           strict_keywords)
 
 REFINE_METHODS = ("powell", "gradient")
+#: drawn lengths in units of a pair's Bohr radius: a cusp needs ~1e-3 (exponents ~1e6 a⁻²), a diffuse
+#: or Rydberg state ~1e3 (⟨r⟩ ~ n² a); beyond 1e-4..1e4 the functions drawn next to c_A lose their
+#: digits (He: every trial refused at 1e4..2e4, A not positive definite at 1e-9..1e-8), and far
+#: beyond, their exponents overflow (sampler.py)
+LENGTHS = Lengths(1e-4, 1e4)
+#: c_A (bohr⁻²): the energy does not depend on it (the CM is eliminated), but far from the internal
+#: exponents it costs digits: the stored H, H⁻, He and H 2p bases moved to c_A in 1e-2..1e3 keep their
+#: energies within 6e-14 Eh (as any change of A's bits does), at 1e-3 He moves 2e-12, at 1e5 H 6e-13,
+#: and a run for H at c_A = 1e6 went below the exact energy
+C_A = Real(1e-2, 1e3, True, True)
 SCHEDULE = ("prune", "sweeps", "refine", "polish", "cycles")  # the fixed schedule's settings
 
 
@@ -36,9 +46,9 @@ SETTINGS = {
     "sweeps": Setting(Automatic(Integer(0)), "random replacement sweeps per cycle", "[optimiser] sweeps"),
     "seed": Setting(Integer(0), "seed of the random numbers", "[optimiser] seed"),
     "channels": Setting(Automatic(Channels()), "coordinate sets the functions are drawn in", "[optimiser] channels"),
-    "length_range": Setting(Lengths(), "range of the drawn lengths in units of each pair's Bohr radius",
+    "length_range": Setting(LENGTHS, "range of the drawn lengths in units of each pair's Bohr radius",
                             "[optimiser] length_range"),
-    "c_A": Setting(Real(0.0), "exponent of the centre-of-mass coordinate", "[basis] c_A"),
+    "c_A": Setting(C_A, "exponent of the centre-of-mass coordinate in bohr⁻²", "[basis] c_A"),
     "kind": Setting(Automatic(Choice(tuple(FAMILIES))), "basis type", "[basis] type"),
     "K_max": Setting(Automatic(Integer(0, K_LIMIT)), "largest power K of an ECG-GVR function", "[basis] K_max"),
     "refine": Setting(Automatic(Integer(0)), "refinement sweeps per cycle", "[optimiser] refine"),
@@ -73,10 +83,7 @@ def check(name: str, value, label: str | None = None):
     """`value` of setting `name`, normalised (ints, floats, a tuple for length_range); InputError
     naming `label` (default: the name), the value and what is allowed."""
     s = SETTINGS[name]
-    try:
-        return s.rule(value)
-    except (Refused, TypeError, ValueError):
-        raise InputError(f"{label or name} = {value!r}: must be {s.rule.allowed} ({s.meaning})") from None
+    return checked(s.rule, value, label or name, s.meaning)
 
 
 @strict_keywords
@@ -88,10 +95,11 @@ class Optimiser:
 
     Basis: size — functions to grow to (≤ MAX_SIZE, what memory allows); kind — the basis
     family ("pecg", "ecg-gvr", "fecg"); c_A — exponent of the CM coordinate in bohr⁻², shared by
-    every function (> 0); K_max — largest power K of an ECG-GVR function (0..60).
+    every function (1e-2..1e3, `C_A`); K_max — largest power K of an ECG-GVR function (0..60).
     Sampling: trials — competitive trials per step; seed — of the random numbers; channels —
     "pairs", "all" or a list of coordinate-set names the functions are drawn in; length_range —
-    [lo, hi] of the drawn lengths in units of each pair's Bohr radius (sampler.pair_lengths);
+    [lo, hi] of the drawn lengths in units of each pair's Bohr radius (sampler.pair_lengths; within
+    1e-4..1e4, `LENGTHS`);
     learned — share of trials from the learned per-channel distributions (0..1); learn_after —
     functions of a channel before its distribution is learned; near — share of a growth step's
     trials that perturb functions of the basis at their own scale; with near > 0 a replacement

@@ -2,6 +2,15 @@
 
 Source: E. Tiesinga et al., CODATA 2018, Rev. Mod. Phys. 93, 025010 (2021):
 m_p/m_e, m_d/m_e, m_t/m_e, m_mu/m_e, m_alpha/m_e, m_h/m_e (helion = 3He nucleus).
+
+The ranges a particle may have (`MASS`, `CHARGE`): masses from 1e-6 m_e (no charged particle is
+lighter than the electron; lighter ones are models, and only mass ratios matter) to 1e12 m_e
+(nuclei reach 4.4e5; at 1e12 the finite-mass corrections, ~m_e/M = 1e-12 relative, are as small
+as the errors of the best ECG energies: the infinite-mass limit); charges 0 or 1e-3 ≤ |q| ≤ 1e3 e
+(every nucleus, and fractional model charges; a pair's Bohr radius grows as 1/|q| and its binding
+falls as q²: 1e3 bohr and 5e-7 Eh for an electron at |q| = 1e-3). Within these ranges, and those
+of length_range and c_A (optimise/settings.py), every length and exponent the sampler draws is a
+finite double (optimise/sampler.py; tests/test_messages.py).
 """
 from __future__ import annotations
 
@@ -9,13 +18,17 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from ..errors import InputError
-from ..validation import half_integer, number
+from ..validation import Magnitude, Real, checked, half_integer
+
+#: particle masses in m_e and charges in e (module docstring)
+MASS = Real(1e-6, 1e12, True, True)
+CHARGE = Magnitude(1e-3, 1e3)
 
 
 @dataclass(frozen=True)
 class Particle:
-    """A point particle: `name`, `mass` in m_e (> 0), `charge` in e, `spin` in ħ (0, 1/2, 1, ...);
-    InputError for anything else."""
+    """A point particle: `name`, `mass` in m_e (1e-6..1e12, `MASS`), `charge` in e (0 or
+    1e-3 ≤ |q| ≤ 1e3, `CHARGE`), `spin` in ħ (0, 1/2, 1, ...); InputError for anything else."""
 
     name: str
     mass: float
@@ -26,8 +39,8 @@ class Particle:
         if not isinstance(self.name, str) or not self.name:
             raise InputError(f"particle name {self.name!r}: must be a non-empty string")
         label = f"particle {self.name!r}"
-        object.__setattr__(self, "mass", number(self.mass, f"{label}: mass", positive=True))
-        object.__setattr__(self, "charge", number(self.charge, f"{label}: charge"))
+        object.__setattr__(self, "mass", checked(MASS, self.mass, f"{label}: mass", "electron masses"))
+        object.__setattr__(self, "charge", checked(CHARGE, self.charge, f"{label}: charge", "elementary charges"))
         object.__setattr__(self, "spin", half_integer(self.spin, f"{label}: spin"))
 
     @property

@@ -24,7 +24,10 @@ from math import factorial, sqrt
 import numpy as np
 
 from ..errors import SpinError
-from .permutations import class_sum, compose, lift, normalised, product, sign
+from .permutations import adjoint, class_sum, compose, lift, normalised, product, same, sign
+
+#: coefficients (relative to the identity's) that differ by less are the same: rationals written as floats
+ROUNDING = 1e-10
 
 
 def clebsch_gordan(j1: Fraction, m1: Fraction, j2: Fraction, m2: Fraction, j: Fraction, m: Fraction) -> float:
@@ -186,35 +189,75 @@ class Symmetriser:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Symmetriser":
-        """The operator of an `as_dict` block; SpinError if it is malformed."""
-        try:
-            perms = tuple(tuple(int(i) for i in p) for p in d["permutations"])
-            coefs = tuple(float(c) for c in d["coefficients"])
-        except (KeyError, TypeError, ValueError) as exc:
-            raise SpinError(f"malformed symmetry operator ({exc})") from exc
+        """The operator of an `as_dict` block; SpinError naming what is malformed (no other keys,
+        integer positions, real coefficients: no booleans, no strings; no permutation twice)."""
+        if not isinstance(d, dict) or set(d) != {"permutations", "coefficients"}:
+            raise SpinError("symmetry must be {permutations: [[0, 1, ...], ...], coefficients: [...]}, got keys "
+                            f"{sorted(d) if isinstance(d, dict) else type(d).__name__}")
+        perms, coefs = d["permutations"], d["coefficients"]
+        if not (isinstance(perms, list) and all(isinstance(p, list) and all(type(i) is int for i in p) for p in perms)):
+            raise SpinError("symmetry: permutations must be lists of integer positions 0..n-1")
+        if not (isinstance(coefs, list) and all(type(c) in (int, float) for c in coefs)):
+            raise SpinError("symmetry: coefficients must be numbers (no strings, no booleans)")
+        perms, coefs = tuple(map(tuple, perms)), tuple(map(float, coefs))
         if len(perms) != len(coefs) or not perms:
             raise SpinError("symmetry operator: permutations and coefficients do not match")
         k = len(perms[0])
         if any(sorted(p) != list(range(k)) for p in perms) or not all(np.isfinite(coefs)):
             raise SpinError(f"symmetry operator: every permutation must reorder 0..{k - 1} and every "
                             "coefficient be finite")
+        if len(set(perms)) != len(perms):
+            raise SpinError("symmetry operator: a permutation is listed twice")
         if not dict(zip(perms, coefs)).get(tuple(range(k)), 0.0) > 0:
             raise SpinError("symmetry operator: the identity needs a positive coefficient")
         return cls(perms, coefs)
 
-    def equivalent(self, other: "Symmetriser", tol: float = 1e-10) -> bool:
-        """The same operator up to an overall factor."""
+    def equivalent(self, other: "Symmetriser", tol: float = ROUNDING) -> bool:
+        """The same operator up to an overall factor (coefficients relative to the identity's
+        within `tol`: rationals written as floats)."""
         a, b = dict(zip(self.permutations, self.coefficients)), dict(zip(other.permutations, other.coefficients))
         identity = tuple(range(len(self.permutations[0])))
         if identity not in a or identity not in b:
             return False
         return all(abs(a.get(p, 0.0) / a[identity] - b.get(p, 0.0) / b[identity]) <= tol for p in set(a) | set(b))
 
+    def check_projector(self, groups: list[Group]) -> None:
+        """Refuse (SpinError) an operator O that is not a projector onto functions of the spin state
+        of `groups`: O† = O (c_P = c_{P⁻¹}), O² ∝ O, and Z O ∝ O for Z the central idempotent of
+        the state's irreducible representation (`central`). Such an O is positive semidefinite
+        and lies in that representation, so the Rayleigh–Ritz energy with it is one of that state:
+        the spin-projected operator of the state (one row), an ecgpack Young operator Y†Y
+        (another row). Coefficients compare within ROUNDING of the identity's."""
+        n = len(self.permutations[0])
+        if not dict(zip(self.permutations, self.coefficients)).get(tuple(range(n)), 0.0) > 0:
+            raise SpinError("the identity needs a positive coefficient")
+        op = self.operator()
+        if not same(op, adjoint(op), ROUNDING):
+            raise SpinError("not Hermitian (the coefficients of P and P⁻¹ differ)")
+        if not same(normalised(product(op, op)), op, ROUNDING):
+            raise SpinError("not a projector (its square is not a multiple of it)")
+        identity, z = tuple(range(n)), central(n, groups)
+        zo = product(z, op)
+        if not zo.get(identity, 0.0) > ROUNDING * z[identity]:
+            raise SpinError("it projects onto functions of another symmetry")
+        if not same(normalised(zo), op, ROUNDING):
+            raise SpinError("it projects onto functions of other symmetries too")
+
+
+def central(n: int, groups: list[Group]) -> dict:
+    """∝ the central idempotent Z of the spin state of `groups`: the projector onto every function
+    of that symmetry (each group's class sum of its spin-projected operator, multiplied)."""
+    z = {tuple(range(n)): 1.0}
+    for g in groups:
+        gop = {lift(gp, g.indices, n): c for gp, c in g.coefficients().items()}
+        z = product(z, class_sum(gop, g.indices))
+    return z
+
 
 def implied_spins(op: dict, groups: list[tuple[int, ...]], spins: list[Fraction], n: int) -> list[Fraction] | None:
     """The total spin of each group of identical particles (`groups`: their indices, `spins`:
-    their spin s) whose spin-projected operator lies in the same irreducible representation
-    as the operator `op`, or None when there is no such spin state."""
+    their spin s) whose irreducible representation the operator `op` lies in (Z op ∝ op,
+    `central`), or None when it lies in no single one (a mixture of spin states, or none)."""
     choices = []
     for idx, s in zip(groups, spins):
         opts = []
@@ -228,13 +271,9 @@ def implied_spins(op: dict, groups: list[tuple[int, ...]], spins: list[Fraction]
                 pass
             cand += 1
         choices.append(opts)
-    scale = max(abs(c) for c in op.values())
+    op = normalised(op)
     for combo in itertools.product(*choices):
-        z = {tuple(range(n)): 1.0}
-        for idx, s, S in zip(groups, spins, combo):
-            gop = {lift(gp, idx, n): c for gp, c in Group("g", idx, s, S).coefficients().items()}
-            z = product(z, class_sum(gop, idx))
-        prod = product(op, z)
-        if prod and max(abs(c) for c in prod.values()) > 1e-9 * scale * max(abs(c) for c in z.values()):
+        zo = product(central(n, [Group("g", idx, s, S) for idx, s, S in zip(groups, spins, combo)]), op)
+        if zo.get(tuple(range(n)), 0.0) > 0 and same(normalised(zo), op, ROUNDING):
             return list(combo)
     return None

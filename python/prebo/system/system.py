@@ -5,14 +5,22 @@ Equation numbers refer to Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
-from ..validation import MAX_PARTICLES, half_integer, number, strict_keywords
+from ..errors import InputError, SpinError
+from ..validation import MAX_PARTICLES, Integer, Real, Sign, checked, half_integer, strict_keywords
 from .particles import Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
+
+#: N: bound few-body states have far smaller ones (H₂'s last rotational level has N = 31); the
+#: ECG-GVR quadrature holds 2 K + N ≤ 1021 (crates/prebo-core/src/gvr.rs)
+N_RANGE = Integer(0, 1000)
+#: a given dissociation threshold (Eh): fragments (bound: < 0) and free particles at rest (0) lie at
+#: or below 0 (prebo.thresholds)
+THRESHOLD_RANGE = Real(-math.inf, 0.0, hi_closed=True)
 
 
 @strict_keywords
@@ -20,12 +28,12 @@ from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
 class State:
     """The quantum numbers of the state sought.
 
-    Parameters: `N`, the total orbital angular momentum quantum number (≥ 0, units of ħ);
-    `parity`, +1 or -1; `spin`, {particle name: total spin S} of each group of identical
-    particles (0, 1/2, 1, ...); a group not named gets its lowest total spin (singlet,
-    doublet, para); `threshold`, a dissociation threshold (Eh) the user knows to lie below the
-    hydrogen-like ones `prebo.thresholds` finds (e.g. Li⁺ + e for Li), or None. InputError for
-    anything else (unknown keywords included).
+    Parameters: `N`, the total orbital angular momentum quantum number (0..1000, `N_RANGE`;
+    units of ħ); `parity`, +1 or -1 (N and parity Python or numpy integers, not bools); `spin`,
+    {particle name: total spin S} of each group of identical particles (0, 1/2, 1, ...); a group
+    not named gets its lowest total spin (singlet, doublet, para); `threshold`, a dissociation
+    threshold (Eh, ≤ 0) the user knows to lie below the hydrogen-like ones `prebo.thresholds`
+    finds (e.g. Li⁺ + e for Li), or None. InputError for anything else (unknown keywords included).
     """
 
     N: int = 0
@@ -34,16 +42,15 @@ class State:
     threshold: float | None = None
 
     def __post_init__(self):
-        if isinstance(self.N, bool) or not isinstance(self.N, int) or self.N < 0:
-            raise InputError(f"state: N = {self.N!r}: must be a non-negative integer")
-        if isinstance(self.parity, bool) or not isinstance(self.parity, int) or self.parity not in (1, -1):
-            raise InputError(f"state: parity = {self.parity!r}: must be +1 or -1")
+        object.__setattr__(self, "N", checked(N_RANGE, self.N, "state: N", "the total orbital angular momentum"))
+        object.__setattr__(self, "parity", checked(Sign(), self.parity, "state: parity"))
         if not isinstance(self.spin, dict) or not all(isinstance(k, str) for k in self.spin):
             raise InputError(f"state: spin = {self.spin!r}: must map particle names to total spins, e.g. {{e = 0}}")
         for name, S in self.spin.items():
             half_integer(S, f"state: spin of {name!r}")
         if self.threshold is not None:
-            object.__setattr__(self, "threshold", number(self.threshold, "state: threshold"))
+            object.__setattr__(self, "threshold", checked(THRESHOLD_RANGE, self.threshold, "state: threshold",
+                                                          "Eh: fragments and free particles at rest lie at or below 0"))
 
 
 class System:
@@ -58,7 +65,8 @@ class System:
     explicit symmetry operator (e.g. an ecgpack file's Young operator) that replaces the
     spin state's own — kept only when it differs from it beyond an overall factor, so a
     system carries an explicit operator exactly when its spin state does not describe its
-    symmetry. InputError (SpinError for impossible spins) for anything invalid.
+    symmetry, and refused unless it is one of the state (`Symmetriser.check_projector`).
+    InputError (SpinError for impossible spins and operators) for anything invalid.
     """
 
     def __init__(self, particles, state: State | None = None, symmetriser: Symmetriser | None = None,
@@ -73,9 +81,7 @@ class System:
         self.groups = self._groups()
         self._symmetriser = None
         if symmetriser is not None:
-            self._check_operator(symmetriser)
-            if not symmetriser.equivalent(self.symmetriser):
-                self._symmetriser = symmetriser
+            self._take(symmetriser)
 
     # --- identical particles -------------------------------------------------
     def _groups(self) -> list[Group]:
@@ -102,6 +108,10 @@ class System:
             groups.append(Group(name, tuple(idx), first.spin, S))
         return groups
 
+    def spins(self) -> str:
+        """The total spins of the groups of identical particles, for messages ("e: S = 1/2")."""
+        return ", ".join(f"{g.name}: S = {g.total_spin}" for g in self.groups) or "no identical particles"
+
     @property
     def symmetriser(self) -> Symmetriser:
         """The symmetry operator: the explicit one if given, else the spin state's (`prebo.system.symmetry`)."""
@@ -109,15 +119,24 @@ class System:
             return self._symmetriser
         return Symmetriser.from_groups(self.n, self.groups)
 
-    def _check_operator(self, sym: Symmetriser) -> None:
-        """An explicit operator may only permute identical particles and must contain the identity."""
-        identity = tuple(range(self.n))
-        if identity not in sym.permutations:
-            raise InputError("symmetry operator: the identity permutation is missing")
-        for p in sym.permutations:
-            if len(p) != self.n or sorted(p) != list(identity) or any(
-                    self.particles[i].name != self.particles[p[i]].name for i in range(self.n)):
-                raise InputError(f"symmetry operator: {list(p)} permutes particles that are not identical")
+    def _take(self, sym: Symmetriser, what: str = "the symmetry operator") -> None:
+        """Carry the operator `sym` when it is not the spin state's own (up to a factor); SpinError
+        saying `what` is not that of the state unless it contains the identity, permutes only
+        identical particles and projects onto functions of the state (`Symmetriser.check_projector`)."""
+        try:
+            identity = tuple(range(self.n))
+            if identity not in sym.permutations:
+                raise SpinError("the identity permutation is missing")
+            for p in sym.permutations:
+                if len(p) != self.n or sorted(p) != list(identity) or any(
+                        self.particles[i].name != self.particles[p[i]].name for i in range(self.n)):
+                    raise SpinError(f"{list(p)} permutes particles that are not identical")
+            if sym.equivalent(self.symmetriser):
+                return
+            sym.check_projector(self.groups)
+        except SpinError as exc:
+            raise SpinError(f"{what} is not that of the state ({self.spins()}): {exc}") from None
+        self._symmetriser = sym
 
     # --- masses and charges --------------------------------------------------
     @property
@@ -184,18 +203,25 @@ class System:
 
     @classmethod
     def from_dict(cls, d: dict, symmetry: dict | None = None) -> "System":
-        """The system of `to_dict`, with the operator of a `Symmetriser.as_dict` block `symmetry`
-        (explicit when it is not the spin state's own); InputError/SpinError if malformed."""
+        """The system of `to_dict`, and the operator of a `Symmetriser.as_dict` block `symmetry`
+        checked against its state: the state's own (up to a factor and rounding), or one of the
+        state kept explicitly (`Symmetriser.check_projector`, an ecgpack import's); InputError,
+        SpinError naming what is malformed, or that the stored operator is not that of the state."""
         if not isinstance(d, dict) or "particles" not in d:
             raise InputError("system: missing 'particles'")
+        unknown = set(d) - {"particles", "state"}
+        if unknown:
+            raise InputError(f"system: unknown keys {sorted(unknown)} (allowed: particles, state)")
         if not isinstance(d.get("state", {}), dict):
             raise InputError(f"state = {d['state']!r}: must be a table of N, parity, spin and threshold")
         st = dict(d.get("state", {}))
         unknown = set(st) - {"N", "parity", "spin", "threshold"}
         if unknown:
             raise InputError(f"state: unknown keys {sorted(unknown)}")
-        return cls(d["particles"], State(**st),
-                   symmetriser=Symmetriser.from_dict(symmetry) if symmetry is not None else None)
+        system = cls(d["particles"], State(**st))
+        if symmetry is not None:
+            system._take(Symmetriser.from_dict(symmetry), "the stored symmetry")
+        return system
 
     def label(self) -> str:
         """The particle names, space-separated (``"p p e e"``)."""

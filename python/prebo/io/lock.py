@@ -1,0 +1,98 @@
+"""A run folder's advisory lock: the file FOLDER/.lock, held (fcntl.flock, exclusive) by the one
+process whose run owns the folder and removed when the run ends. The kernel drops the lock with
+the process however it ends (an exception, a signal, a kill), so a stale .lock owns nothing.
+
+`owned` creates the folder if it is missing, and removes what it created if the run left it
+empty: a refused run leaves no trace. A run nested in one that owns the folder (the CLI's run
+around `prebo.optimise`, `resume_from` around it) holds it already.
+"""
+from __future__ import annotations
+
+import fcntl
+import os
+import threading
+from contextlib import contextmanager
+from pathlib import Path
+
+from ..errors import OutputError
+
+LOCK = ".lock"
+
+_held = threading.local()  # the folders (device, inode) this thread owns
+
+
+@contextmanager
+def owned(folder):
+    """Own `folder` for the duration of the block (created if missing; OutputError naming it when
+    it cannot be created, or when another run, in this process or another, owns it)."""
+    folder = Path(folder)
+    created = _make(folder)
+    st = os.stat(folder)
+    key = (st.st_dev, st.st_ino)
+    held = vars(_held).setdefault("folders", set())
+    if key in held:
+        yield
+        return
+    try:
+        fd = _acquire(folder / LOCK)
+    except BaseException:
+        _remove_empty(created)
+        raise
+    held.add(key)
+    try:
+        yield
+    finally:
+        held.discard(key)
+        (folder / LOCK).unlink(missing_ok=True)  # while held: whoever opened it before finds it gone (_acquire)
+        os.close(fd)
+        _remove_empty(created)
+
+
+def _make(folder: Path) -> list[Path]:
+    """Create `folder` and its missing parents; those created, deepest first."""
+    missing = [p for p in (folder, *folder.parents) if not p.exists()]
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"{folder}: cannot create the output folder ({exc.strerror})") from exc
+    return missing
+
+
+def _remove_empty(created: list[Path]) -> None:
+    """Remove the folders `owned` created, deepest first, as long as they are empty."""
+    for p in created:
+        try:
+            p.rmdir()
+        except OSError:
+            return
+
+
+def _acquire(path: Path) -> int:
+    """The descriptor of the lock file `path`, locked, with this process's id in it."""
+    while True:
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as exc:
+            raise OutputError(f"{path.parent}: cannot lock the output folder ({exc.strerror})") from exc
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            pid = os.read(fd, 32).decode(errors="replace").strip()
+            os.close(fd)
+            raise OutputError(f"{path.parent}: another prebo run{f' (pid {pid})' if pid else ''} owns this folder") \
+                from None
+        except OSError as exc:  # a file system without locks
+            os.close(fd)
+            raise OutputError(f"{path.parent}: cannot lock the output folder ({exc.strerror})") from exc
+        try:
+            if os.path.samestat(os.fstat(fd), os.stat(path)):
+                break
+        except FileNotFoundError:
+            pass
+        os.close(fd)  # locked a file its owner removed as it ended: lock the one there now
+    try:
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+    except OSError:
+        pass  # the id only names the owner to a second run; a full disk stops the run at its first write
+    return fd
