@@ -164,6 +164,15 @@ def test_growth_stalled_at_the_overlap_threshold_names_the_threshold():
     assert "overlap condition, 9.98e+12, is near 1/threshold" in at_limit and "lower threshold (now 1e-13)" in at_limit
     assert "raise max_overlap" in stalled(427, opts, 9.0e11) and "threshold" not in stalled(427, opts, 9.0e11)
 
+
+def test_growth_stalled_by_the_uncertainty_says_so():
+    """He's growth stalled at 580 functions with σ = 1.0e-13 Eh (benchmarks/README, issue 37): the
+    message, which blamed linear dependence alone, names the uncertainty and its price."""
+    from prebo.optimise.methods import stalled
+    why = stalled(580, prebo.Optimiser(threshold=2.0**-53), 3.65e14, 1.0e-13)  # that run's threshold
+    assert "gaining less than the energy's uncertainty σ = 1.0e-13 Eh and 100 times what it adds to σ" in why
+    assert "overlap condition 3.6e+14" in why
+
 def test_size_beyond_memory_is_refused(tmp_path, capsys):
     from prebo.validation import MAX_SIZE
     err = toml_error(capsys, tmp_path, H_TOML.replace("size = 3", "size = 1_000_000_000"),

@@ -340,8 +340,8 @@ def parser() -> argparse.ArgumentParser:
                                                                      for k, op in OPERATORS.items()))
     en.add_argument("--threshold", type=fraction, metavar="T",
                     help="relative overlap eigenvalue below which directions are dropped (default: the "
-                         "threshold of the run that wrote the file; else 2^-53, every direction double "
-                         "precision resolves, as ecgpack solves its files)")
+                         "threshold of the run that wrote the file; else 4 x 2^-53, every direction the "
+                         "elements resolve, as ecgpack solves its files)")
     en.add_argument("--json", action="store_true", help="print one JSON object")
     en.set_defaults(func=cmd_energy)
     im = sub.add_parser("import", help="convert an ecgpack / ATOM-MOL-nonBO FILE.inout.txt to basis.json")

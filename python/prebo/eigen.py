@@ -65,15 +65,17 @@ from .errors import LinearDependenceError, NonFiniteError, NotPositiveDefiniteEr
 
 #: relative error assumed for every stored matrix element: 4 unit roundoffs (a few ulp)
 ELEMENT_ERROR = 4 * 2.0**-53
-#: the default relative overlap eigenvalue below which `solve` drops directions: the unit roundoff,
-#: the smallest one double precision resolves, so every resolved direction is kept, as ecgpack's
-#: solver keeps them (its He-490 file: 2 of 490 directions lie below 1e-13 and carry 1.7e-10 Eh,
-#: tests/test_ecgpack.py). The lowest root is refined in extended precision (`refine`) and the
-#: energy's uncertainty σ says what the elements' rounding leaves; the optimiser keeps a change only
-#: if it gains more than σ and 100 times what it adds to σ (optimise/expansion.py). The former
-#: default, 1e-13, stopped He's growth at 598 functions (overlap condition 2.3e13, where a new
-#: function costs a dropped direction) and H2+'s main job never comes near it (condition ≤ 2.5e8)
-THRESHOLD = 2.0**-53
+#: the default relative overlap eigenvalue below which `solve` drops directions: ELEMENT_ERROR, the
+#: relative error of the elements themselves, so every direction the elements resolve is kept, as
+#: ecgpack's solver keeps them (its He-490 file: 2 of 490 directions lie below 1e-13 and carry
+#: 1.7e-10 Eh, tests/test_ecgpack.py), and rounding is not: an exact duplicate's overlap eigenvalue
+#: comes out at 0.5-2 unit roundoffs, kept or not by the BLAS kernel at 2^-53 (tests/test_eigen.py).
+#: The lowest root is refined in extended precision (`refine`) and the energy's uncertainty says
+#: what the elements' rounding leaves (`uncertainty`); the optimiser keeps a change only if it gains
+#: more than σ and 100 times what it adds to σ (optimise/expansion.py). The former default, 1e-13,
+#: stopped He's growth at 598 functions (overlap condition 2.3e13, where a new function costs a
+#: dropped direction); H2+'s main job never comes near either (condition ≤ 2.5e8)
+THRESHOLD = ELEMENT_ERROR
 #: the largest ELEMENT_ERROR × overlap condition at which the first-order uncertainty holds: the
 #: spread of perturbed energies over the estimate was 1.09–1.15 at 0.35, 1.4–2.0 at 0.75 and 3000–5600
 #: at 1.2 (He with near-duplicate functions, tests/test_eigen.py); beyond it `uncertainty` perturbs.

@@ -39,15 +39,17 @@ def energy_at(steps: list, t: float) -> float:
 
 
 def convergence(history: list, opts: Optimiser, stopped: str | None, seconds: float,
-                stalled_at: int | None = None, advantage: float | None = None, condition: float = 0.0) -> dict:
+                stalled_at: int | None = None, advantage: float | None = None, condition: float = 0.0,
+                sigma: float = 0.0) -> dict:
     """The report of a run with `history` (module docstring); `stalled_at`: the size at which growth
-    stalled; `advantage`: that of the adaptive schedule; `condition`: the basis's overlap condition."""
+    stalled; `advantage`: that of the adaptive schedule; `condition`, `sigma`: the basis's overlap
+    condition and energy uncertainty (Eh)."""
     steps = [h for h in history if len(h) >= 4]
     pruned = [k for k in range(1, len(steps)) if steps[k][0] < steps[k - 1][0]]
     steps = steps[pruned[-1]:] if pruned else steps
     report = {"stopped": stopped, "seconds": seconds, "adaptive": opts.adaptive, "advantage": advantage,
               "recent": None, "extrapolation": None,
-              "stalled": None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts, condition)}}
+              "stalled": None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts, condition, sigma)}}
     if len(steps) >= 2:
         last = steps[-min(RECENT + 1, len(steps)):]
         gain, span = last[0][1] - last[-1][1], last[-1][3] - last[0][3]

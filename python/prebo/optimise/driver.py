@@ -164,7 +164,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         best.coefficients = ex.eig.vectors[:, 0]
     best.convergence = convergence(history, opts, stopped, wall(), schedule.stalled,
                                    schedule.advantage(len(ex.basis)) if opts.adaptive else None,
-                                   ex.eig.overlap_condition)
+                                   ex.eig.overlap_condition, ex.sigma)
     return best
 
 

@@ -42,7 +42,7 @@ import numpy as np
 from .. import eigen
 from ..errors import StalledError, UnsupportedError
 from .checkpoint import Cursor
-from .expansion import Expansion
+from .expansion import SIGMA_PRICE, Expansion
 from .momentum import Momentum
 from .polish import polish
 from .refine import partners, refine_group, refine_newcomer, regenerate_function
@@ -108,21 +108,26 @@ class Grow:
                                    "symmetriser annihilates them, or their integrals lose their digits); choose "
                                    f"another [basis] type, or a smaller c_A (now {run.sampler.opts.c_A:g})")
         if run.stalled == STALL_STEPS:
-            raise StalledError(f"optimiser: {stalled(len(ex.basis), run.sampler.opts, ex.eig.overlap_condition)}")
+            why = stalled(len(ex.basis), run.sampler.opts, ex.eig.overlap_condition, ex.sigma)
+            raise StalledError(f"optimiser: {why}")
 
 
-def stalled(nb: int, opts: Optimiser, condition: float = 0.0) -> str:
+def stalled(nb: int, opts: Optimiser, condition: float = 0.0, sigma: float = 0.0) -> str:
     """Why growth stopped at `nb` functions, and the settings to change: at an overlap `condition`
     within a decade of 1/threshold a new function costs a dropped direction (eigen.solve), so no
     trial lowers the energy (He at 427 functions, benchmarks/README, "Cheaper steps at large N");
-    otherwise every trial was refused by the linear-dependence guard."""
+    otherwise every trial was refused by the linear-dependence guard or gained too little beyond
+    the energy's uncertainty `sigma` (Eh; Expansion.keep_if_lower: He at 580 functions with σ =
+    1.0e-13, benchmarks/README, "Defaults that know the numerics")."""
     if condition * opts.threshold >= 0.1:
         return (f"no trial of the last {STALL_STEPS} growth steps lowered the energy at {nb} functions: the "
                 f"overlap condition, {condition:.2e}, is near 1/threshold, where a new function costs a dropped "
                 f"direction; lower threshold (now {opts.threshold:g})")
     return (f"every trial of the last {STALL_STEPS} growth steps was rejected at {nb} functions (linearly "
-            f"dependent on the basis or implausible); raise max_overlap (now {opts.max_overlap:g}), lower "
-            f"min_norm (now {opts.min_norm:g}) or change length_range (now {list(opts.length_range)})")
+            f"dependent on the basis, implausible, or gaining less than the energy's uncertainty σ = {sigma:.1e} Eh "
+            f"and {SIGMA_PRICE:g} times what it adds to σ, at overlap condition {condition:.1e}); raise max_overlap "
+            f"(now {opts.max_overlap:g}), lower min_norm (now {opts.min_norm:g}) or change length_range (now "
+            f"{list(opts.length_range)})")
 
 
 @dataclass(frozen=True)
