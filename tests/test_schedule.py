@@ -39,13 +39,15 @@ def test_a_molecule_gets_ecg_gvr_functions_with_powers_from_its_nuclear_mass():
 def test_the_default_threshold_keeps_every_direction_a_run_grows_into():
     """Issue 37, case 14: the He basis of 700 functions the adaptive schedule grew (overlap condition
     6.1e13, past 1/1e-13, the former default) is evaluated with every direction by default, to the
-    energy the run optimised; 1e-13 dropped two directions worth 7.2e-11 Eh and stopped growth."""
+    energy the run optimised (to the ulp the refinement stops at: Haswell's kernel gives one ulp
+    more); 1e-13 dropped two directions worth 7.2e-11 Eh and stopped growth."""
     folder = ROOT / "examples" / "bases" / "auto-he-700"
     basis = Basis.load(folder / "basis.json")
     assert Optimiser().threshold == eigen.THRESHOLD
     r = prebo.evaluate(basis)
     assert r["overlap_condition"] > 1e13 and r["kept"] == len(basis) == 700
-    assert r["energy"] == json.loads((folder / "basis.json").read_text())["energy"]
+    stored = json.loads((folder / "basis.json").read_text())["energy"]
+    assert abs(r["energy"] - stored) <= 2 * np.spacing(abs(stored))  # the refinement's stop: an ulp on any BLAS kernel
 
 
 def test_an_atom_gets_plain_ecgs_and_a_p_state_ecg_gvr_functions_without_powers():
