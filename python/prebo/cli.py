@@ -24,16 +24,20 @@ from .validation import path_name
 RESULT = "result.json"
 
 
-def _result(basis, where, threshold: float, coordinates: str = "lab", operators=()) -> dict:
+def _result(basis, where, threshold: float, coordinates: str = "lab", operators=(), roots: int = 1) -> dict:
     """The JSON-ready result of `basis` (overlap directions below `threshold` dropped, with the
-    expectation values of `operators`; results.evaluate); NonFiniteError naming the keys that
-    are not finite numbers, and every error prefixed with `where` (the basis file)."""
+    expectation values of `operators` and the lowest `roots` levels; results.evaluate);
+    NonFiniteError naming the keys that are not finite numbers, and every error prefixed with
+    `where` (the basis file)."""
     from .results import evaluate, public
 
     try:
-        r = public(evaluate(basis, coordinates=coordinates, operators=operators, threshold=threshold))
-        flat = r | {f"{name} {pair}": v for name, values in r.get("expectation", {}).items()
-                    for pair, v in values.items()}
+        r = public(evaluate(basis, coordinates=coordinates, operators=operators, threshold=threshold, roots=roots))
+        flat = {}
+        for prefix, part in [("", r)] + [(f"level {v['root']} ", v) for v in r.get("levels", [])]:
+            flat |= {prefix + k: v for k, v in part.items()}
+            flat |= {f"{prefix}{name} {pair}": v for name, values in part.get("expectation", {}).items()
+                     for pair, v in values.items()}
         bad = [f"{k} = {v}" for k, v in flat.items() if isinstance(v, float) and not math.isfinite(v)]
         if bad:
             raise NonFiniteError(f"the result is not finite ({', '.join(bad)}): the basis's integrals "
@@ -81,6 +85,32 @@ def _print_result(r: dict) -> None:
         for pair, value in values.items():
             t.add_row(f"{name} {pair}", f"{value:.10g} {op.unit}")
     Console().print(t)
+    if "levels" in r:
+        _print_levels(r)
+
+
+def _print_levels(r: dict) -> None:
+    """The levels of a result with several roots, and the transitions from the lowest and between
+    neighbours (results.evaluate; every pair is in the JSON)."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from .results import HARTREE_CM
+
+    levels = Table("root", "energy (Eh)", "σ (Eh)", "η_TI", "E − E_0 (cm⁻¹)", "bound", title="levels",
+                   caption="bound: below the lowest dissociation threshold by more than σ")
+    gaps = {(d["lower"], d["upper"]): d for d in r["transitions"]}
+    for v in r["levels"]:
+        gap = gaps[(0, v["root"])]["cm-1"] if v["root"] else 0.0
+        levels.add_row(str(v["root"]), f"{v['energy']:.12f}", f"{v['energy_uncertainty']:.1e}", f"{v['virial']:.1e}",
+                       f"{gap:.6f}", "yes" if v["bound"] else "no")
+    Console().print(levels)
+    steps = Table("transition", "ΔE (Eh)", "ΔE (cm⁻¹)", "uncertainty (cm⁻¹)", title="between neighbouring levels")
+    for v in r["levels"][1:]:
+        d = gaps[(v["root"] - 1, v["root"])]
+        steps.add_row(f"{d['lower']} → {d['upper']}", f"{d['Eh']:.10f}", f"{d['cm-1']:.6f}",
+                      f"{d['uncertainty'] * HARTREE_CM:.1e}")
+    Console().print(steps)
 
 
 def _warn_if_unbound(r: dict) -> None:
@@ -91,6 +121,11 @@ def _warn_if_unbound(r: dict) -> None:
         print(f"prebo: warning: E = {r['energy']:.12g} Eh is not below the dissociation threshold "
               f"{r['threshold']:.12g} Eh ({r['threshold_fragments']}): the state is not bound in this basis "
               "(a small virial coefficient is no evidence of binding)", file=sys.stderr)
+    above = [v["root"] for v in r.get("levels", [])[1:] if not v["bound"]]
+    if above and r["bound"]:
+        which = f"level {above[0]}" if len(above) == 1 else f"{len(above)} levels ({above[0]}, ..., {above[-1]})"
+        print(f"prebo: warning: {which} not below the dissociation threshold {r['threshold']:.12g} Eh "
+              f"({r['threshold_fragments']}): not bound in this basis (discretised continuum)", file=sys.stderr)
 
 
 def cmd_run(args) -> int:
@@ -264,7 +299,7 @@ def cmd_energy(args) -> int:
     re-evaluate a stored basis (Eh), with the expectation values of registered operators; a warning
     on stderr (exit status 0) when the state is not bound in the basis."""
     basis, stored = load_basis(args.basis)
-    r = _result(basis, args.basis, args.threshold or stored, args.coordinates, args.operator)
+    r = _result(basis, args.basis, args.threshold or stored, args.coordinates, args.operator, args.roots)
     if args.json:
         print(json.dumps(r, allow_nan=False))
     else:
@@ -313,6 +348,13 @@ def fraction(text: str) -> float:
     return within(text, 0.0, 1.0, "a number between 0 and 1")
 
 
+def positive_integer(text: str) -> int:
+    """A command line's count: an integer ≥ 1."""
+    if not (text.isascii() and text.isdigit() and int(text) >= 1):
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer ≥ 1")
+    return int(text)
+
+
 def parser() -> argparse.ArgumentParser:
     """The `prebo` argument parser with its five subcommands."""
     p = Parser(prog="prebo", description="pre-Born–Oppenheimer ECG solver")
@@ -342,6 +384,9 @@ def parser() -> argparse.ArgumentParser:
                     help="relative overlap eigenvalue below which directions are dropped (default: the "
                          "threshold of the run that wrote the file; else 4 x 2^-53, every direction the "
                          "elements resolve, as ecgpack solves its files)")
+    en.add_argument("--roots", type=positive_integer, default=1, metavar="K",
+                    help="report the lowest K levels of the state's symmetry (each an upper bound to its exact "
+                         "level) and the transition energies between them, in Eh and cm⁻¹")
     en.add_argument("--json", action="store_true", help="print one JSON object")
     en.set_defaults(func=cmd_energy)
     im = sub.add_parser("import", help="convert an ecgpack / ATOM-MOL-nonBO FILE.inout.txt to basis.json")

@@ -114,8 +114,8 @@ def solve(H: np.ndarray, S: np.ndarray, threshold: float = THRESHOLD, roots: int
     H, S: (nb, nb) symmetric Hamiltonian (hartree) and overlap matrices; threshold: overlap
     eigenvalues (of S scaled to unit diagonal) below threshold × the largest are dropped.
     Returns an `Eigen`. NonFiniteError for NaN or infinite elements, NotPositiveDefiniteError for
-    an overlap that is not positive definite, LinearDependenceError when nothing is kept or a
-    refined root does not converge."""
+    an overlap that is not positive definite, LinearDependenceError when fewer than `roots`
+    directions are kept or a refined root does not converge."""
     require_finite(H, "Hamiltonian", "H")
     require_finite(S, "overlap", "S")
     diag = np.diag(S).copy()
@@ -131,6 +131,9 @@ def solve(H: np.ndarray, S: np.ndarray, threshold: float = THRESHOLD, roots: int
     keep = s > threshold * s[-1]
     if not np.any(keep):
         raise LinearDependenceError("overlap matrix has no eigenvalue above the threshold")
+    if roots > keep.sum():
+        raise LinearDependenceError(f"{roots} roots asked for, but the basis resolves {int(keep.sum())} directions "
+                                    f"of its {len(S)} (overlap condition {s[-1] / max(s[0], 1e-300):.2e})")
     X = V[:, keep] / np.sqrt(s[keep])
     Hs = H * np.outer(d, d)
     with lapack_threads(len(S)):
@@ -185,17 +188,17 @@ def first_order(eig: Eigen) -> bool:
     return ELEMENT_ERROR * eig.overlap_condition <= FIRST_ORDER
 
 
-def uncertainty(eig: Eigen, S: np.ndarray, *terms: np.ndarray, threshold: float = THRESHOLD) -> float:
-    """The standard deviation (hartree) of the lowest energy of `eig` from independent relative
-    errors ELEMENT_ERROR of the elements of S and of each term of H = Σ terms: first-order theory
-    (`energy_uncertainty`) where it holds (`first_order`), else the largest move of the lowest
+def uncertainty(eig: Eigen, S: np.ndarray, *terms: np.ndarray, threshold: float = THRESHOLD, root: int = 0) -> float:
+    """The standard deviation (hartree) of energy `root` of `eig` (0: the lowest) from independent
+    relative errors ELEMENT_ERROR of the elements of S and of each term of H = Σ terms: first-order
+    theory (`energy_uncertainty`) where it holds (`first_order`), else the largest move of that
     energy re-solved (`threshold`) with every element so perturbed, DRAWS times from a fixed seed —
     the experiment that measures the first-order estimate (docs/conventions.md). There the moves
     have heavy tails (a few draws fall by 1 Eh where most move 1e-4) and a drift, so their largest
     is reported, not their standard deviation: the number stays an honest bound where double
     precision runs out. LinearDependenceError where such rounding leaves no lowest root."""
     if first_order(eig):
-        return energy_uncertainty(eig.vectors[:, 0], float(eig.energies[0]), S, *terms)
+        return energy_uncertainty(eig.vectors[:, root], float(eig.energies[root]), S, *terms)
     rng = np.random.default_rng(0)
     n = len(S)
 
@@ -207,12 +210,12 @@ def uncertainty(eig: Eigen, S: np.ndarray, *terms: np.ndarray, threshold: float 
     for _ in range(DRAWS):
         H = sum(perturbed(t) for t in terms)
         try:
-            energies.append(solve(H, perturbed(S), threshold).energies[0])
+            energies.append(solve(H, perturbed(S), threshold, root + 1).energies[root])
         except (LinearDependenceError, NotPositiveDefiniteError) as exc:
             raise LinearDependenceError(f"double precision cannot resolve this basis (overlap condition "
                                         f"{eig.overlap_condition:.2e}): rounding its elements by a few ulp leaves "
                                         f"no lowest root ({exc})") from None
-    return float(np.max(np.abs(np.array(energies) - eig.energies[0])))
+    return float(np.max(np.abs(np.array(energies) - eig.energies[root])))
 
 
 def lowest_with_added(E, C, h, s, h_nn, s_nn, min_norm: float = 1e-10) -> float:

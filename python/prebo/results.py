@@ -23,12 +23,20 @@ its energy no better than this. A basis with a function whose elements lost thei
 cancellation (integrals.py), or whose state has no positive kinetic energy, is refused. A
 non-finite element of H or S is an error (`eigen.solve`), never a number.
 
+With `roots` = K > 1 the lowest K levels of the symmetry are reported too: `levels`, one dict per
+root k = 0..K-1 (root, energy, energy_uncertainty, virial, kinetic, potential, bound,
+binding_energy, and n2 and expectation where the ground state has them), each eigenvalue an upper
+bound to its exact level (Hylleraas–Undheim–MacDonald), and `transitions`, one dict per pair of
+levels i < j: lower, upper, Eh (E_j − E_i), cm-1 (× HARTREE_CM) and uncertainty (the levels'
+uncertainties added in quadrature, Eh). The top-level keys stay those of root 0.
+
 `bound` is False when the energy is not below the threshold: the basis describes fragments and free
 particles, not a bound state. The virial coefficient cannot tell: a basis scaled to its variational
 optimum satisfies the virial theorem, 2<T> + <V> = 0, whatever it describes (tests/test_thresholds.py).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -40,24 +48,32 @@ from .expectation import expectation, operator
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
 from .optimise.settings import check
 from .thresholds import candidates, lowest
+from .validation import Integer, checked
+
+#: the hartree in wavenumbers, E_h/(hc) in cm⁻¹ (CODATA 2018: E. Tiesinga et al., Rev. Mod. Phys.
+#: 93, 025010 (2021), hartree-inverse meter relationship 2.1947463136320e7 m⁻¹)
+HARTREE_CM = 219474.6313632
 
 
-def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.THRESHOLD, operators=()) -> dict:
-    """The energies of `basis`'s lowest state.
+def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.THRESHOLD, operators=(),
+             roots: int = 1) -> dict:
+    """The energies of `basis`'s lowest state, and of its lowest `roots` levels.
 
     Parameters: `basis`, a non-empty `Basis`; `coordinates`, "lab" (LFCC with the CM kinetic
     energy eliminated, Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018)) or "ti"
     (translationally invariant coordinates, only for one c_A shared by every function);
     `threshold`, the relative overlap eigenvalue below which directions are dropped
     (`eigen.solve`); `operators`, names of registered operators (`expectation.OPERATORS`, e.g.
-    "r2") whose expectation values to add.
+    "r2") whose expectation values to add; `roots`, how many of the lowest levels to report
+    (`levels` and `transitions` when more than one).
 
     Returns a dict with the keys of the module docstring — energy, energy_uncertainty,
     energy_lab, kinetic, potential, threshold and binding_energy in Eh; bound a bool; virial,
     overlap_condition dimensionless; n2 in ħ²; expectation in each operator's unit — and
     `coefficients`, the S-normalised ground-state vector. InputError for a basis that is not a
     non-empty `Basis` or does not fit its system (its arrays or system replaced since it was built),
-    an unknown `coordinates` or operator; CancellationError for a function whose elements lost
+    an unknown `coordinates` or operator, `roots` not a positive integer or above the basis size;
+    LinearDependenceError for more roots than the basis resolves; CancellationError for a function whose elements lost
     their digits (Representation.require_resolved); NonFiniteError and the eigen errors as
     `eigen.solve` raises them."""
     if not isinstance(basis, Basis) or len(basis) == 0:
@@ -69,6 +85,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     operators = (operators,) if isinstance(operators, str) else tuple(operators)
     for name in operators:
         operator(name)
+    roots = checked(Integer(1, len(basis)), roots, "evaluate: roots", f"levels of a basis of {len(basis)} functions")
     basis = replace(basis)  # built again: the constructor's checks against the system it has now
     basis.validate()  # a Basis built in Python: symmetric, positive definite, CM-separable A
     system = basis.system
@@ -86,36 +103,23 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         energy_lab = None  # filled below: CM factor exp(-c_A X^2) common to all functions
     else:
         raise InputError(f"evaluate: coordinates = {coordinates!r}: must be 'lab' or 'ti'")
-    ti = eigen.solve(m["T_ti"] + m["V"], m["S"], threshold)
-    c = ti.vectors[:, 0]
-    kinetic, potential = float(c @ m["T_ti"] @ c), float(c @ m["V"] @ c)
-    energy = float(ti.energies[0])
-    uncertainty = eigen.uncertainty(ti, m["S"], m["T_ti"], m["V"], threshold=threshold)
-    if not kinetic > uncertainty:
-        raise CancellationError(f"the state's internal kinetic energy, {kinetic:.3g} Eh, is not positive beyond the "
-                                f"energy's uncertainty ({uncertainty:.1e} Eh): rounding dominates this basis's matrix "
-                                "elements, and its energy means nothing")
-    if energy_lab is None:
-        energy_lab = energy + 1.5 * c_A / system.m_total
-    extra = {}
-    if not basis.family.conserves_L:  # not an angular-momentum eigenfunction: report <N²>_TI
-        n2 = laboratory(system).angular(basis, system.cm_vector)
-        extra["n2"] = float(c @ n2 @ c)
-    if operators:
-        extra["expectation"] = {name: expectation(rep, basis, c, name) for name in operators}
+    ti = eigen.solve(m["T_ti"] + m["V"], m["S"], threshold, roots)
     low = lowest(system)
-    return extra | {
-        "energy": energy,
-        "energy_uncertainty": uncertainty,
+    n2 = None if basis.family.conserves_L else laboratory(system).angular(basis, system.cm_vector)
+    levels = [level(ti, k, m, low.energy, threshold, n2, {name: expectation(rep, basis, ti.vectors[:, k], name)
+                                                        for name in operators}) for k in range(roots)]
+    ground = levels[0]
+    if energy_lab is None:
+        energy_lab = ground["energy"] + 1.5 * c_A / system.m_total
+    extra = {}
+    if roots > 1:
+        extra["levels"] = levels
+        extra["transitions"] = [transition(a, b) for i, a in enumerate(levels) for b in levels[i + 1:]]
+    return {k: v for k, v in ground.items() if k != "root"} | extra | {
         "energy_lab": energy_lab,
-        "virial": abs(1.0 + potential / (2.0 * kinetic)),
-        "kinetic": kinetic,
-        "potential": potential,
         "threshold": low.energy,
         "threshold_fragments": low.fragments,
         "thresholds": {t.fragments: t.energy for t in candidates(system)},
-        "bound": energy < low.energy - uncertainty,
-        "binding_energy": low.energy - energy,
         "n_basis": len(basis),
         "basis_type": basis.family.name,
         "particles": [p.to_dict() for p in system.particles],
@@ -124,8 +128,48 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         "coordinates": coordinates,
         "overlap_condition": ti.overlap_condition,
         "kept": ti.kept,
-        "coefficients": c,
+        "coefficients": ti.vectors[:, 0],
     }
+
+
+def level(eig: eigen.Eigen, k: int, m: dict, threshold_energy: float, threshold: float, n2=None,
+          expectations: dict | None = None) -> dict:
+    """Root `k` of the solution `eig` of the matrices `m` (S, T_ti, V): its energy and uncertainty
+    (`eigen.uncertainty` at overlap `threshold`), virial coefficient, kinetic and potential energies,
+    whether it lies below the lowest dissociation threshold `threshold_energy` (Eh) beyond its
+    uncertainty, <N²>_TI from the matrix `n2` if given, and `expectations` if any (module
+    docstring). CancellationError where its internal kinetic energy is not positive beyond the
+    uncertainty: rounding dominates the elements, and the level means nothing."""
+    c = eig.vectors[:, k]
+    kinetic, potential = float(c @ m["T_ti"] @ c), float(c @ m["V"] @ c)
+    energy = float(eig.energies[k])
+    uncertainty = eigen.uncertainty(eig, m["S"], m["T_ti"], m["V"], threshold=threshold, root=k)
+    state = "the state's" if k == 0 else f"level {k}'s"
+    if not kinetic > uncertainty:
+        raise CancellationError(f"{state} internal kinetic energy, {kinetic:.3g} Eh, is not positive beyond the "
+                                f"energy's uncertainty ({uncertainty:.1e} Eh): rounding dominates this basis's matrix "
+                                "elements, and its energy means nothing")
+    extra = {} if n2 is None else {"n2": float(c @ n2 @ c)}  # not an angular-momentum eigenfunction
+    if expectations:
+        extra["expectation"] = expectations
+    return extra | {
+        "root": k,
+        "energy": energy,
+        "energy_uncertainty": uncertainty,
+        "virial": abs(1.0 + potential / (2.0 * kinetic)),
+        "kinetic": kinetic,
+        "potential": potential,
+        "bound": energy < threshold_energy - uncertainty,
+        "binding_energy": threshold_energy - energy,
+    }
+
+
+def transition(lower: dict, upper: dict) -> dict:
+    """The transition between two `level`s: E_upper − E_lower in Eh and cm⁻¹, with the levels'
+    uncertainties in quadrature (Eh)."""
+    gap = upper["energy"] - lower["energy"]
+    return {"lower": lower["root"], "upper": upper["root"], "Eh": gap, "cm-1": gap * HARTREE_CM,
+            "uncertainty": math.hypot(lower["energy_uncertainty"], upper["energy_uncertainty"])}
 
 
 def public(result: dict) -> dict:

@@ -1,0 +1,98 @@
+"""Several roots of one basis (issue 39): `prebo.evaluate(basis, roots=K)` and `prebo energy --roots K`
+report the lowest K levels of the symmetry, each an upper bound to its exact level
+(Hylleraas–Undheim–MacDonald), their uncertainties, whether each is bound, and the transitions."""
+import json
+
+import numpy as np
+import pytest
+
+import prebo
+from prebo.cli import main
+from prebo.errors import InputError, LinearDependenceError
+from prebo.io import basis_json
+from prebo.results import HARTREE_CM
+
+from conftest import ROOT
+
+BASES = ROOT / "examples" / "bases"
+
+
+def hydrogen(size: int = 50, ratio: float = 1.45, widest: float = 3e-4):
+    """H (finite proton mass) in `size` even-tempered s Gaussians exp(-a r²), a = widest × ratio^k,
+    of r = r_e − r_p, each times the CM Gaussian exp(−c_A X²), c_A = 1: A = a w wᵀ + c_A μ μᵀ with
+    w = (1, −1), μ = m/M (prebo's CM-separable form). Returns (basis, μ_red)."""
+    d = json.loads((BASES / "h" / "basis.json").read_text())
+    system = basis_json.from_dict(d, "h").system
+    d = {k: d[k] for k in ("format", "version", "conventions", "system", "symmetry", "basis_type")}
+    w, mu = np.array([1.0, -1.0]), system.cm_vector
+    d["functions"] = [{"A": (a * np.outer(w, w) + np.outer(mu, mu)).tolist(), "c_A": 1.0, "channel": "pairs"}
+                      for a in widest * ratio ** np.arange(size)]
+    m = system.masses
+    return basis_json.from_dict(d, "even-tempered H"), m[0] * m[1] / (m[0] + m[1])
+
+
+def test_hydrogen_s_levels_are_upper_bounds_within_1e8_of_the_exact_ones():
+    """1s-4s of H with μ = m_p/(1 + m_p): E_n = −μ/(2n²) exactly; every root lies above its level
+    (HUM) and, in 50 even-tempered s Gaussians, within 1e-8 relative; the 1s → 2s transition is
+    3μ/8 Eh, in cm⁻¹ by the CODATA 2018 hartree."""
+    basis, mu = hydrogen()
+    r = prebo.evaluate(basis, roots=4)
+    exact = np.array([-mu / (2 * n**2) for n in range(1, 5)])
+    energies = np.array([v["energy"] for v in r["levels"]])
+    assert np.all(energies > exact) and np.all((energies - exact) / -exact < 1e-8), (energies - exact) / -exact
+    assert [v["root"] for v in r["levels"]] == [0, 1, 2, 3] and all(v["bound"] for v in r["levels"])
+    assert [(t["lower"], t["upper"]) for t in r["transitions"]] == [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+    first = r["transitions"][0]
+    assert first["Eh"] == energies[1] - energies[0] and first["cm-1"] == first["Eh"] * HARTREE_CM
+    assert abs(first["Eh"] - 3 * mu / 8) < 1e-8 * mu
+    assert HARTREE_CM == pytest.approx(2.1947463136320e5, rel=1e-13)
+
+
+def test_the_ground_state_keys_are_those_of_one_root():
+    """Asking for several roots leaves root 0's result as it was, bit for bit (the main job and every
+    stored basis keep their energies)."""
+    basis = basis_json.load(BASES / "he" / "basis.json")
+    one, three = prebo.evaluate(basis), prebo.evaluate(basis, roots=3)
+    assert "levels" not in one and "transitions" not in one
+    for key in ("energy", "energy_uncertainty", "energy_lab", "virial", "kinetic", "potential", "bound",
+                "binding_energy", "overlap_condition", "kept"):
+        assert three[key] == one[key], key
+    assert np.array_equal(three["coefficients"], one["coefficients"])
+    assert three["levels"][0] == {k: one[k] for k in three["levels"][0] if k != "root"} | {"root": 0}
+    assert three["levels"][1]["energy"] < three["levels"][2]["energy"]
+
+
+def test_a_level_above_the_threshold_is_reported_not_bound(capsys):
+    """H⁻ has one bound state: root 1 of its singlet S symmetry lies above H(1s) + e, and is said so
+    (JSON `bound` false, the table's 'no' and one warning line), never claimed as a level."""
+    path = BASES / "h-" / "basis.json"
+    assert main(["energy", str(path), "--roots", "2", "--json"]) == 0
+    out, err = capsys.readouterr()
+    r = json.loads(out)
+    assert r["bound"] and not r["levels"][1]["bound"] and r["levels"][1]["energy"] > r["threshold"]
+    assert "level 1 not below the dissociation threshold" in err and len(err.splitlines()) == 1
+    assert main(["energy", str(path), "--roots", "2"]) == 0
+    out, _ = capsys.readouterr()
+    assert "levels" in out and "0 → 1" in out
+
+
+@pytest.mark.parametrize("roots, message", [("0", "'0' is not an integer ≥ 1"), ("-1", "'-1' is not an integer ≥ 1"),
+                                            ("1.5", "'1.5' is not an integer ≥ 1"),
+                                            ("151", "roots = 151: must be an integer in 1..150")])
+def test_roots_outside_the_basis_are_refused_in_one_line(capsys, roots, message):
+    try:
+        status = main(["energy", str(BASES / "he" / "basis.json"), "--roots", roots])
+    except SystemExit as exc:  # argparse's refusals
+        status = exc.code
+    assert status == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.splitlines()) == 1
+
+
+def test_roots_beyond_the_resolved_directions_and_bad_types_are_refused():
+    basis, _ = hydrogen(size=12, ratio=1.0005)  # nearly duplicate functions: most directions dropped
+    with pytest.raises(LinearDependenceError, match="12 roots asked for, but the basis resolves"):
+        prebo.evaluate(basis, roots=12)
+    for bad in (True, 2.0, "2", None):
+        with pytest.raises(InputError, match="evaluate: roots"):
+            prebo.evaluate(basis, roots=bad)
