@@ -15,7 +15,7 @@ import numpy as np
 from prebo import Optimiser, System, eigen
 from prebo.basis import Basis
 from prebo.integrals import laboratory
-from prebo.optimise.checkpoint import Cursor
+from prebo.optimise.cursor import Cursor
 from prebo.optimise.defaults import resolved
 from prebo.optimise.expansion import Expansion
 from prebo.optimise.methods import Run, methods

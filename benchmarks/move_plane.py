@@ -26,10 +26,11 @@ import numpy as np
 from prebo.basis import Basis
 from prebo.errors import PreboError
 from prebo.integrals import laboratory
-from prebo.optimise.checkpoint import CHECKPOINT, load_checkpoint
+from prebo.optimise.checkpoint import CHECKPOINT
 from prebo.optimise.expansion import Expansion
 from prebo.optimise.momentum import MAX_STEP
 from prebo.optimise.parametrisation import Parametrisation
+from prebo.optimise.resume import load_checkpoint
 
 
 def watch(folder: Path, out: Path) -> None:

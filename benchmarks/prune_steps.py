@@ -1,7 +1,7 @@
 """One pruning of a run's basis, taken apart (benchmarks/README, "Pruning that refines after each
-removal"): `--grow N` growth steps past the size as methods.Prune makes them (the best of the
+removal"): `--grow N` growth steps past the size as methods.PruneStep makes them (the best of the
 run's trials, refined, then refined with its partners), then the removals back to the size, each
-of the function whose removal raises the energy least — as Prune.remove (the function it
+of the function whose removal raises the energy least — as PruneStep.remove (the function it
 overlapped most then refined with its partners), or with `--plain` removed only (the code before
 session 26). First, what removing each function alone would cost (eigen.lowest_without_each);
 then per seed: each growth step's gain and seconds, each removal's cost, the net gain and the
@@ -18,10 +18,11 @@ import numpy as np
 
 from prebo import eigen
 from prebo.integrals import laboratory
-from prebo.optimise.checkpoint import Cursor, load_checkpoint, resumed
+from prebo.optimise.cursor import Cursor
 from prebo.optimise.expansion import Expansion
-from prebo.optimise.methods import Grow, Prune, Refinement, Run
+from prebo.optimise.methods import Grow, Minimiser, PruneStep, Run
 from prebo.optimise.report import Reporter
+from prebo.optimise.resume import load_checkpoint, resumed
 from prebo.optimise.sampler import Sampler
 
 
@@ -34,8 +35,8 @@ def main() -> None:
     a = ap.parse_args()
     d, system, opts = load_checkpoint(a.checkpoint)
     basis, *_ = resumed(d, opts, np.random.default_rng(0), a.checkpoint)
-    refinement = Refinement(opts.refine_evaluations, opts.refine_method, opts.refine_group)
-    prune = Prune(Grow(opts.trials, refinement), refinement)
+    refinement = Minimiser(opts.refine_evaluations, opts.refine_method, opts.refine_group)
+    prune = PruneStep(Grow(opts.trials, refinement), refinement)
     with eigen.lapack_threads(len(basis)), Reporter(opts, False) as report:
         for k, seed in enumerate(int(s) for s in a.seeds.split(",")):
             ex = Expansion(basis.subset(slice(None)), laboratory(system), opts.threshold, opts.min_norm,

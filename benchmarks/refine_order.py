@@ -21,7 +21,7 @@ from prebo.basis import Basis
 from prebo.integrals import laboratory
 from prebo.optimise import Expansion, Optimiser
 from prebo.optimise.parametrisation import Parametrisation
-from prebo.optimise.refine import Objective, refine_function
+from prebo.optimise.refine import FunctionEnergy, refine_function
 
 
 def energy_gradients(state) -> list[np.ndarray]:
@@ -52,7 +52,7 @@ def run(basis: Basis, opts: Optimiser, order: str, count: int, start: int):
         visit = (start + np.arange(count)) % len(basis)
     screened = time.perf_counter() - t0
     if order == "gradient":  # untimed check against the secular-equation gradient of the first function
-        obj = Objective(st, int(visit[0]))
+        obj = FunctionEnergy(st, int(visit[0]))
         g_obj = obj.energy_and_gradient(obj.p.theta())[1]
         print(f"function {visit[0]}: |∂E/∂θ| {np.linalg.norm(g_obj):.3e}; Hellmann–Feynman differs by "
               f"{np.linalg.norm(g[visit[0]] - g_obj) / np.linalg.norm(g_obj):.1e} (relative)")

@@ -5,7 +5,7 @@ its independence of the rest from the rest's own solve and from the whole basis'
 (Expansion.independence), and the block update's energy at the group's own parameters less the
 refined energy (the offset; min_norm ignored); or with `--polish N` the time and gain of one joint
 step of at most N L-BFGS iterations over every parameter (polish.polish); or with `--near T` the
-time and gain of `--steps` replacement steps (methods.Sweep with `near` > 0) whose T trials all
+time and gain of `--steps` replacement steps (methods.Replace with `near` > 0) whose T trials all
 move the function replaced: its neighbours in K, then perturbations of it (Sampler.perturbed); the
 best is kept if it lowers the energy, refined first with `--refine`; or with `--converge I,J,...`
 how far each group's L-BFGS gets from the basis as it stands (nothing kept): the gain of one
@@ -38,14 +38,16 @@ import numpy as np
 from prebo import eigen
 from prebo.basis import Basis
 from prebo.integrals import laboratory
-from prebo.optimise.checkpoint import CHECKPOINT, Cursor, load_checkpoint, resumed
+from prebo.optimise.checkpoint import CHECKPOINT
+from prebo.optimise.cursor import Cursor
 from prebo.optimise.expansion import Expansion
-from prebo.optimise.methods import Refinement, Run, Sweep
+from prebo.optimise.methods import Minimiser, Replace, Run
 from prebo.optimise.momentum import Momentum
 from prebo.optimise.parametrisation import Parametrisation
 from prebo.optimise.polish import Joint, polish
-from prebo.optimise.refine import GroupObjective, lbfgs, partners, refine_group
+from prebo.optimise.refine import GroupEnergy, lbfgs, partners, refine_group
 from prebo.optimise.report import Reporter
+from prebo.optimise.resume import load_checkpoint, resumed
 from prebo.optimise.sampler import Sampler
 
 
@@ -70,10 +72,10 @@ def survey(ex: Expansion, group: int, stride: int) -> None:
 
 
 def sweep_near(ex: Expansion, run_opts, system, i: int, a, report: Reporter) -> bool:
-    """One replacement step of function i (methods.Sweep) whose `a.near` trials move it only
+    """One replacement step of function i (methods.Replace) whose `a.near` trials move it only
     (`near` > 0: its neighbours in K, then perturbations of it); True if the energy fell."""
     E = ex.energy
-    step = Sweep(a.near, Refinement(a.evaluations, "gradient") if a.refine else None)
+    step = Replace(a.near, Minimiser(a.evaluations, "gradient") if a.refine else None)
     step.step(Run(ex, Sampler(system, run_opts, np.random.default_rng(i)), report), Cursor("sweep", index=i))
     return ex.energy < E
 
@@ -93,7 +95,7 @@ def k_moves(ex: Expansion, i: int, size: int, evaluations: int, sampler: Sampler
     idx = [i] + partners(ex, i, size - 1)
     best_E, best_f = ex.energy, None
     for f in [None] + [g for g in sampler.neighbours(ex.basis.subset([i])) if abs(int(g.K[0]) - int(ex.basis.K[i])) == 1]:
-        obj = GroupObjective(ex, idx)
+        obj = GroupEnergy(ex, idx)
         if f is not None:
             obj.p[0] = Parametrisation.of(f)
         lbfgs(obj.energy_and_gradient, obj.theta(), evaluations)
@@ -102,7 +104,7 @@ def k_moves(ex: Expansion, i: int, size: int, evaluations: int, sampler: Sampler
     return best_f is not None and ex.gains(best_E) and ex.put_group(idx, best_f)
 
 
-def newton(obj: GroupObjective, steps: int, h: float = 1e-4) -> list[tuple[float, int]]:
+def newton(obj: GroupEnergy, steps: int, h: float = 1e-4) -> list[tuple[float, int]]:
     """`steps` Newton steps on obj from its θ, each on the forward-difference Hessian of the exact
     gradient (symmetrised), shifted by the first of λ = 0, 1e-8, ..., 1e-4 that lowers the energy
     (steps longer than 1 in θ shortened); (best energy, energies evaluated) after each step."""
@@ -140,10 +142,10 @@ def converge(ex: Expansion, groups: list[int], size: int, evaluations: int) -> N
     for i in groups:
         idx = [i] + partners(ex, i, size - 1)
         t0 = time.perf_counter()
-        obj = GroupObjective(ex, idx)
+        obj = GroupEnergy(ex, idx)
         lbfgs(obj.energy_and_gradient, obj.theta(), evaluations)
         t1 = time.perf_counter()
-        steps = newton(GroupObjective(ex, idx), 3)
+        steps = newton(GroupEnergy(ex, idx), 3)
         print(f"group {idx}: L-BFGS ({evaluations} energies) {E0 - obj.best_E:.2e} Eh in {t1 - t0:.1f} s; Newton "
               + ", ".join(f"{E0 - e:.2e} ({n} energies)" for e, n in steps) + f" in {time.perf_counter() - t1:.1f} s")
 

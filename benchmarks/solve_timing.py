@@ -14,8 +14,8 @@ from threadpoolctl import threadpool_limits
 
 from prebo import eigen
 from prebo.integrals import laboratory
-from prebo.optimise.checkpoint import load_checkpoint, resumed
 from prebo.optimise.expansion import Expansion
+from prebo.optimise.resume import load_checkpoint, resumed
 
 
 def best(f, repeat: int) -> float:

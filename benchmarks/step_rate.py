@@ -25,10 +25,11 @@ except ImportError:  # code before the LAPACK thread limit
 
 from prebo import eigen
 from prebo.integrals import laboratory
-from prebo.optimise.checkpoint import Cursor, load_checkpoint, resumed
+from prebo.optimise.cursor import Cursor
 from prebo.optimise.expansion import Expansion
 from prebo.optimise.methods import Run, methods
 from prebo.optimise.report import Reporter
+from prebo.optimise.resume import load_checkpoint, resumed
 from prebo.optimise.sampler import Sampler
 
 

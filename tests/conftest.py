@@ -1,3 +1,4 @@
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -16,20 +17,49 @@ def references():
     return tomllib.loads((ROOT / "tests" / "data" / "reference_energies.toml").read_text())
 
 
-def random_basis(system, nb, rng, c_A=None, sets=None):
-    """nb random CM-separable pECGs of `system`, each drawn in a random coordinate set.
+def pair_A(system, alpha: dict, c_A: float) -> np.ndarray:
+    """Σ_{i<j} α_ij w_ij w_ij^T + c_A μ μ^T, w_ij = e_i - e_j, μ = m/m_tot (A 1 = c_A μ, as prebo
+    requires); `alpha`: α_ij by pair (i, j)."""
+    mu = system.cm_vector
+    A = c_A * np.outer(mu, mu)
+    for (i, j), a in alpha.items():
+        w = np.zeros(system.n)
+        w[i], w[j] = 1.0, -1.0
+        A += a * np.outer(w, w)
+    return A
 
-    𝒜 = L L^T + 0.05 I (random lower-triangular L) in the chosen set x, A = U_x^T blockdiag(𝒜, c_A) U_x.
-    `c_A=None` draws a different c_A per function."""
-    sets = sets or prebo.all_sets(system.masses)
+
+def random_pair_A(system, rng, c_A: float) -> np.ndarray:
+    """`pair_A` with every α_ij uniform in [0.3, 1.6], drawn pair by pair."""
+    return pair_A(system, {p: rng.uniform(0.3, 1.6) for p in itertools.combinations(range(system.n), 2)}, c_A)
+
+
+def random_set_A(system, rng, sets, c_A=None) -> tuple:
+    """(x, A, c_A): a coordinate set x drawn from `sets`, 𝒜 = L L^T + 0.05 I (random lower-triangular
+    L) in x and A = U_x^T blockdiag(𝒜, c_A) U_x; `c_A=None` draws c_A uniform in [0.3, 3]."""
     n = system.n
+    x = sets[rng.integers(len(sets))]
+    L = np.tril(rng.normal(size=(n - 1, n - 1)))
+    c = rng.uniform(0.3, 3.0) if c_A is None else c_A
+    return x, x.to_lab(L @ L.T + 0.05 * np.eye(n - 1), c), c
+
+
+def random_basis(system, nb, rng, c_A=None, sets=None):
+    """nb random CM-separable pECGs of `system`, each drawn in a random coordinate set (`random_set_A`;
+    `sets` default: prebo.all_sets). `c_A=None` draws a different c_A per function."""
+    sets = sets or prebo.all_sets(system.masses)
     A, cs, names = [], [], []
     for _ in range(nb):
-        x = sets[rng.integers(len(sets))]
-        L = np.tril(rng.normal(size=(n - 1, n - 1)))
-        A_int = L @ L.T + 0.05 * np.eye(n - 1)
-        c = rng.uniform(0.3, 3.0) if c_A is None else c_A
-        A.append(x.to_lab(A_int, c))
+        x, a, c = random_set_A(system, rng, sets, c_A)
+        A.append(a)
         cs.append(c)
         names.append(x.name)
     return prebo.Basis(system, np.array(A), np.array(cs), names)
+
+
+def random_centres(system, nb, rng, cm_free=False, scale=0.5) -> np.ndarray:
+    """(nb, n, 3) centres normal with spread `scale`; `cm_free`: μ^T s = 0 for every function."""
+    s = rng.normal(scale=scale, size=(nb, system.n, 3))
+    if cm_free:
+        s -= np.einsum("i,bic->bc", system.cm_vector, s)[:, None, :]
+    return s

@@ -5,6 +5,7 @@ import pytest
 import prebo
 from prebo.basis import FAMILIES, Basis, family
 from prebo.errors import InputError
+from test_imports import graph
 
 
 def test_families_by_name():
@@ -125,4 +126,13 @@ def test_no_module_outside_the_basis_package_tests_the_family_name():
                          if isinstance(c, ast.Constant)}
                 if names & set(FAMILIES):
                     found.append(f"{path.relative_to(root)}:{node.lineno}")
+    assert not found
+
+
+def test_no_module_outside_the_basis_package_imports_a_family_module():
+    """Families are reached through the registry (prebo.basis.family(name)): no module outside
+    prebo/basis/ imports prebo.basis.gvr, .fecg or .pecg, inside functions or not (test_imports.graph)."""
+    modules = {type(f).__module__ for f in FAMILIES.values()}  # prebo.basis.pecg, .gvr, .fecg
+    found = [f"{m} imports {', '.join(sorted(e & modules))}" for m, e in graph().items()
+             if m.split(".")[:2] != ["prebo", "basis"] and e & modules]
     assert not found

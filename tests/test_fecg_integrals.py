@@ -79,6 +79,7 @@ import pytest
 import prebo
 from prebo.integrals import laboratory, translationally_invariant
 
+from conftest import random_basis, random_centres, random_pair_A
 from fecg_reference import (N_THETA, blind_log_gaussian, coulomb_pair, coulomb_reference, gh_pair,
                             log_gauss_integral, reference)
 
@@ -90,24 +91,6 @@ RTOL = 1e-10  # quadrature comparisons (the rules are exact; observed ~1e-14)
 # ---------------------------------------------------------------------------
 def _p(name, mass, charge):
     return {"name": name, "mass": mass, "charge": charge, "spin": 0.5}
-
-
-def separable_A(masses, alpha, c_A):
-    """Σ_{i<j} α_ij (e_i-e_j)(e_i-e_j)^T + c_A (m/m_tot)(m/m_tot)^T."""
-    n = len(masses)
-    mu = masses / masses.sum()
-    A = c_A * np.outer(mu, mu)
-    for (i, j), a in alpha.items():
-        e = np.zeros(n)
-        e[i], e[j] = 1.0, -1.0
-        A += a * np.outer(e, e)
-    return A
-
-
-def random_A(system, rng, c_A):
-    n = system.n
-    alpha = {(i, j): rng.uniform(0.3, 1.6) for i, j in itertools.combinations(range(n), 2)}
-    return separable_A(system.masses, alpha, c_A)
 
 
 def fecg_basis(system, A, c_A, centres):
@@ -182,7 +165,7 @@ def test_two_particle_quadrature(charges):
     s = prebo.System([_p("a", 1.7, q[0]), _p("b", 0.6, q[1])])
     rng = np.random.default_rng(21 + len(charges))
     cA = np.array([0.7, 1.3, 0.45, 2.1])
-    A = np.array([random_A(s, rng, c) for c in cA])
+    A = np.array([random_pair_A(s, rng, c) for c in cA])
     centres = rng.normal(scale=0.5, size=(4, 2, 3))
     centres[1] += np.array([0.4, -0.3, 0.5])  # a large CM displacement
     centres[2] = centres[0]  # same centres, other exponent: r̄ = s for that pair
@@ -204,7 +187,7 @@ THREE_BODY = [_p("a", 1.7, 2.0), _p("b", 0.6, -1.0), _p("c", 3.1, -1.0)]
 
 def three_body_basis(system, rng, nb):
     cA = rng.uniform(0.4, 2.0, nb)
-    A = np.array([random_A(system, rng, c) for c in cA])
+    A = np.array([random_pair_A(system, rng, c) for c in cA])
     centres = rng.normal(scale=0.4, size=(nb, system.n, 3))
     centres[1] += np.array([0.3, 0.5, -0.4])
     if nb > 3:
@@ -273,25 +256,10 @@ SYSTEMS = {
 }
 
 
-def random_set_basis(system, nb, rng, shared_c_A=None):
-    """Exponents drawn in random coordinate sets (prebo.all_sets, CoordinateSet.to_lab)."""
-    sets = prebo.all_sets(system.masses)
-    n = system.n
-    A, cA = [], []
-    for _ in range(nb):
-        x = sets[rng.integers(len(sets))]
-        Lm = np.tril(rng.normal(size=(n - 1, n - 1)))
-        c = shared_c_A if shared_c_A is not None else rng.uniform(0.3, 3.0)
-        A.append(x.to_lab(Lm @ Lm.T + 0.05 * np.eye(n - 1), c))
-        cA.append(c)
-    return np.array(A), np.array(cA)
-
-
-def random_centres(system, nb, rng, cm_free=False, scale=0.5):
-    s = rng.normal(scale=scale, size=(nb, system.n, 3))
-    if cm_free:  # μ^T s = 0 for every function
-        s -= np.einsum("i,bc->bic", np.ones(system.n), np.einsum("i,bic->bc", system.cm_vector, s))
-    return s
+def random_exponents(system, nb, rng, c_A=None):
+    """(A, c_A) of nb functions drawn in random coordinate sets (conftest.random_basis)."""
+    plain = random_basis(system, nb, rng, c_A)
+    return plain.A, plain.c_A
 
 
 @pytest.mark.parametrize("name", list(SYSTEMS))
@@ -299,7 +267,7 @@ def test_zero_centres_equal_plain_ecg(name):
     s = SYSTEMS[name]()
     rng = np.random.default_rng(40 + len(name))
     nb = 6
-    A, cA = random_set_basis(s, nb, rng)
+    A, cA = random_exponents(s, nb, rng)
     pecg = laboratory(s).matrices(prebo.Basis(s, A, cA))
     pecg_int = laboratory(s, kinetic="internal").matrices(prebo.Basis(s, A, cA))
     zero = fecg_basis(s, A, cA, np.zeros((nb, s.n, 3)))
@@ -355,7 +323,7 @@ def test_small_shift_coulomb():
     s = prebo.System(THREE_BODY)
     rng = np.random.default_rng(17)
     cA = np.array([0.8, 1.4, 0.55])
-    A = np.array([random_A(s, rng, c) for c in cA])
+    A = np.array([random_pair_A(s, rng, c) for c in cA])
     P = SMALL_PATTERNS
     z2, m = z2_table(s, A, P)
     big = sorted(z2.items(), key=lambda kv: -kv[1])
@@ -396,7 +364,7 @@ def test_translation_free_kinetic_equals_internal(name):
     s = SYSTEMS[name]()
     rng = np.random.default_rng(60 + len(name))
     nb = 8
-    A, cA = random_set_basis(s, nb, rng)
+    A, cA = random_exponents(s, nb, rng)
     centres = random_centres(s, nb, rng)
     centres[::3] += rng.normal(size=(len(centres[::3]), 1, 3))  # large CM displacements
     basis = fecg_basis(s, A, cA, centres)
@@ -412,7 +380,7 @@ def test_translation_free_kinetic_equals_ticc(name):
     s = SYSTEMS[name]()
     rng = np.random.default_rng(80 + len(name))
     nb = 8
-    A, cA = random_set_basis(s, nb, rng, shared_c_A=1.1)
+    A, cA = random_exponents(s, nb, rng, c_A=1.1)
     centres = random_centres(s, nb, rng, cm_free=True)
     assert np.max(np.abs(np.einsum("i,bic->bc", s.cm_vector, centres))) < 1e-15
     basis = fecg_basis(s, A, cA, centres)
@@ -432,7 +400,7 @@ def test_rotational_invariance(name):
     s = SYSTEMS[name]()
     rng = np.random.default_rng(90 + len(name))
     nb = 6
-    A, cA = random_set_basis(s, nb, rng)
+    A, cA = random_exponents(s, nb, rng)
     centres = random_centres(s, nb, rng)
     base = prebo_all(s, fecg_basis(s, A, cA, centres))
     n2 = base[2]

@@ -9,7 +9,7 @@ from prebo.integrals import laboratory
 from prebo.optimise import Expansion, Optimiser, Sampler
 from prebo.optimise.parametrisation import Parametrisation
 from prebo.optimise.polish import Joint, polish
-from prebo.optimise.refine import GroupObjective, Objective, partners, refine_function, refine_group, regenerate_function
+from prebo.optimise.refine import FunctionEnergy, GroupEnergy, partners, refine_function, refine_group, regenerate_function
 from prebo.system import State, System
 
 P = {"name": "p", "mass": 1836.15267}
@@ -72,7 +72,7 @@ def test_energy_gradient_matches_finite_differences(case):
     f = p.function(theta)
     basis.append(f)
     st = Expansion(basis, laboratory(system), 1e-13)
-    obj = Objective(st, len(basis) - 1)
+    obj = FunctionEnergy(st, len(basis) - 1)
     e, g = obj.energy_and_gradient(theta)
     assert e == pytest.approx(obj.energy(theta), abs=1e-12)
     fd = np.array([richardson(obj.energy, theta, k, 1e-3) for k in range(len(theta))])
@@ -88,7 +88,7 @@ def test_group_energy_and_gradient_match_a_full_solve_and_finite_differences(cas
     basis.append(p.function(theta))
     st = Expansion(basis, laboratory(system), 1e-13)
     idx = [len(basis) - 1] + partners(st, len(basis) - 1, size - 1)
-    obj = GroupObjective(st, idx)
+    obj = GroupEnergy(st, idx)
     t0 = obj.theta()
     e, g = obj.energy_and_gradient(t0)
     assert e == pytest.approx(st.energy, rel=1e-12)
@@ -213,7 +213,7 @@ def test_extreme_parameters_are_refused_not_collapsed():
         p.function(extreme)
     basis.append(p.function(theta))
     st = Expansion(basis, laboratory(system), 1e-13)
-    obj = Objective(st, len(basis) - 1)
+    obj = FunctionEnergy(st, len(basis) - 1)
     assert obj.energy(extreme) == obj.worse and obj.energy_and_gradient(extreme)[0] == obj.worse
     rows, diag = st.rep.rows(p.function(theta), basis.subset(range(6)))
     S_b = np.diag(st.m["S"])[:6]

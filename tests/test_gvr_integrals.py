@@ -74,6 +74,7 @@ import pytest
 import prebo
 from prebo.integrals import laboratory, translationally_invariant
 
+from conftest import pair_A, random_set_A
 from gvr_reference import (gauss_legendre_01, gauss_moment, gh_overlap_kinetic, gh_tensor, mp_reference,
                            spherical_overlap_coulomb)
 
@@ -90,18 +91,6 @@ def _p(name, mass, charge):
 def two_body(N, charges):
     return prebo.System([_p("a", 1.7, charges[0]), _p("b", 0.6, charges[1])],
                         state=prebo.State(N=N, parity=(-1) ** N))
-
-
-def separable_A(masses, alpha, c_A):
-    """Σ_{i<j} α_ij (e_i-e_j)(e_i-e_j)^T + c_A (m/m_tot)(m/m_tot)^T."""
-    n = len(masses)
-    w = masses / masses.sum()
-    A = c_A * np.outer(w, w)
-    for (i, j), a in alpha.items():
-        e = np.zeros(n)
-        e[i], e[j] = 1.0, -1.0
-        A += a * np.outer(e, e)
-    return A
 
 
 def gvr_basis(system, A, c_A, u, K):
@@ -138,7 +127,7 @@ TWO_BODY_CHARGES = {0: (2.0, -1.0), 1: (1.5, 0.8), 2: (-1.0, -0.7)}
 def test_two_body_quadrature(N):
     s = two_body(N, TWO_BODY_CHARGES[N])
     m = s.masses
-    A = [separable_A(m, {(0, 1): al}, c) for al, c, _, _ in TWO_BODY_FUNCS]
+    A = [pair_A(s, {(0, 1): al}, c) for al, c, _, _ in TWO_BODY_FUNCS]
     cA = [f[1] for f in TWO_BODY_FUNCS]
     u = [f[2] for f in TWO_BODY_FUNCS]
     K = [f[3] for f in TWO_BODY_FUNCS]
@@ -178,10 +167,8 @@ def test_k0_n0_equals_plain_ecg():
     nb = 6
     A, cA, u = [], [], []
     for k in range(nb):
-        x = sets[rng.integers(len(sets))]
-        Lm = np.tril(rng.normal(size=(2, 2)))
-        c = rng.uniform(0.3, 3.0)
-        A.append(x.to_lab(Lm @ Lm.T + 0.05 * np.eye(2), c))
+        x, a, c = random_set_A(s, rng, sets)
+        A.append(a)
         cA.append(c)
         u.append(x.U.T @ np.array([*rng.normal(size=2), rng.normal() if k % 2 else 0.0]))
     gvr = laboratory(s).matrices(gvr_basis(s, A, cA, u, [0] * nb))
@@ -233,7 +220,7 @@ def test_two_body_radial_high_k(N):
     al = [0.9, 1.3, 2.1, 0.7, 1.6, 2.6]
     cA = [0.7, 1.3, 0.45, 2.0, 0.9, 0.6]
     mu = [1.0, -0.8, 1.3, 0.6, -1.1, 1.1]
-    A = [separable_A(s.masses, {(0, 1): a}, c) for a, c in zip(al, cA)]
+    A = [pair_A(s, {(0, 1): a}, c) for a, c in zip(al, cA)]
     u = [(k, -k) for k in mu]
     basis = gvr_basis(s, A, cA, u, Ks)
     lab = laboratory(s).matrices(basis)
@@ -289,7 +276,7 @@ HIGH_K_FUNCS = [  # (α_ij, c_A, u, K); S of the (17, 40), (40, 40) pairs 1-2, 1
 def test_three_body_moments_high_k(N):
     """Non-parallel u_I, u_J (c_U != 0 for most), K up to 40: every element against the mpmath moment route."""
     s = three_body_system(N)
-    A = [separable_A(s.masses, a, c) for a, c, _, _ in HIGH_K_FUNCS]
+    A = [pair_A(s, a, c) for a, c, _, _ in HIGH_K_FUNCS]
     cA = [f[1] for f in HIGH_K_FUNCS]
     u = [f[2] for f in HIGH_K_FUNCS]
     Ks = [f[3] for f in HIGH_K_FUNCS]
@@ -329,10 +316,8 @@ def random_gvr_basis(system, nb, rng, shared_c_A=None, c_U_zero=False):
     n = system.n
     A, cA, u, K, names = [], [], [], [], []
     for k in range(nb):
-        x = sets[rng.integers(len(sets))]
-        Lm = np.tril(rng.normal(size=(n - 1, n - 1)))
-        c = shared_c_A if shared_c_A is not None else rng.uniform(0.3, 3.0)
-        A.append(x.to_lab(Lm @ Lm.T + 0.05 * np.eye(n - 1), c))
+        x, a, c = random_set_A(system, rng, sets, shared_c_A)
+        A.append(a)
         cA.append(c)
         cU = 0.0 if (c_U_zero or k % 3 == 0) else rng.uniform(0.2, 1.5) * rng.choice([-1, 1])
         u.append(x.U.T @ np.array([*rng.normal(size=n - 1), cU]))

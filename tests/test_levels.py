@@ -9,7 +9,6 @@ import pytest
 import prebo
 from prebo.cli import main
 from prebo.errors import InputError, LinearDependenceError
-from prebo.io import basis_json
 from prebo.results import HARTREE_CM
 
 from conftest import ROOT
@@ -22,13 +21,13 @@ def hydrogen(size: int = 50, ratio: float = 1.45, widest: float = 3e-4):
     of r = r_e − r_p, each times the CM Gaussian exp(−c_A X²), c_A = 1: A = a w wᵀ + c_A μ μᵀ with
     w = (1, −1), μ = m/M (prebo's CM-separable form). Returns (basis, μ_red)."""
     d = json.loads((BASES / "h" / "basis.json").read_text())
-    system = basis_json.from_dict(d, "h").system
+    system = prebo.Basis.from_dict(d, "h").system
     d = {k: d[k] for k in ("format", "version", "conventions", "system", "symmetry", "basis_type")}
     w, mu = np.array([1.0, -1.0]), system.cm_vector
     d["functions"] = [{"A": (a * np.outer(w, w) + np.outer(mu, mu)).tolist(), "c_A": 1.0, "channel": "pairs"}
                       for a in widest * ratio ** np.arange(size)]
     m = system.masses
-    return basis_json.from_dict(d, "even-tempered H"), m[0] * m[1] / (m[0] + m[1])
+    return prebo.Basis.from_dict(d, "even-tempered H"), m[0] * m[1] / (m[0] + m[1])
 
 
 def test_hydrogen_s_levels_are_upper_bounds_within_1e8_of_the_exact_ones():
@@ -51,7 +50,7 @@ def test_hydrogen_s_levels_are_upper_bounds_within_1e8_of_the_exact_ones():
 def test_the_ground_state_keys_are_those_of_one_root():
     """Asking for several roots leaves root 0's result as it was, bit for bit (the main job and every
     stored basis keep their energies)."""
-    basis = basis_json.load(BASES / "he" / "basis.json")
+    basis = prebo.Basis.load(BASES / "he" / "basis.json")
     one, three = prebo.evaluate(basis), prebo.evaluate(basis, roots=3)
     assert "levels" not in one and "transitions" not in one
     for key in ("energy", "energy_uncertainty", "energy_lab", "virial", "kinetic", "potential", "bound",

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import functools
 import itertools
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,7 +21,7 @@ from numpy.polynomial.hermite import hermgauss
 import prebo
 from prebo.integrals import laboratory, translationally_invariant
 
-ROOT = Path(__file__).resolve().parents[1]
+from conftest import ROOT, random_centres, random_pair_A
 
 
 def _p(name, mass, charge):
@@ -36,21 +35,10 @@ def distinguishable(n, N=0):
     return prebo.System(parts, state=prebo.State(N=N, parity=(-1) ** N))
 
 
-def separable_A(system, rng, c_A):
-    """Σ_{i<j} α_ij w_ij w_ijᵀ + c_A μμᵀ with random α_ij (A 1 = c_A μ, as prebo requires)."""
-    mu = system.masses / system.masses.sum()
-    A = c_A * np.outer(mu, mu)
-    for i, j in itertools.combinations(range(system.n), 2):
-        e = np.zeros(system.n)
-        e[i], e[j] = 1.0, -1.0
-        A += rng.uniform(0.3, 1.6) * np.outer(e, e)
-    return A
-
-
-def random_basis(kind, system, rng, nb=3, shared_c_A=None, cm_free=False):
-    """nb random functions of one family; `cm_free`: c_U = 0 (ECG-GVR) or μᵀs = 0 (FECG)."""
+def family_basis(kind, system, rng, nb=3, shared_c_A=None, cm_free=False):
+    """nb random functions of one family in pair form; `cm_free`: c_U = 0 (ECG-GVR) or μᵀs = 0 (FECG)."""
     c_A = np.full(nb, shared_c_A) if shared_c_A else rng.uniform(0.4, 2.0, nb)
-    A = np.array([separable_A(system, rng, c) for c in c_A])
+    A = np.array([random_pair_A(system, rng, c) for c in c_A])
     extra = {}
     if kind == "ecg-gvr":
         u = rng.normal(size=(nb, system.n))
@@ -58,11 +46,7 @@ def random_basis(kind, system, rng, nb=3, shared_c_A=None, cm_free=False):
             u -= u.mean(axis=1, keepdims=True)  # 1ᵀu = c_U = 0
         extra = {"u": u, "K": rng.integers(0, 2, nb)}
     elif kind == "fecg":
-        s = rng.normal(scale=0.5, size=(nb, system.n, 3))
-        if cm_free:
-            mu = system.masses / system.masses.sum()
-            s -= np.einsum("k,bkc->bc", mu, s)[:, None, :]  # μᵀs = 0
-        extra = {"s": s}
+        extra = {"s": random_centres(system, nb, rng, cm_free)}
     return prebo.Basis(system, A, c_A, kind=kind, **extra)
 
 
@@ -120,7 +104,7 @@ CASES = [("pecg", 2, 0), ("pecg", 3, 0), ("fecg", 2, 0), ("fecg", 3, 0),
 def test_r2_elements_against_quadrature(kind, n, N):
     """Every element of ⟨r_ij²⟩ for every pair, normalised functions, to 1e-12 of the quadrature."""
     system = distinguishable(n, N)
-    basis = random_basis(kind, system, np.random.default_rng(7 + n + N), nb=3)
+    basis = family_basis(kind, system, np.random.default_rng(7 + n + N), nb=3)
     pairs = [p for p in itertools.combinations(range(n), 2)]
     w = np.zeros((len(pairs), n))
     for k, (i, j) in enumerate(pairs):
@@ -142,7 +126,7 @@ def test_r2_is_the_same_in_lfcc_and_ticc(kind):
     matrices equal those in Jacobi coordinates, for three particles with two identical ones."""
     e, p = _p("e", 1.0, -1.0), _p("p", 1836.15267343, 1.0)
     system = prebo.System([p, p, e], state=prebo.State(N=0, parity=1))
-    basis = random_basis(kind, system, np.random.default_rng(3), nb=4, shared_c_A=0.9, cm_free=True)
+    basis = family_basis(kind, system, np.random.default_rng(3), nb=4, shared_c_A=0.9, cm_free=True)
     w = np.array([[1.0, -1.0, 0.0], [1.0, 0.0, -1.0], [0.0, 1.0, -1.0]])
     lab = laboratory(system).operator("r2", basis, w)
     ti = translationally_invariant(system).operator("r2", basis, w)
@@ -177,7 +161,7 @@ def test_pair_class_averages_of_a_symmetrised_state(kind, names):
     masses = {"p": 1836.15267343, "e": 1.0}
     charges = {"p": 1.0, "e": -1.0}
     system = prebo.System([_p(x, masses[x], charges[x]) for x in names], state=prebo.State(N=0, parity=1))
-    basis = random_basis(kind, system, rng, nb=3)
+    basis = family_basis(kind, system, rng, nb=3)
     result = prebo.evaluate(basis, operators=["r2"])
     c = result["coefficients"]
     labels = [f"{x}{i}" for i, x in enumerate(names)]

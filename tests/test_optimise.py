@@ -11,6 +11,7 @@ import pytest
 import prebo
 from prebo.optimise import Cursor, Optimiser
 from prebo.optimise.defaults import resolved
+from prebo.optimise.fixed import Fixed
 from conftest import ROOT
 
 INPUT = """
@@ -78,36 +79,52 @@ def test_resume_without_checkpoint_is_a_clear_error(tmp_path):
     assert r.returncode == 2 and "no checkpoint" in r.stderr and "Traceback" not in r.stderr
 
 
-def test_cursor_schedule():
+def test_fixed_schedule():
     opts = resolved(Optimiser(size=2, sweeps=1, refine=2, polish=2), prebo.System(["p", "e"]))
-    c, seen = Cursor().advance(0, opts), []
+    schedule = Fixed(opts)
+    c, seen = schedule.first(), []
     nb = 0
     while c.phase != "done":
+        assert schedule.stopped is None
         seen.append((c.phase, c.sweep, c.index))
         nb = min(nb + 1, 2) if c.phase == "grow" else nb
-        c = c.advance(nb, opts)
+        c = schedule.advance(c, nb, -0.5, 1.0)
     assert seen == [("grow", 0, 0), ("grow", 0, 0), ("sweep", 0, 0), ("sweep", 0, 1),
                     ("refine", 0, 0), ("refine", 0, 1), ("refine", 1, 0), ("refine", 1, 1),
                     ("polish", 0, 0), ("polish", 1, 0)]
+    assert schedule.stopped == "schedule" and schedule.advantage(2) is None and not schedule.stall(2)
+    assert schedule.restart("grow", 2, 0.0, -1.0) is None and schedule.resume(c, "budget", 2, -0.5, 1.0) == (c, "budget")
 
 
-def test_cursor_repeats_the_block_after_growth_in_cycles():
+def test_a_fixed_schedule_stores_the_schedule_block_of_an_adaptive_one_before_its_first_pass():
+    """One "schedule" block format for both kinds, as every checkpoint so far holds it."""
+    from prebo.optimise.adaptive import Adaptive
+    from prebo.optimise.schedule import schedule_of
+    opts = resolved(Optimiser(size=2, sweeps=1), prebo.System(["p", "e"]))
+    assert Fixed(opts).to_dict() == Adaptive(opts).to_dict()
+    assert isinstance(schedule_of(opts, json.loads(json.dumps(Fixed(opts).to_dict()))), Fixed)
+    assert isinstance(schedule_of(resolved(Optimiser(size=2), prebo.System(["p", "e"]))), Adaptive)
+
+
+def test_a_fixed_schedule_repeats_the_block_after_growth_in_cycles():
     opts = resolved(Optimiser(size=1, sweeps=1, refine=0, polish=1, cycles=3), prebo.System(["p", "e"]))
-    c, seen = Cursor().advance(1, opts), []
+    schedule = Fixed(opts)
+    c, seen = schedule.advance(Cursor(), 1, -0.5, 0.0), []
     while c.phase != "done":
         seen.append((c.phase, c.sweep, c.index, c.cycle))
-        c = c.advance(1, opts)
+        c = schedule.advance(c, 1, -0.5, 0.0)
     assert seen == [(phase, 0, 0, cycle) for cycle in range(3) for phase in ("sweep", "polish")]
     assert Cursor(**{"phase": "polish", "sweep": 0, "index": 0}).cycle == 0  # checkpoints before cycles
 
 
 def test_each_cycle_grows_past_the_size_and_prunes_back_first():
     opts = resolved(Optimiser(size=3, prune=2, refine=1, cycles=2), prebo.System(["p", "e"]))
-    c, seen, nb = Cursor().advance(0, opts), [], 0
+    schedule = Fixed(opts)
+    c, seen, nb = schedule.first(), [], 0
     while c.phase != "done":
         seen.append((c.phase, c.index, c.cycle, nb))
         nb += 1 if c.phase == "grow" or (c.phase == "prune" and c.index == 0) else -1 if c.phase == "prune" else 0
-        c = c.advance(nb, opts)
+        c = schedule.advance(c, nb, -0.5, 0.0)
     block = [("prune", 0, 3), ("prune", 0, 4), ("prune", 1, 5), ("prune", 1, 4)] + [("refine", i, 3) for i in range(3)]
     assert seen == [("grow", 0, 0, k) for k in range(3)] + [(p, i, cycle, n) for cycle in (0, 1)
                                                            for p, i, n in block]
@@ -120,7 +137,7 @@ def test_pruning_removes_the_function_that_costs_least():
     from prebo import eigen
     from prebo.integrals import laboratory
     from prebo.optimise import Expansion
-    from prebo.optimise.methods import Grow, Prune, Refinement, Run
+    from prebo.optimise.methods import Grow, Minimiser, PruneStep, Run
     from prebo.optimise.report import Reporter
     basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json").subset(np.arange(40))
     ex = Expansion(basis, laboratory(basis.system), 1e-13)
@@ -134,7 +151,7 @@ def test_pruning_removes_the_function_that_costs_least():
     partner = int(np.argmax(overlap)) - (int(np.argmax(overlap)) > cheapest)  # its index after the removal
     kept = ex.basis.subset(np.flatnonzero(np.arange(40) != cheapest))
     opts = resolved(Optimiser(size=39, prune=1, refine=1), basis.system)
-    Prune(Grow(5), Refinement(5, "gradient")).step(Run(ex, None, Reporter(opts, False, 40)), Cursor("prune", index=1))
+    PruneStep(Grow(5), Minimiser(5, "gradient")).step(Run(ex, None, Reporter(opts, False, 40)), Cursor("prune", index=1))
     moved = [k for k in range(39) if not np.array_equal(ex.basis.A[k], kept.A[k])]
     assert len(ex.basis) == 39 and moved == [partner] and ex.energy < fresh[cheapest]
     rebuilt = laboratory(basis.system).matrices(ex.basis)
@@ -142,19 +159,20 @@ def test_pruning_removes_the_function_that_costs_least():
 
 
 def test_each_phase_has_its_method_configured_by_the_settings():
-    from prebo.optimise import Grow, Polish, Refine, Refinement, Sweep
-    from prebo.optimise.methods import Extrapolate, Prune, methods
+    from prebo.optimise import Grow, Minimiser, MomentumMove, Polish, PrunePass, PruneStep, Refine, Replace
+    from prebo.optimise.methods import methods
     he = prebo.System(["alpha", "e", "e"])
     plain = methods(resolved(Optimiser(trials=7, polish_iterations=9, sweeps=0), he))
-    assert plain == {"grow": Grow(7), "prune": Prune(Grow(7), Refinement(200, "gradient")), "sweep": Sweep(7),
-                     "refine": Refine(Refinement(200, "gradient")), "polish": Polish(9)}
+    assert plain == {"grow": Grow(7), "prune": PruneStep(Grow(7), Minimiser(200, "gradient")), "sweep": Replace(7),
+                     "refine": Refine(Minimiser(200, "gradient")), "polish": Polish(9)}
     refined = methods(Optimiser(trials=3, refine=1, refine_evaluations=40, refine_method="powell"))
-    assert refined["grow"] == Grow(3, Refinement(40, "powell")) and refined["sweep"].refine == Refinement(40, "powell")
+    assert refined["grow"] == Grow(3, Minimiser(40, "powell")) and refined["sweep"].newcomer == Minimiser(40, "powell")
     grouped = methods(Optimiser(refine=1, refine_evaluations=40, refine_group=2))  # refinement sweeps only
-    assert grouped["refine"] == Refine(Refinement(40, "gradient", 2)) and grouped["sweep"].refine == Refinement(40, "gradient")
+    assert grouped["refine"] == Refine(Minimiser(40, "gradient", 2)) and grouped["sweep"].newcomer == Minimiser(40, "gradient")
     adaptive = methods(resolved(Optimiser(trials=5), he))  # the adaptive schedule refines every new function
-    assert adaptive["grow"] == Grow(5, Refinement(30, "gradient")) and adaptive["sweep"] == Sweep(5, Refinement(30, "gradient"))
-    assert adaptive["momentum"] == Extrapolate() and "momentum" not in plain  # the adaptive schedule's moves
+    assert adaptive["grow"] == Grow(5, Minimiser(30, "gradient")) and adaptive["sweep"] == Replace(5, Minimiser(30, "gradient"))
+    assert adaptive["prune"] == PrunePass(PruneStep(Grow(5, Minimiser(30, "gradient")), Minimiser(30, "gradient", 3)))
+    assert adaptive["momentum"] == MomentumMove() and "momentum" not in plain  # the adaptive schedule's moves
 
 
 def test_refinement_and_learning_lower_the_energy():
@@ -271,7 +289,7 @@ def test_a_function_perturbed_at_its_own_scale_keeps_its_channel_and_tail(kind, 
 def test_an_adaptive_sweep_tries_moves_of_the_function_it_may_replace():
     from prebo.integrals import laboratory
     from prebo.optimise import Expansion
-    from prebo.optimise.methods import Run, Sweep
+    from prebo.optimise.methods import Replace, Run
     from prebo.optimise.report import Reporter
     from prebo.optimise.sampler import Sampler
     basis = prebo.Basis.load(ROOT / "examples" / "bases" / "he" / "basis.json")
@@ -281,7 +299,7 @@ def test_an_adaptive_sweep_tries_moves_of_the_function_it_may_replace():
     perturbed = sampler.perturbed
     sampler.perturbed = lambda f, k: seen.append((f, k)) or perturbed(f, k)
     with Reporter(Optimiser(size=len(basis)), False) as report:
-        Sweep(10).step(Run(ex, sampler, report), Cursor("sweep", index=4))
+        Replace(10).step(Run(ex, sampler, report), Cursor("sweep", index=4))
     (f, k), = seen
     assert k == 10 and np.array_equal(f.A, basis.subset([4]).A)  # plain ECGs: no neighbours in K
 
@@ -322,7 +340,7 @@ def test_a_growth_step_refines_the_newcomer_before_it_joins_and_solves_once(monk
     from prebo import eigen
     from prebo.integrals import laboratory
     from prebo.optimise import Expansion
-    from prebo.optimise.methods import Grow, Refinement, Run
+    from prebo.optimise.methods import Grow, Minimiser, Run
     from prebo.optimise.report import Reporter
     from prebo.optimise.sampler import Sampler
     system = prebo.System(["p", "e", "e"], spin={"e": 0})
@@ -334,7 +352,7 @@ def test_a_growth_step_refines_the_newcomer_before_it_joins_and_solves_once(monk
     raw = float(np.min(ex.candidates(trials)[0]))
     solves, solve = [], eigen.solve
     monkeypatch.setattr(eigen, "solve", lambda *a, **k: solves.append(1) or solve(*a, **k))
-    Grow(5, Refinement(30, "gradient")).step(Run(ex, sampler, Reporter(opts, False, 6)), Cursor("grow", sweep=7))
+    Grow(5, Minimiser(30, "gradient")).step(Run(ex, sampler, Reporter(opts, False, 6)), Cursor("grow", sweep=7))
     assert len(ex.basis) == 7 and len(solves) == 1
     assert ex.energy < raw - 1e-9
 
@@ -353,6 +371,22 @@ def test_a_checkpoint_has_a_line_per_key_and_per_function():
     assert d["functions"] == json.loads((ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json").read_text())["functions"]
     lines = text.splitlines()
     assert len(lines) == 2 + len(d) + 1 + len(d["functions"])  # braces, keys, the list's closing bracket
+
+
+def test_history_rows_are_named_in_memory_and_stored_as_they_were(tmp_path):
+    """history.Step names a row's fields; written back, a checkpoint's rows are the lists it held,
+    a row per line, the three-long rows of checkpoints before wall times included."""
+    from prebo.io.files import write_json_atomic
+    from prebo.optimise.history import Step, check_history
+    rows = [[1, -0.4, "grow"], [2, -0.45, "grow", 1.5], [2, -0.47, "refine", 3.0]]
+    steps = [Step(*row) for row in check_history(json.loads(json.dumps(rows)))]
+    assert [(h.size, h.energy, h.phase, h.seconds) for h in steps] == [(1, -0.4, "grow", None), (2, -0.45, "grow", 1.5),
+                                                                        (2, -0.47, "refine", 3.0)]
+    assert steps[1] == Step(2, -0.45, "grow", 1.5) and len(Step(1, -0.4, "grow")) == 3
+    write_json_atomic(tmp_path / "h.json", {"history": steps})
+    written = (tmp_path / "h.json").read_text()
+    write_json_atomic(tmp_path / "h.json", {"history": rows})
+    assert written == (tmp_path / "h.json").read_text() and len(written.splitlines()) == 4 + len(rows)  # a row per line
 
 
 def test_a_function_grown_past_the_size_is_refined_with_its_partners(monkeypatch):
@@ -375,7 +409,7 @@ def test_a_function_grown_past_the_size_is_refined_with_its_partners(monkeypatch
 
 
 def test_an_adaptive_pruning_keeps_the_size_and_is_undone_unless_it_gains(monkeypatch):
-    """The adaptive schedule's pruning (methods.Pruning) grows pruned(N_b) functions past the size
+    """The adaptive schedule's pruning (methods.PrunePass) grows pruned(N_b) functions past the size
     and removes as many in one step; removing the dearest function instead of the cheapest makes it
     lose, and the basis before it comes back, bit for bit."""
     from prebo.integrals import laboratory
@@ -386,7 +420,7 @@ def test_an_adaptive_pruning_keeps_the_size_and_is_undone_unless_it_gains(monkey
     system = prebo.System(["p", "e", "e"], spin={"e": 0})
     basis = prebo.optimise(system, Optimiser(size=20, trials=5, seed=4, sweeps=0), progress=False)  # grown only
     opts = resolved(Optimiser(size=20, trials=10, seed=5), system)
-    assert opts.adaptive and isinstance(m.methods(opts)["prune"], m.Pruning)
+    assert opts.adaptive and isinstance(m.methods(opts)["prune"], m.PrunePass)
     ex = Expansion(basis, laboratory(system), 1e-13)
     run = m.Run(ex, Sampler(system, opts, np.random.default_rng(5)), Reporter(opts, False, 20),
                 momentum=m.Momentum(basis))
@@ -409,11 +443,11 @@ def test_a_run_that_stops_above_its_lowest_state_returns_that_state_and_keeps_it
     """A fixed-schedule pruning that raises the energy (made to remove the dearest functions)
     leaves the run above the state it pruned: the run returns that state, out/lowest.json holds
     it beside the checkpoint, and a resumed run returns it too."""
-    from prebo.optimise import methods as m
+    from prebo import eigen
     from prebo.optimise import optimise, resume_from
 
-    without = m.eigen.lowest_without_each
-    monkeypatch.setattr(m.eigen, "lowest_without_each", lambda E, C: -without(E, C))
+    without = eigen.lowest_without_each
+    monkeypatch.setattr(eigen, "lowest_without_each", lambda E, C: -without(E, C))
     system = prebo.System(["p", "e"])
     basis = optimise(system, Optimiser(size=3, prune=2, cycles=1, trials=5, seed=3), out=tmp_path, progress=False)
     checkpoint = json.loads((tmp_path / "basis.json").read_text())
@@ -461,16 +495,16 @@ def test_optimise_refuses_an_empty_out_and_resume_from_a_folder_that_is_not_a_pa
 
 
 def test_lowest_json_is_written_when_the_run_leaves_its_lowest_state_and_removed_when_it_is_back(tmp_path):
-    """checkpoint.Lowest: a state above the lowest, or of more than `size` functions, writes the
+    """lowest.Lowest: a state above the lowest, or of more than `size` functions, writes the
     lowest to lowest.json; a state as low at the size removes it; a fresh run's tracker removes a
     file an earlier run left, a resumed run's reads it back and refuses one of another system."""
     from types import SimpleNamespace
-    from prebo.optimise.checkpoint import Lowest
+    from prebo.optimise.lowest import Lowest
 
     basis = prebo.Basis.load(ROOT / "examples/bases/h/basis.json")
 
     def state(n, energy):
-        return SimpleNamespace(basis=basis.subset(slice(0, n)), energy=energy, eig=SimpleNamespace(vectors=np.eye(n)))
+        return SimpleNamespace(basis=basis.subset(slice(0, n)), energy=energy, coefficients=np.eye(n)[:, 0])
 
     lowest, path = Lowest(basis, 3, tmp_path, {"optimiser": {}}, resumed=False), tmp_path / "lowest.json"
     lowest.see(state(3, -0.4))

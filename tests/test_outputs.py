@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 import prebo
 from prebo.cli import main
 from prebo.errors import InputError, OutputError
-from prebo.optimise.checkpoint import PHASES
+from prebo.optimise.cursor import PHASES
 
 ROOT = Path(__file__).resolve().parents[1]
 LI = ROOT / "tests" / "data" / "ecgpack" / "ecgpack-Li7-100.inout.txt"

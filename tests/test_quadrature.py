@@ -67,6 +67,8 @@ from scipy.integrate import quad
 import prebo
 from prebo.integrals import laboratory
 
+from conftest import pair_A
+
 RTOL = 1e-8
 N_GH = 20  # Gauss-Hermite nodes per dimension
 BETA = 0.8  # quadrature weight exp(-BETA u^T (A_I + A_J) u): not the integrand's own
@@ -92,20 +94,16 @@ SYSTEMS = {
 
 
 def make_basis(system, nb=3, seed=0):
-    """nb exponent matrices A = Σ_{i<j} α_ij (e_i-e_j)(e_i-e_j)^T + c_A (m/m_tot)(m/m_tot)^T."""
+    """nb exponent matrices A = Σ_{i<j} α_ij (e_i-e_j)(e_i-e_j)^T + c_A (m/m_tot)(m/m_tot)^T (conftest.pair_A)."""
     rng = np.random.default_rng(seed)
     n = system.n
-    u = system.masses / system.m_total
+    u = system.cm_vector
     As, cs = [], []
     for b in range(nb):
         scale = [0.3, 1.0, 2.5, 0.6][b % 4]  # functions of quite different size
-        A = np.zeros((n, n))
-        for i, j in itertools.combinations(range(n), 2):
-            e = np.zeros(n)
-            e[i], e[j] = 1.0, -1.0
-            A += scale * rng.uniform(0.2, 1.5) * np.outer(e, e)
+        A = pair_A(system, {p: scale * rng.uniform(0.2, 1.5) for p in itertools.combinations(range(n), 2)}, 0.0)
         c = rng.uniform(0.3, 2.0)
-        A += c * np.outer(u, u)
+        A += c * np.outer(u, u)  # the CM term last, as these bases were always summed
         As.append(A)
         cs.append(c)
     A, c = np.array(As), np.array(cs)

@@ -1,6 +1,6 @@
 """The schedule that chooses itself (issue 17): settings chosen from the physics (optimise.defaults),
 sampling lengths from each pair's Bohr radius (sampler.pair_lengths), the adaptive schedule
-(optimise.schedule), the wall-time budget and the convergence report (optimise.convergence)."""
+(optimise.adaptive), the wall-time budget and the convergence report (optimise.convergence)."""
 import json
 import subprocess
 import sys
@@ -17,7 +17,8 @@ from prebo.optimise.convergence import convergence
 from prebo.optimise.defaults import GROUP, TRIALS, resolved
 from prebo.optimise.sampler import pair_lengths
 from prebo.optimise.momentum import EVERY
-from prebo.optimise.schedule import CHUNK, PRUNE, RATIO, REVISIT, Adaptive, pruned
+from prebo.optimise.adaptive import CHUNK, PRUNE, RATIO, REVISIT, Adaptive, Pass, pruned
+from prebo.optimise.history import Step
 
 from conftest import ROOT
 
@@ -108,18 +109,18 @@ def test_the_sampler_draws_every_pair_within_its_range():
 def passes(schedule, *rows):
     """Record passes (kind, nb, gain, seconds) one after another, as the driver would (the first
     from no function: no energy before it)."""
-    E, t = (schedule.passes[-1][3], schedule.passes[-1][5]) if schedule.passes else (None, 0.0)
+    E, t = (schedule.passes[-1].after, schedule.passes[-1].end) if schedule.passes else (None, 0.0)
     for kind, nb, gain, seconds in rows:
         after = -1.0 if E is None else E - gain
-        schedule.passes.append([kind, nb, E, after, t, t + seconds, nb if kind in ("grow", "polish", "prune") else
-                                min(CHUNK, nb)])
+        schedule.passes.append(Pass(kind, nb, E, after, t, t + seconds, nb if kind in ("grow", "polish", "prune") else
+                                    min(CHUNK, nb)))
         E, t = after, t + seconds
     return E
 
 
 def now(schedule):
     """The seconds of the run at the end of the last recorded pass."""
-    return schedule.passes[-1][5] if schedule.passes else 0.0
+    return schedule.passes[-1].end if schedule.passes else 0.0
 
 
 def test_growth_first_then_every_kind_once_then_the_best_rate():
@@ -144,7 +145,7 @@ def test_a_pass_ends_after_a_chunk_and_the_next_sweep_goes_on_where_it_stopped()
         c = s.advance(c, 120, -3.0, 20.0)
         assert (c.phase, c.sweep, c.index) == ("refine", k + 1, (101 + k) % 120)
     c = s.advance(c, 120, -3.0, 20.0)
-    assert s.passes[-1][0] == "refine" and s.passes[-1][6] == CHUNK and c.cycle == 5
+    assert s.passes[-1].kind == "refine" and s.passes[-1].functions == CHUNK and c.cycle == 5
     assert s.next["refine"] == (100 + CHUNK) % 120 and s.begin("refine", 120, 6).index == 30
     grow = Cursor("grow", sweep=10, cycle=7)
     assert s.advance(grow, 9, -3.0, 21.0) == grow  # growth goes on to its target size
@@ -157,7 +158,7 @@ def test_a_pruning_is_one_pass_of_one_step_at_full_size():
     assert pruned(120) == 12 and pruned(500) == PRUNE and pruned(5) == 1
     c = s.advance(s.begin("prune", 120, 4), 120, -3.5, 6.0)
     p = s.passes[-1]
-    assert (p[0], p[1], p[3], p[5], p[6]) == ("prune", 120, -3.5, 6.0, 120) and c.cycle == 5  # visits every function
+    assert (p.kind, p.size, p.after, p.end, p.functions) == ("prune", 120, -3.5, 6.0, 120) and c.cycle == 5  # visits every function
 
 
 def test_at_full_size_the_basis_moves_on_after_every_EVERY_passes_that_moved_functions_since_a_move_or_pruning():
@@ -171,7 +172,7 @@ def test_at_full_size_the_basis_moves_on_after_every_EVERY_passes_that_moved_fun
     E = passes(s, ("sweep", 120, 1e-3, 1.0))
     assert s.choose(120, E, now(s)) == "momentum" and s.choose(119, E, now(s)) != "momentum"  # full size only
     c = s.advance(s.begin("momentum", 120, 9), 120, E - 1e-2, now(s) + 1.0)
-    assert s.passes[-1][0] == "momentum" and s.passes[-1][6] == 120 and c.phase == "refine"  # its rate is not used
+    assert s.passes[-1].kind == "momentum" and s.passes[-1].functions == 120 and c.phase == "refine"  # its rate is not used
     E = passes(s, *[("refine", 120, 1e-3, 1.0)] * (EVERY - 1), ("prune", 120, 1e-3, 1.0), ("refine", 120, 1e-3, 1.0))
     assert s.choose(120, E, now(s)) != "momentum"  # counted again from the pruning
     assert Adaptive.check(s.opts, json.loads(json.dumps(s.to_dict()))).passes == s.passes
@@ -242,7 +243,9 @@ def test_a_budget_overrides_exhaustion_until_the_time_left_would_gain_less_than_
     end = 600.0 - 0.5 * tolerance / (0.9 * RATIO * 1e-3)  # half the tolerance left to gain
     assert s.choose(100, E, end) is None and s.stopped == "budget"
     s.opts = replace(s.opts, budget=1200.0)  # resumed with a larger budget (driver.optimise): it goes on
-    assert s.reopen(100, E, end).phase in ("refine", "sweep", "polish", "prune")
+    cursor, stopped = s.resume(Cursor("done"), "budget", 100, E, end)
+    assert cursor.phase in ("refine", "sweep", "polish", "prune") and stopped is None
+    assert s.resume(Cursor("done"), "converged", 100, E, end) == (Cursor("done"), "converged")  # it stays converged
 
 
 def test_a_budget_is_used_while_the_passes_still_gain():
@@ -251,7 +254,7 @@ def test_a_budget_is_used_while_the_passes_still_gain():
     (the old default tolerance, 1e-10 |E| = 2.9e-10 Eh, called it converged)."""
     he = prebo.System(["alpha", "e", "e"], spin={"e": 0})
     s = Adaptive(resolved(Optimiser(size=700, budget=300.0), he))
-    s.passes.append(["grow", 700, -2.9033045, -2.9033045575, 0.0, 150.0, 700])
+    s.passes.append(Pass("grow", 700, -2.9033045, -2.9033045575, 0.0, 150.0, 700))
     E = passes(s, ("refine", 700, 2e-12, 10.0), ("sweep", 700, 2e-12, 12.0), ("polish", 700, 1e-13, 10.0),
                ("prune", 700, 1e-12, 10.0))
     assert 700 / CHUNK * 2e-12 < 1e-10 * abs(E) and now(s) == 192.0
@@ -288,21 +291,22 @@ def test_a_malformed_schedule_block_is_refused(block):
     with pytest.raises(ValueError, match="schedule must be"):
         Adaptive.check(Optimiser(), block)
     good = {"passes": [["grow", 1, None, -1.0, 0.0, 1.0, 1]], "start": [-1.0, 1.0], "next": {"refine": 0, "sweep": 0}}
-    assert Adaptive.check(Optimiser(), good).passes == good["passes"]
+    assert Adaptive.check(Optimiser(), good).passes == [Pass("grow", 1, None, -1.0, 0.0, 1.0, 1)]
+    assert json.loads(json.dumps(Adaptive.check(Optimiser(), good).to_dict())) == good | {"stalled": None, "restarts": 0}
 
 
 # --- the convergence report ------------------------------------------------------------------
 def test_the_extrapolation_is_exact_for_geometrically_falling_gains():
     """Gains falling by q per equal span of time: Aitken's Δ² gives the remaining g q/(1 − q) exactly."""
     E_inf, q = -2.0, 0.5
-    history = [[5, -1.0, "grow", 1.0]] + [[10, E_inf + q ** (k / 10), "refine", 10.0 + k] for k in range(31)]
+    history = [Step(5, -1.0, "grow", 1.0)] + [Step(10, E_inf + q ** (k / 10), "refine", 10.0 + k) for k in range(31)]
     r = convergence(history, Optimiser(), "exhausted", 40.0)
-    assert r["extrapolation"]["remaining"] == pytest.approx(history[-1][1] - E_inf, rel=1e-12)
+    assert r["extrapolation"]["remaining"] == pytest.approx(history[-1].energy - E_inf, rel=1e-12)
     assert r["extrapolation"]["energy"] == pytest.approx(E_inf, rel=1e-12)
     assert "not the error against the exact energy" in r["extrapolation"]["caveat"]
-    assert r["recent"]["steps"] == 10 and r["recent"]["gain"] == pytest.approx(history[-11][1] - history[-1][1])
+    assert r["recent"]["steps"] == 10 and r["recent"]["gain"] == pytest.approx(history[-11].energy - history[-1].energy)
     assert r["recent"]["rate"] == pytest.approx(r["recent"]["gain"] / 10.0)
-    rising = [[10, -1.0 - 0.01 * k * k, "refine", float(k)] for k in range(30)]  # gains not yet falling
+    rising = [Step(10, -1.0 - 0.01 * k * k, "refine", float(k)) for k in range(30)]  # gains not yet falling
     assert convergence(rising, Optimiser(), "budget", 30.0)["extrapolation"] is None
 
 
@@ -334,8 +338,16 @@ def test_an_input_without_optimiser_table_runs_to_an_exhausted_basis_with_a_repo
                             "--quiet"], capture_output=True, text=True, timeout=600)
     assert again.returncode == 0, again.stderr
     more = json.loads((tmp_path / "he" / "basis.json").read_text())
-    assert more["stopped"] in ("budget", "converged") and len(more["schedule"]["passes"]) > len(d["schedule"]["passes"])
-    assert more["elapsed"] >= d["elapsed"] and more["energy"] <= d["energy"]
+    assert more["stopped"] in ("budget", "converged") and more["elapsed"] >= d["elapsed"] and more["energy"] <= d["energy"]
+    # the budget overrides exhaustion while the best kind's last rate buys a gain of the tolerance in
+    # the 1.5 s: then the run goes on (passes ended, or one in flight when the budget ran out, its
+    # cursor kept); else it ends at once as the budget's end (which of the two depends on the
+    # measured seconds of the first run)
+    schedule = Adaptive.check(resolved(Optimiser(size=24), prebo.System(["alpha", "e", "e"], spin={"e": 0})),
+                              d["schedule"])
+    buys = schedule.best() * (budget - d["elapsed"]) >= schedule.tolerance(d["energy"])
+    went_on = len(more["schedule"]["passes"]) > len(d["schedule"]["passes"]) or more["progress"]["phase"] != "done"
+    assert went_on == buys and (buys or more["stopped"] == "budget"), (schedule.best(), more["stopped"])
 
 
 def test_the_budget_stops_a_run_and_a_resumed_adaptive_run_goes_on(tmp_path):
@@ -376,18 +388,21 @@ def test_growth_that_stalls_ends_at_the_size_reached_in_an_adaptive_schedule(tmp
 def test_the_convergence_report_starts_after_the_last_pruning():
     """A basis grown past its size and pruned back starts again from a higher energy: the recent
     gain and the extrapolation are those of the steps since, never a loss across the pruning."""
-    grown = [[3, -1.0, "grow", 1.0], [4, -1.2, "prune", 2.0], [5, -1.3, "prune", 3.0]]
-    since = [[3, -1.1 - 0.1 * (1 - 0.5**k), "refine", 4.0 + k] for k in range(7)]
+    grown = [Step(3, -1.0, "grow", 1.0), Step(4, -1.2, "prune", 2.0), Step(5, -1.3, "prune", 3.0)]
+    since = [Step(3, -1.1 - 0.1 * (1 - 0.5**k), "refine", 4.0 + k) for k in range(7)]
     report = convergence(grown + since, Optimiser(size=3, prune=2, refine=1), "schedule", 11.0)
-    assert report["recent"]["steps"] == 6 and report["recent"]["gain"] == pytest.approx(since[0][1] - since[-1][1])
+    assert report["recent"]["steps"] == 6 and report["recent"]["gain"] == pytest.approx(since[0].energy - since[-1].energy)
     assert report["extrapolation"]["energy"] == pytest.approx(-1.2, abs=2e-3)
 
 
 def test_growth_starts_afresh_once_when_it_settles_on_a_fragment_and_a_distant_particle():
     """At min(size, RESTART_AT) functions, just grown and not bound: a fresh start, RESTARTS at most."""
     s = Adaptive(resolved(Optimiser(size=40), prebo.System(["p", "d", "e"])))
-    assert s.restart(20, -0.4998, -0.4998) and not s.restart(20, -0.5, -0.4998) and not s.restart(19, -0.1, -0.4998)
-    assert not Adaptive(s.opts, restarts=2).restart(20, -0.1, -0.4998)
+    fresh = s.restart("grow", 20, -0.4998, -0.4998)
+    assert fresh.restarts == 1 and fresh.passes == [] and fresh.first() == s.first()
+    assert s.restart("grow", 20, -0.5, -0.4998) is None and s.restart("grow", 19, -0.1, -0.4998) is None
+    assert s.restart("refine", 20, -0.1, -0.4998) is None  # only just grown
+    assert Adaptive(s.opts, restarts=2).restart("grow", 20, -0.1, -0.4998) is None
     assert Adaptive.check(s.opts, Adaptive(s.opts, restarts=1).to_dict()).restarts == 1
 
 

@@ -12,7 +12,7 @@ import prebo
 from conftest import ROOT
 from prebo.cli import main
 from prebo.errors import InputError
-from prebo.io import basis_json, toml
+from prebo.io import toml
 from prebo.system.particles import KNOWN
 from prebo.thresholds import hydrogen_like, lowest
 from test_validation import cli_error, toml_text
@@ -97,7 +97,7 @@ def test_toml_threshold_reaches_the_run_and_its_result(tmp_path, capsys):
     assert r["thresholds"] == {"p-e + e": pytest.approx(-mu(M["p"], 1) / 2, rel=1e-14), "given": -0.6}
     assert r["bound"] is False and r["binding_energy"] == pytest.approx(-0.6 - r["energy"], rel=1e-14)
     assert err.startswith("prebo: warning: E = ") and "(given)" in err and err.count("\n") == 1, err
-    assert basis_json.load(tmp_path / "out" / "basis.json").system.state.threshold == -0.6
+    assert prebo.Basis.load(tmp_path / "out" / "basis.json").system.state.threshold == -0.6
 
 
 # --- bound or not: an atom plus a distant particle ------------------------------------------

@@ -52,7 +52,7 @@ def _print_result(r: dict) -> None:
     from rich.table import Table
 
     from .optimise.convergence import STOPPED
-    from .optimise.schedule import RATIO
+    from .optimise.adaptive import RATIO
 
     t = Table(show_header=False, box=None)
     t.add_row("energy (translation-free)", f"{r['energy']:.12f} Eh")
@@ -137,7 +137,7 @@ def cmd_run(args) -> int:
     basis. The run owns DIR from before it looks into it until it ends (io/lock.py). A new run
     refuses a DIR that holds an earlier run's outputs unless `--force` (`claim`). Returns the exit
     status 0."""
-    from .io.basis_json import write_json_atomic
+    from .io.files import write_json_atomic
     from .errors import InputError, StalledError
     from .io import toml
     from .io.lock import owned
@@ -280,6 +280,7 @@ def load_basis(path) -> tuple:
     """A basis.json, or an ecgpack ``*.inout.txt`` (recognised by its name), and the overlap
     threshold of the code that wrote it: a run's (its "optimiser" block), else eigen.THRESHOLD
     (every direction double precision resolves, as ecgpack keeps them)."""
+    from .basis import Basis
     from .eigen import THRESHOLD
     from .errors import InputError
     from .io import basis_json
@@ -290,7 +291,7 @@ def load_basis(path) -> tuple:
     if str(path).endswith(".toml"):
         raise InputError(f"{path}: a TOML input, not a basis; optimise it with `prebo run {path}`")
     d = basis_json.read(path)
-    basis = basis_json.from_dict(d, str(path))  # d, its settings included, is checked from here on
+    basis = Basis.from_dict(d, str(path))  # d, its settings included, is checked from here on
     return basis, (d.get("optimiser") or {}).get("threshold", THRESHOLD)
 
 

@@ -324,12 +324,13 @@ def lowest_without_each(E: np.ndarray, C: np.ndarray) -> np.ndarray:
     return hi
 
 
-def lowest_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10) -> np.ndarray:
-    """`lowest_with_added` for k trials at once: rows H, S (k x nb), diagonals h_nn, s_nn (k)."""
+def lowest_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10, root: int = 0) -> np.ndarray:
+    """`lowest_with_added` for k trials at once: rows H, S (k x nb), diagonals h_nn, s_nn (k); with
+    `root` > 0, eigenvalue `root` instead of the lowest (module docstring: the roots interlace)."""
     c = np.ascontiguousarray
     E = c(E, dtype=float)
     C = c(np.asarray(C, dtype=float).reshape(-1, len(E)) if len(E) else np.zeros((0, 0)))
-    out = _core.lowest_with_added(E, C, c(H, dtype=float), c(S, dtype=float), c(h_nn, dtype=float),
-                                  c(s_nn, dtype=float), float(min_norm))
+    out = _core.root_with_added(E, C, c(H, dtype=float), c(S, dtype=float), c(h_nn, dtype=float),
+                                c(s_nn, dtype=float), float(min_norm), root)
     out[~np.isfinite(out)] = np.inf  # NaN elements (a near-singular trial) never win
     return out

@@ -23,9 +23,10 @@ FORMATS = (".png", ".pdf", ".svg")
 def history(folder: Path) -> list:
     """The optimisation history of the run checkpoint folder/basis.json: rows [basis size,
     energy (Eh), phase, wall time (s) when recorded]; BasisFileError naming the file (and the
-    row: checkpoint.check_history) if there is none or a row is not one."""
+    row: history.check_history) if there is none or a row is not one."""
     from .io.basis_json import read
-    from .optimise.checkpoint import CHECKPOINT, check_history
+    from .optimise.checkpoint import CHECKPOINT
+    from .optimise.history import check_history
 
     path = Path(folder) / CHECKPOINT
     d = read(path)
@@ -63,7 +64,7 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None, 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .io.basis_json import write_atomic
+    from .io.files import write_atomic
 
     runs = [(Path(folder).name, history(folder)) for folder in folders]
     if start is not None:

@@ -3,13 +3,18 @@
 //! An optimiser evaluates many trials against one basis: every energy of a refinement, every
 //! trial of a replacement. The basis's symmetry images (`TᵀAT`, their Cholesky factors and
 //! normalisations) and the kernels' prepared forms of them do not depend on the trial, so an
-//! `Engine` keeps the last few, keyed by the exact bits of the basis parameters and the type
-//! of the preparation: a hit gives what a rebuild would, bit for bit.
+//! `Engine` keeps the last few, keyed by the exact bits of the basis parameters (`Keyed`) and the
+//! type of the preparation: a hit gives what a rebuild would, bit for bit.
 use std::any::{Any, TypeId};
 use std::sync::{Arc, Mutex};
 
 use crate::error::Result;
-use crate::family::Params;
+
+/// Parameters as a cache key: every value's exact bits, and enough lengths that two different
+/// parameter sets never give the same key.
+pub trait Keyed {
+    fn key(&self) -> Vec<u64>;
+}
 
 /// Preparations kept (most recent first): a refinement alternates at most a row and a row
 /// gradient against one basis, a sweep moves on to the next.
@@ -26,11 +31,8 @@ struct Key {
 }
 
 impl Key {
-    fn new<T: Any>(p: &Params) -> Self {
-        let floats = p.a.iter().chain(p.c_a).chain(p.v).map(|x| x.to_bits());
-        let lengths = [p.a.len(), p.c_a.len(), p.v.len()].map(|n| n as u64);
-        let bits = lengths.into_iter().chain(floats).chain(p.k_pow.iter().map(|&k| k as u64)).collect();
-        Self { ty: TypeId::of::<T>(), bits }
+    fn new<T: Any>(p: &(impl Keyed + ?Sized)) -> Self {
+        Self { ty: TypeId::of::<T>(), bits: p.key() }
     }
 }
 
@@ -42,7 +44,11 @@ pub struct Cache {
 
 impl Cache {
     /// The preparation `T` of the basis `p`: the kept one, or `build()` (kept if it succeeds).
-    pub fn get<T: Any + Send + Sync>(&self, p: &Params, build: impl FnOnce() -> Result<T>) -> Result<Arc<T>> {
+    pub fn get<T: Any + Send + Sync>(
+        &self,
+        p: &(impl Keyed + ?Sized),
+        build: impl FnOnce() -> Result<T>,
+    ) -> Result<Arc<T>> {
         let key = Key::new::<T>(p);
         let mut entries = self.lock();
         if let Some(at) = entries.iter().position(|(k, _)| *k == key) {
@@ -79,8 +85,21 @@ impl std::fmt::Debug for Cache {
 mod tests {
     use super::*;
 
+    /// Parameters `A` and `c_A`, keyed as `families::Exponents`.
+    struct Params<'a> {
+        a: &'a [f64],
+        c_a: &'a [f64],
+    }
+
+    impl Keyed for Params<'_> {
+        fn key(&self) -> Vec<u64> {
+            let lengths = [self.a.len() as u64, self.c_a.len() as u64];
+            lengths.into_iter().chain(self.a.iter().chain(self.c_a).map(|x| x.to_bits())).collect()
+        }
+    }
+
     fn params<'a>(a: &'a [f64], c: &'a [f64]) -> Params<'a> {
-        Params { a, c_a: c, ..Default::default() }
+        Params { a, c_a: c }
     }
 
     #[test]

@@ -8,6 +8,10 @@ use std::ops::{Add, Div, Mul, Sub};
 use nalgebra::{Cholesky, RealField, SMatrix, SVector};
 
 use crate::error::{CoreError, Result};
+use crate::scalar::Scalar;
+
+/// Largest number of coordinates compiled (laboratory frame: particles).
+pub const MAX_DIM: usize = 8;
 
 pub type Mat<const D: usize> = SMatrix<f64, D, D>;
 pub type Vector<const D: usize> = SVector<f64, D>;
@@ -23,6 +27,7 @@ pub trait Real:
     + Mul<f64, Output = Self>
     + Div<f64, Output = Self>
     + Value
+    + Scalar
 {
 }
 
@@ -35,6 +40,7 @@ impl<T> Real for T where
         + Mul<f64, Output = T>
         + Div<f64, Output = T>
         + Value
+        + Scalar
 {
 }
 
@@ -88,14 +94,6 @@ impl<const D: usize> Gaussian<D> {
     pub fn new(a: Mat<D>, c_a: f64, index: usize) -> Result<Self> {
         let log_det = log_det_pd(&a).ok_or(CoreError::NotPositiveDefinite { function: index })?;
         Ok(Self { a, log_det, c_a })
-    }
-
-}
-
-impl<const D: usize, Ctx> crate::images::Transform<D, Ctx> for Gaussian<D> {
-    /// The permuted (or otherwise linearly transformed) function `phi(T r)`: `A -> T^T A T`.
-    fn transformed(&self, t: &Mat<D>, _: &Ctx, index: usize) -> Result<Self> {
-        Self::new(t.transpose() * self.a * t, self.c_a, index)
     }
 }
 
@@ -165,6 +163,31 @@ pub struct Operators<const D: usize> {
     /// Total mass for the c_A elimination of the CM kinetic energy (paper eq. ecg-transl);
     /// `None` when the coordinates carry no CM part.
     pub cm_mass: Option<f64>,
+}
+
+/// The Coulomb pairs in the kernels' form: per pair `2 q` and the non-zero terms `(a, b, f)`,
+/// `a <= b`, `f = w_a w_b` (doubled off the diagonal), so that `wᵀBw = Σ f B_ab`.
+pub type CoulombTerms = Vec<(f64, Vec<(usize, usize, f64)>)>;
+
+impl<const D: usize> Operators<D> {
+    /// The Coulomb pairs as `CoulombTerms`.
+    pub fn coulomb_terms(&self) -> CoulombTerms {
+        self.pairs
+            .iter()
+            .map(|(w, q)| {
+                let mut terms = Vec::new();
+                for a in 0..D {
+                    for b in a..D {
+                        let f = if a == b { w[a] * w[a] } else { 2.0 * w[a] * w[b] };
+                        if f != 0.0 {
+                            terms.push((a, b, f));
+                        }
+                    }
+                }
+                (2.0 * q, terms)
+            })
+            .collect()
+    }
 }
 
 /// One (normalised, un-symmetrised) matrix element of every operator.

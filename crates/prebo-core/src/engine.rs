@@ -1,19 +1,17 @@
 //! The engine: one basis family in one coordinate representation, with every build the
-//! binding offers. Flat row-major arrays in and out; the coordinate dimension `n` and the
-//! family are dispatched once per call to the const-generic, family-generic path (`path`).
+//! binding offers. Flat row-major arrays in and out, a basis as the arrays of its family's
+//! parameter tuple (`families::Column`, read by `Family::params`); the coordinate dimension `n`
+//! and the family are dispatched once per call to the const-generic, family-generic builds.
 use crate::cache::Cache;
-use crate::ecg::{Element, Mat, Operators, Vector};
+use crate::ecg::{Element, Mat, Operators, Vector, MAX_DIM};
 use crate::error::{CoreError, Result};
-use crate::family::{check, Directions, Family, Params};
-use crate::fecg::{self, FloatingEcg};
-use crate::gvr::EcgGvr;
+use crate::families::floating::{fecg, FloatingEcg};
+use crate::families::gvr::EcgGvr;
+use crate::families::plain::PlainEcg;
+use crate::families::{check, Column, Directions, Family, Field, Parameters};
 use crate::matrices::Matrices;
 use crate::operators;
 use crate::path;
-use crate::plain::PlainEcg;
-
-/// Largest number of coordinates compiled (laboratory frame: particles).
-pub const MAX_DIM: usize = 8;
 
 /// The basis families.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,6 +34,15 @@ impl Kind {
             Kind::Pecg => <PlainEcg as Family<1>>::NAME,
             Kind::EcgGvr => <EcgGvr as Family<1>>::NAME,
             Kind::Fecg => <FloatingEcg as Family<1>>::NAME,
+        }
+    }
+
+    /// The arrays of the family's parameter tuple (`Family::FIELDS`).
+    pub fn fields(self) -> &'static [Field] {
+        match self {
+            Kind::Pecg => <PlainEcg as Family<1>>::FIELDS,
+            Kind::EcgGvr => <EcgGvr as Family<1>>::FIELDS,
+            Kind::Fecg => <FloatingEcg as Family<1>>::FIELDS,
         }
     }
 
@@ -139,23 +146,29 @@ macro_rules! dispatch {
     };
 }
 
-fn matrices_d<const D: usize, F: Family<D>>(e: &Engine, basis: &Params) -> Result<Matrices> {
+fn count_d<const D: usize, F: Family<D>>(basis: &[Column]) -> Result<usize> {
+    Ok(F::params(basis)?.len())
+}
+
+fn matrices_d<const D: usize, F: Family<D>>(e: &Engine, basis: &[Column]) -> Result<Matrices> {
+    let basis = F::params(basis)?;
     let (ops, sym) = e.rep.operators::<D>();
-    F::matrices(&F::context(ops, e.n_ang, &[basis])?, &sym, basis)
+    F::matrices(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis)
 }
 
 fn rows_d<const D: usize, F: Family<D>>(
     e: &Engine,
-    trials: &Params,
-    basis: &Params,
+    trials: &[Column],
+    basis: &[Column],
     position: Option<usize>,
 ) -> Result<(Matrices, Vec<Element>)> {
+    let (trials, basis) = (F::params(trials)?, F::params(basis)?);
     let (ops, sym) = e.rep.operators::<D>();
     F::rows(
-        &F::context(ops, e.n_ang, &[trials, basis])?,
+        &F::context(ops, e.n_ang, &[&trials, &basis])?,
         &sym,
-        trials,
-        basis,
+        &trials,
+        &basis,
         position,
         &e.cache,
     )
@@ -163,28 +176,31 @@ fn rows_d<const D: usize, F: Family<D>>(
 
 fn row_gradient_d<const D: usize, F: Family<D>>(
     e: &Engine,
-    trial: &Params,
+    trial: &[Column],
     dir: &Directions,
-    basis: &Params,
+    basis: &[Column],
 ) -> Result<(Matrices, Vec<Element>)> {
+    let (trial, basis) = (F::params(trial)?, F::params(basis)?);
     let (ops, sym) = e.rep.operators::<D>();
-    F::row_gradient(&F::context(ops, e.n_ang, &[trial, basis])?, &sym, trial, dir, basis, &e.cache)
+    F::row_gradient(&F::context(ops, e.n_ang, &[&trial, &basis])?, &sym, &trial, dir, &basis, &e.cache)
 }
 
-fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &Params, w: &[f64]) -> Result<Vec<f64>> {
+fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
     let element = operators::lookup::<D, F>(name)?;
+    let basis = F::params(basis)?;
     let (ops, sym) = e.rep.operators::<D>();
-    path::operator::<D, F>(&F::context(ops, e.n_ang, &[basis])?, &sym, basis, element, w)
+    path::operator::<D, F>(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis, element, w)
 }
 
-fn angular_d<const D: usize, F>(e: &Engine, basis: &Params, mu: &[f64]) -> Result<Vec<f64>>
+fn angular_d<const D: usize, F>(e: &Engine, basis: &[Column], mu: &[f64]) -> Result<Vec<f64>>
 where
     F: Family<D, Function<f64> = fecg::Fecg<D>, Context = Operators<D>>,
 {
     check(mu.len(), D, "mass fractions")?;
     let mu = Vector::<D>::from_row_slice(mu);
+    let basis = F::params(basis)?;
     let (ops, sym) = e.rep.operators::<D>();
-    let b = path::images::<D, F>(&ops, &sym, basis)?;
+    let b = path::images::<D, F>(&ops, &sym, &basis)?;
     Ok(path::symmetric_scalar(&b, |x, y| fecg::angular(x, y, &mu)))
 }
 
@@ -201,30 +217,45 @@ impl Engine {
         Ok(Self { kind, rep, n_ang, cache: Cache::default() })
     }
 
+    /// The number of functions of a parameter tuple (checked as every build checks it).
+    pub fn count(&self, params: &[Column]) -> Result<usize> {
+        dispatch!(self, count_d(params))
+    }
+
     /// Overlap, kinetic (full and translation-free) and Coulomb matrices of a basis.
-    pub fn matrices(&self, basis: &Params) -> Result<Matrices> {
+    pub fn matrices(&self, basis: &[Column]) -> Result<Matrices> {
         dispatch!(self, matrices_d(self, basis))
     }
 
     /// Rows of trial functions against a basis, with the trials' diagonal elements; oriented
     /// for a trial that will sit at `position` (`None`: appended) when `kind.oriented()`.
-    pub fn rows(&self, trials: &Params, basis: &Params, position: Option<usize>) -> Result<(Matrices, Vec<Element>)> {
+    pub fn rows(
+        &self,
+        trials: &[Column],
+        basis: &[Column],
+        position: Option<usize>,
+    ) -> Result<(Matrices, Vec<Element>)> {
         dispatch!(self, rows_d(self, trials, basis, position))
     }
 
     /// The row of one function against a basis and its diagonal with their derivatives along
     /// `dir`: `(1 + P) x nb` matrices (row 0 the values, the function as bra), `1 + P` diagonals.
-    pub fn row_gradient(&self, trial: &Params, dir: &Directions, basis: &Params) -> Result<(Matrices, Vec<Element>)> {
+    pub fn row_gradient(
+        &self,
+        trial: &[Column],
+        dir: &Directions,
+        basis: &[Column],
+    ) -> Result<(Matrices, Vec<Element>)> {
         dispatch!(self, row_gradient_d(self, trial, dir, basis))
     }
 
     /// The symmetrised matrices of the registered operator `name`, one per vector `w` (`p x n`).
-    pub fn operator(&self, name: &str, basis: &Params, w: &[f64]) -> Result<Vec<f64>> {
+    pub fn operator(&self, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
         dispatch!(self, operator_d(self, name, basis, w))
     }
 
     /// The symmetrised `<phi_I|N_TI²|phi_J>` matrix of a floating-ECG basis (LFCC; `mu` = m/m_tot).
-    pub fn angular(&self, basis: &Params, mu: &[f64]) -> Result<Vec<f64>> {
+    pub fn angular(&self, basis: &[Column], mu: &[f64]) -> Result<Vec<f64>> {
         if self.kind != Kind::Fecg {
             return Err(CoreError::Unsupported(format!(
                 "<N²> matrices of {} functions (fecg only)",

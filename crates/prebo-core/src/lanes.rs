@@ -1,22 +1,14 @@
-//! Values of the ECG-GVR kernel (`gvr_kernel::element`): one element (`f64`), or the elements of
-//! one bra with `L` symmetry images of a ket at once ([`Lanes`]), structure of arrays. Every
-//! operation is the scalar one, lane by lane (no fused multiply-add, the libm `ln`/`exp` called
-//! per lane), so each lane has the bits of the scalar kernel on every instruction set.
+//! Values of the ECG-GVR kernel (`families::gvr::gvr_kernel::element`): one element (`f64`), or
+//! the elements of one bra with `L` symmetry images of a ket at once ([`Lanes`]), structure of
+//! arrays. Every operation is the scalar one, lane by lane (no fused multiply-add, the libm
+//! `ln`/`exp` called per lane), so each lane has the bits of the scalar kernel on every
+//! instruction set.
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
+use crate::scalar::{binary_power, Scalar};
+
 /// A value of the kernel: `f64` or [`Lanes`].
-pub trait Lane:
-    Copy
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Div<Output = Self>
-    + Neg<Output = Self>
-    + Add<f64, Output = Self>
-    + Sub<f64, Output = Self>
-    + Mul<f64, Output = Self>
-    + Div<f64, Output = Self>
-{
+pub trait Lane: Scalar + Neg<Output = Self> + Sub<f64, Output = Self> + Div<f64, Output = Self> {
     /// Lanes
     const L: usize;
     /// The value with lane `l` equal to `f(l)`.
@@ -61,6 +53,29 @@ impl<const L: usize> Lane for Lanes<L> {
     #[inline(always)]
     fn lane(self, l: usize) -> f64 {
         self.0[l]
+    }
+}
+
+impl<const L: usize> Scalar for Lanes<L> {
+    #[inline(always)]
+    fn of(x: f64) -> Self {
+        Self::splat(x)
+    }
+    #[inline(always)]
+    fn sqrt(x: Self) -> Self {
+        x.map(f64::sqrt)
+    }
+    #[inline(always)]
+    fn ln(x: Self) -> Self {
+        x.map(f64::ln)
+    }
+    #[inline(always)]
+    fn clamp_unit(x: Self) -> Self {
+        x.map(|v| v.clamp(-1.0, 1.0))
+    }
+    #[inline(always)]
+    fn powu(x: Self, k: u32) -> Self {
+        binary_power(x, k, Self::splat(1.0))
     }
 }
 

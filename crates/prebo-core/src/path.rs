@@ -9,17 +9,16 @@ use crate::assemble;
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Vector};
 use crate::error::Result;
-use crate::family::{check, Directions, Family, Params, Symmetry};
+use crate::families::{check, Directions, Family, Parameters, Symmetry};
 use crate::gradient::{self, Dual};
 use crate::images::Images;
 use crate::matrices::Matrices;
-use crate::operators::ElementFn;
 
 /// The functions of `p` with their images under `sym`.
 pub fn images<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     sym: &Symmetry<D>,
-    p: &Params,
+    p: &F::Params<'_>,
 ) -> Result<Images<F::Function<f64>>> {
     Images::new(F::functions(p, ctx)?, sym, ctx)
 }
@@ -28,14 +27,18 @@ pub fn images<const D: usize, F: Family<D>>(
 pub fn basis_images<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     sym: &Symmetry<D>,
-    p: &Params,
+    p: &F::Params<'_>,
     cache: &Cache,
 ) -> Result<Arc<Images<F::Function<f64>>>> {
     cache.get(p, || images::<D, F>(ctx, sym, p))
 }
 
 /// The symmetrised `nb x nb` matrices of a basis.
-pub fn matrices<const D: usize, F: Family<D>>(ctx: &F::Context, sym: &Symmetry<D>, basis: &Params) -> Result<Matrices> {
+pub fn matrices<const D: usize, F: Family<D>>(
+    ctx: &F::Context,
+    sym: &Symmetry<D>,
+    basis: &F::Params<'_>,
+) -> Result<Matrices> {
     let b = images::<D, F>(ctx, sym, basis)?;
     Ok(assemble::symmetric(b.len(), |i, j| {
         b.element(&b.functions[i], j, |x, y| F::element(x, y, ctx))
@@ -50,8 +53,8 @@ pub fn matrices<const D: usize, F: Family<D>>(ctx: &F::Context, sym: &Symmetry<D
 pub fn rows<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     sym: &Symmetry<D>,
-    trials: &Params,
-    basis: &Params,
+    trials: &F::Params<'_>,
+    basis: &F::Params<'_>,
     position: Option<usize>,
     cache: &Cache,
 ) -> Result<(Matrices, Vec<Element>)> {
@@ -111,9 +114,9 @@ fn gradient_chunk<const D: usize, F: Family<D>, const W: usize>(
 pub fn row_gradient<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     sym: &Symmetry<D>,
-    trial: &Params,
+    trial: &F::Params<'_>,
     dir: &Directions,
-    basis: &Params,
+    basis: &F::Params<'_>,
     cache: &Cache,
 ) -> Result<(Matrices, Vec<Element>)> {
     check(trial.len(), 1, "trial functions")?;
@@ -126,13 +129,14 @@ pub fn row_gradient<const D: usize, F: Family<D>>(
     })
 }
 
-/// The symmetrised matrix of one extra operator (`operators`) for each vector `w`
-/// (`p x n`, flat): `p` row-major `nb x nb` blocks, upper triangle evaluated, mirrored.
+/// The symmetrised matrix of one extra operator (`operators`, its element `<phi_I| O(w) |phi_J>`)
+/// for each vector `w` (`p x n`, flat): `p` row-major `nb x nb` blocks, upper triangle
+/// evaluated, mirrored.
 pub fn operator<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     sym: &Symmetry<D>,
-    basis: &Params,
-    element: ElementFn<D, F>,
+    basis: &F::Params<'_>,
+    element: impl Fn(&F::Function<f64>, &F::Function<f64>, &F::Context, &Vector<D>) -> f64 + Sync,
     w: &[f64],
 ) -> Result<Vec<f64>> {
     check(w.len(), w.len() / D * D, "operator vectors")?;

@@ -1,18 +1,36 @@
-//! The lowest eigenvalue after adding one function, for many trial functions at once
+//! The eigenvalues after adding one function, for many trial functions at once
 //! (Suzuki & Varga, Lect. Notes Phys. m54, sec. 4.2, the secular equation).
 //!
 //! With S-orthonormal eigenvectors `C` (columns) and eigenvalues `E_k` of the current basis
 //! and a trial with rows `h`, `s` and diagonal `h_nn`, `s_nn`: `d = C^T s`, `b = C^T h`, the
 //! part of the trial orthogonal to the basis has norm² `ν = s_nn − d·d`, couplings
-//! `γ_k = (b_k − E_k d_k)/√ν` and energy `h' = (h_nn − 2 b·d + Σ E_k d_k²)/ν`. The new lowest
-//! eigenvalue is the root below `E_0` of `f(x) = h' − x − Σ γ_k²/(E_k − x)`, which is concave
-//! and decreasing there: Newton from the left, bisection whenever a step leaves the bracket.
-//! Cost per trial: O(N_b · N_kept) for the two products, O(N_kept) per root iteration.
+//! `γ_k = (b_k − E_k d_k)/√ν` and energy `h' = (h_nn − 2 b·d + Σ E_k d_k²)/ν`. The new eigenvalues
+//! are the roots of `f(x) = h' − x − Σ γ_k²/(E_k − x)`, which falls strictly between its poles, so
+//! they interlace with the old ones (Hylleraas–Undheim–MacDonald): root `r` lies in
+//! `(E_{r−1}, E_r]` (`E_{−1} = −∞`, `E_kept = +∞`). The lowest is found by Newton's method from
+//! the left (f is concave below `E_0`), any other from the middle of its bracket; bisection
+//! whenever a step leaves the bracket. Cost per trial: O(N_b · N_kept) for the two products,
+//! O(N_kept) per root iteration.
 use rayon::prelude::*;
 
-/// Lowest root for one trial; `f64::INFINITY` if its orthogonal remainder is below `min_norm · s_nn`.
-pub fn lowest_with_added(e: &[f64], c: &[f64], kept: usize, h: &[f64], s: &[f64], h_nn: f64, s_nn: f64, min_norm: f64) -> f64 {
+/// Root `root` (0: the lowest) of the basis with one trial added; `f64::INFINITY` if the trial's
+/// orthogonal remainder is below `min_norm · s_nn`, NaN if `root` > `kept` (one trial adds one root).
+#[allow(clippy::too_many_arguments)]
+pub fn root_with_added(
+    e: &[f64],
+    c: &[f64],
+    kept: usize,
+    h: &[f64],
+    s: &[f64],
+    h_nn: f64,
+    s_nn: f64,
+    min_norm: f64,
+    root: usize,
+) -> f64 {
     let nb = h.len();
+    if root > kept {
+        return f64::NAN;
+    }
     if kept == 0 {
         return h_nn / s_nn;
     }
@@ -38,13 +56,22 @@ pub fn lowest_with_added(e: &[f64], c: &[f64], kept: usize, h: &[f64], s: &[f64]
         return f64::INFINITY; // NaN elements of a near-singular trial
     }
     let f = |x: f64| hp - x - (0..kept).map(|k| gamma2[k] / (e[k] - x)).sum::<f64>();
-    let top = e[0];
-    let mut lo = top.min(hp) - gamma2.iter().sum::<f64>().sqrt() - 1e-3 * top.abs().max(1.0);
-    while f(lo) < 0.0 {
-        lo -= 2.0 * (top - lo);
+    let reach = gamma2.iter().sum::<f64>().sqrt();
+    let (mut lo, mut hi) = if root == 0 { (f64::NEG_INFINITY, e[0]) } else if root < kept { (e[root - 1], e[root]) } else { (e[kept - 1], f64::INFINITY) };
+    if root == 0 {
+        lo = e[0].min(hp) - reach - 1e-3 * e[0].abs().max(1.0);
+        while f(lo) < 0.0 {
+            lo -= 2.0 * (e[0] - lo);
+        }
     }
-    let mut hi = top;
-    let mut x = lo;
+    if root == kept {
+        let top = e[kept - 1];
+        hi = top.max(hp) + reach + 1e-3 * top.abs().max(1.0);
+        while f(hi) > 0.0 {
+            hi += 2.0 * (hi - top);
+        }
+    }
+    let mut x = if root == 0 { lo } else { 0.5 * (lo + hi) };
     for _ in 0..200 {
         let fx = f(x);
         if fx == 0.0 || hi - lo < 1e-15 * x.abs().max(1.0) {
@@ -65,9 +92,9 @@ pub fn lowest_with_added(e: &[f64], c: &[f64], kept: usize, h: &[f64], s: &[f64]
     x
 }
 
-/// `lowest_with_added` for `k` trials (rows `h`, `s` row-major k x nb), in parallel.
+/// `root_with_added` for `k` trials (rows `h`, `s` row-major k x nb), in parallel.
 #[allow(clippy::too_many_arguments)]
-pub fn lowest_with_added_many(
+pub fn root_with_added_many(
     e: &[f64],
     c: &[f64],
     kept: usize,
@@ -76,13 +103,113 @@ pub fn lowest_with_added_many(
     h_nn: &[f64],
     s_nn: &[f64],
     min_norm: f64,
+    root: usize,
 ) -> Vec<f64> {
     let k = h_nn.len();
     let nb = if k == 0 { 0 } else { h.len() / k };
     (0..k)
         .into_par_iter()
         .map(|t| {
-            lowest_with_added(e, c, kept, &h[t * nb..(t + 1) * nb], &s[t * nb..(t + 1) * nb], h_nn[t], s_nn[t], min_norm)
+            root_with_added(e, c, kept, &h[t * nb..(t + 1) * nb], &s[t * nb..(t + 1) * nb], h_nn[t], s_nn[t], min_norm, root)
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4-function pencil (H, S) and its generalised eigenpairs by a dense solve of the 3 leading
+    /// functions, the 4th as the trial: every root of the secular equation equals the dense
+    /// solve's eigenvalue of the whole pencil.
+    #[test]
+    fn every_root_matches_the_dense_solve() {
+        // S = B^T B (positive definite), H symmetric; functions: 3 in the basis, 1 trial
+        let bm = [[1.0, 0.2, 0.1, 0.3], [0.0, 1.0, 0.4, 0.2], [0.0, 0.0, 1.0, 0.5], [0.0, 0.0, 0.0, 1.0]];
+        let mut s = [[0.0; 4]; 4];
+        for i in 0..4 {
+            for j in 0..4 {
+                s[i][j] = (0..4).map(|k| bm[k][i] * bm[k][j]).sum();
+            }
+        }
+        let h = [[-1.0, 0.3, 0.2, 0.1], [0.3, 0.5, -0.2, 0.4], [0.2, -0.2, 1.5, 0.3], [0.1, 0.4, 0.3, 2.5]];
+        let (e3, c3) = dense(&h, &s, 3);
+        let (e4, _) = dense(&h, &s, 4);
+        let row_h: Vec<f64> = (0..3).map(|i| h[3][i]).collect();
+        let row_s: Vec<f64> = (0..3).map(|i| s[3][i]).collect();
+        for (r, want) in e4.iter().enumerate() {
+            let got = root_with_added(&e3, &c3, 3, &row_h, &row_s, h[3][3], s[3][3], 1e-12, r);
+            assert!((got - want).abs() < 1e-12 * want.abs().max(1.0), "root {r}: {got} vs {want}");
+            if r > 0 {
+                assert!(e3[r - 1] <= got, "root {r} below E_{}", r - 1);
+            }
+            if r < 3 {
+                assert!(got <= e3[r], "root {r} above E_{r}");
+            }
+        }
+        assert!(root_with_added(&e3, &c3, 3, &row_h, &row_s, h[3][3], s[3][3], 1e-12, 4).is_nan());
+    }
+
+    /// Eigenvalues (ascending) and S-orthonormal eigenvectors (row-major n x n) of the leading
+    /// n x n pencil, by Cholesky S = L L^T and Jacobi rotations of L^-1 H L^-T.
+    fn dense(h: &[[f64; 4]; 4], s: &[[f64; 4]; 4], n: usize) -> (Vec<f64>, Vec<f64>) {
+        let mut l = vec![vec![0.0; n]; n];
+        for i in 0..n {
+            for j in 0..=i {
+                let sum: f64 = s[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
+                l[i][j] = if i == j { sum.sqrt() } else { sum / l[j][j] };
+            }
+        }
+        let mut li = vec![vec![0.0; n]; n]; // L^-1
+        for col in 0..n {
+            for i in 0..n {
+                let rhs = if i == col { 1.0 } else { 0.0 };
+                li[i][col] = (rhs - (0..i).map(|k| l[i][k] * li[k][col]).sum::<f64>()) / l[i][i];
+            }
+        }
+        let mut a = vec![vec![0.0; n]; n]; // L^-1 H L^-T
+        for i in 0..n {
+            for j in 0..n {
+                a[i][j] = (0..n).map(|p| (0..n).map(|q| li[i][p] * h[p][q] * li[j][q]).sum::<f64>()).sum();
+            }
+        }
+        let mut v: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect()).collect();
+        for _ in 0..100 {
+            for p in 0..n {
+                for q in p + 1..n {
+                    if a[p][q].abs() < 1e-300 {
+                        continue;
+                    }
+                    let theta = 0.5 * (a[q][q] - a[p][p]) / a[p][q];
+                    let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                    let (cs, sn) = (1.0 / (t * t + 1.0).sqrt(), t / (t * t + 1.0).sqrt());
+                    for k in 0..n {
+                        let (akp, akq) = (a[k][p], a[k][q]);
+                        a[k][p] = cs * akp - sn * akq;
+                        a[k][q] = sn * akp + cs * akq;
+                    }
+                    for k in 0..n {
+                        let (apk, aqk) = (a[p][k], a[q][k]);
+                        a[p][k] = cs * apk - sn * aqk;
+                        a[q][k] = sn * apk + cs * aqk;
+                    }
+                    for k in 0..n {
+                        let (vkp, vkq) = (v[k][p], v[k][q]);
+                        v[k][p] = cs * vkp - sn * vkq;
+                        v[k][q] = sn * vkp + cs * vkq;
+                    }
+                }
+            }
+        }
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&x, &y| a[x][x].partial_cmp(&a[y][y]).unwrap());
+        let e: Vec<f64> = order.iter().map(|&k| a[k][k]).collect();
+        let mut c = vec![0.0; n * n]; // C = L^-T V, row-major n x kept
+        for i in 0..n {
+            for (col, &k) in order.iter().enumerate() {
+                c[i * n + col] = (0..n).map(|p| li[p][i] * v[p][k]).sum();
+            }
+        }
+        (e, c)
+    }
 }

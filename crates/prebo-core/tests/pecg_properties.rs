@@ -1,7 +1,7 @@
 //! Properties of the plain-ECG kernel that need no Python: normalisation, hermiticity,
 //! and the CM elimination equal to the internal mass matrix M - 1 1^T / (2 m_tot).
 use prebo_core::engine::{Engine, Kind, Representation};
-use prebo_core::family::Params;
+use prebo_core::families::Column;
 use prebo_core::matrices::Matrices;
 
 const N: usize = 3;
@@ -57,7 +57,7 @@ fn run(lambda: &[f64], cm_mass: Option<f64>) -> Matrices {
     };
     let (a, c_a) = basis();
     let engine = Engine::new(Kind::Pecg, rep, 0).unwrap();
-    engine.matrices(&Params { a: &a, c_a: &c_a, ..Default::default() }).unwrap()
+    engine.matrices(&[Column::Floats(a), Column::Floats(c_a)]).unwrap()
 }
 
 fn mass_matrix(internal: bool) -> Vec<f64> {
@@ -117,7 +117,7 @@ fn not_positive_definite_is_an_error() {
         cm_mass: None,
     };
     let engine = Engine::new(Kind::Pecg, rep, 0).unwrap();
-    let err = engine.matrices(&Params { a: &a, c_a: &[0.5], ..Default::default() }).unwrap_err();
+    let err = engine.matrices(&[Column::Floats(a), Column::Floats(vec![0.5])]).unwrap_err();
     assert_eq!(
         err,
         prebo_core::CoreError::NotPositiveDefinite { function: 0 }

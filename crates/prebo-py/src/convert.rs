@@ -6,7 +6,7 @@ use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLikeDyn, Py
 use prebo_core::ecg::Element;
 use prebo_core::eigenpair::Indefinite;
 use prebo_core::engine::Kind;
-use prebo_core::family::Params;
+use prebo_core::families::Column;
 use prebo_core::matrices::Matrices;
 use prebo_core::CoreError;
 use pyo3::prelude::*;
@@ -94,60 +94,30 @@ pub fn naturals(x: &Bound<'_, PyAny>, what: &str) -> Result<Vec<u32>> {
         .collect()
 }
 
-/// A family's parameter tuple, owned: pecg `(A, c_A)`, ecg-gvr `(A, u, K, c_A)`, fecg `(A, s, c_A)`.
-#[derive(Default)]
-pub struct OwnedParams {
-    a: Vec<f64>,
-    c_a: Vec<f64>,
-    v: Vec<f64>,
-    k_pow: Vec<u32>,
-}
-
-impl OwnedParams {
-    pub fn new(kind: Kind, params: &Bound<'_, PyAny>) -> Result<Self> {
-        let t = params.downcast::<PyTuple>().map_err(PyErr::from)?;
-        let want = match kind {
-            Kind::Pecg => 2,
-            Kind::EcgGvr => 4,
-            Kind::Fecg => 3,
-        };
-        if t.len() != want {
-            return Err(shape_error(format!(
-                "{} parameters: {} arrays, expected {want}",
-                kind.name(),
-                t.len()
-            )));
-        }
-        let (a, c_a) = (floats(&t.get_item(0)?, "A")?, floats(&t.get_item(want - 1)?, "c_A")?);
-        Ok(match kind {
-            Kind::Pecg => Self {
-                a,
-                c_a,
-                ..Default::default()
-            },
-            Kind::EcgGvr => Self {
-                a,
-                c_a,
-                v: floats(&t.get_item(1)?, "u")?,
-                k_pow: naturals(&t.get_item(2)?, "K")?,
-            },
-            Kind::Fecg => Self {
-                a,
-                c_a,
-                v: floats(&t.get_item(1)?, "s")?,
-                k_pow: vec![],
-            },
+/// A family's parameter tuple, owned: its arrays in the order and of the kinds the family
+/// declares (`Family::FIELDS`: pecg `(A, c_A)`, ecg-gvr `(A, u, K, c_A)`, fecg `(A, s, c_A)`).
+pub fn columns(kind: Kind, params: &Bound<'_, PyAny>) -> Result<Vec<Column>> {
+    let t = params.downcast::<PyTuple>().map_err(PyErr::from)?;
+    let fields = kind.fields();
+    if t.len() != fields.len() {
+        return Err(shape_error(format!(
+            "{} parameters: {} arrays, expected {}",
+            kind.name(),
+            t.len(),
+            fields.len()
+        )));
+    }
+    fields
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let x = t.get_item(i)?;
+            Ok(match f.naturals {
+                true => Column::Naturals(naturals(&x, f.name)?),
+                false => Column::Floats(floats(&x, f.name)?),
+            })
         })
-    }
-
-    pub fn view(&self) -> Params<'_> {
-        Params {
-            a: &self.a,
-            c_a: &self.c_a,
-            v: &self.v,
-            k_pow: &self.k_pow,
-        }
-    }
+        .collect()
 }
 
 pub fn matrix<'py>(py: Python<'py>, rows: usize, cols: usize, v: Vec<f64>) -> Bound<'py, PyArray2<f64>> {

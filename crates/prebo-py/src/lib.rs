@@ -4,10 +4,10 @@
 //! errors map to `prebo.errors` through one `From`.
 mod convert;
 
-use convert::{blocks, dict, floats, floats_shaped, matrix, OwnedParams, Result, Rows, ShapeError};
+use convert::{blocks, columns, dict, floats, floats_shaped, matrix, Result, Rows, ShapeError};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use prebo_core::engine::{self, Kind, Representation};
-use prebo_core::family::Directions;
+use prebo_core::families::Directions;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -77,8 +77,8 @@ impl Engine {
     }
 
     fn matrices<'py>(&self, py: Python<'py>, params: &Bound<'py, PyAny>) -> Result<Bound<'py, PyDict>> {
-        let basis = OwnedParams::new(self.core.kind, params)?;
-        let m = py.allow_threads(|| self.core.matrices(&basis.view()))?;
+        let basis = columns(self.core.kind, params)?;
+        let m = py.allow_threads(|| self.core.matrices(&basis))?;
         Ok(dict(py, m)?)
     }
 
@@ -90,8 +90,8 @@ impl Engine {
         basis: &Bound<'py, PyAny>,
         position: Option<usize>,
     ) -> Result<Rows<'py>> {
-        let (t, b) = (OwnedParams::new(self.core.kind, trials)?, OwnedParams::new(self.core.kind, basis)?);
-        let out = py.allow_threads(|| self.core.rows(&t.view(), &b.view(), position))?;
+        let (t, b) = (columns(self.core.kind, trials)?, columns(self.core.kind, basis)?);
+        let out = py.allow_threads(|| self.core.rows(&t, &b, position))?;
         convert::rows(py, out)
     }
 
@@ -105,13 +105,13 @@ impl Engine {
         dv: Option<&Bound<'py, PyAny>>,
         basis: &Bound<'py, PyAny>,
     ) -> Result<Rows<'py>> {
-        let (t, b) = (OwnedParams::new(self.core.kind, f)?, OwnedParams::new(self.core.kind, basis)?);
+        let (t, b) = (columns(self.core.kind, f)?, columns(self.core.kind, basis)?);
         let da = floats(dA, "dA")?;
         let dv = match dv {
             Some(dv) => floats(dv, "dv")?,
             None => vec![],
         };
-        let out = py.allow_threads(|| self.core.row_gradient(&t.view(), &Directions { a: &da, v: &dv }, &b.view()))?;
+        let out = py.allow_threads(|| self.core.row_gradient(&t, &Directions { a: &da, v: &dv }, &b))?;
         convert::rows(py, out)
     }
 
@@ -122,10 +122,11 @@ impl Engine {
         params: &Bound<'py, PyAny>,
         w: &Bound<'py, PyAny>,
     ) -> Result<Bound<'py, PyArray3<f64>>> {
-        let basis = OwnedParams::new(self.core.kind, params)?;
+        let basis = columns(self.core.kind, params)?;
         let w = floats(w, "w")?;
-        let m = py.allow_threads(|| self.core.operator(name, &basis.view(), &w))?;
-        Ok(blocks(py, basis.view().len(), m))
+        let nb = self.core.count(&basis)?;
+        let m = py.allow_threads(|| self.core.operator(name, &basis, &w))?;
+        Ok(blocks(py, nb, m))
     }
 
     fn angular<'py>(
@@ -134,10 +135,10 @@ impl Engine {
         params: &Bound<'py, PyAny>,
         mu: &Bound<'py, PyAny>,
     ) -> Result<Bound<'py, PyArray2<f64>>> {
-        let basis = OwnedParams::new(self.core.kind, params)?;
+        let basis = columns(self.core.kind, params)?;
         let mu = floats(mu, "mu")?;
-        let nb = basis.view().len();
-        let m = py.allow_threads(|| self.core.angular(&basis.view(), &mu))?;
+        let nb = self.core.count(&basis)?;
+        let m = py.allow_threads(|| self.core.angular(&basis, &mu))?;
         Ok(matrix(py, nb, nb, m))
     }
 
@@ -146,11 +147,13 @@ impl Engine {
     }
 }
 
-/// Lowest eigenvalue after adding each of k trials (secular equation, prebo_core::secular):
-/// `e` (kept), `c` (nb x kept, S-orthonormal columns), rows `h`, `s` (k x nb), diagonals (k).
+/// Eigenvalue `root` (0: the lowest) after adding each of k trials (secular equation,
+/// prebo_core::secular): `e` (kept), `c` (nb x kept, S-orthonormal columns), rows `h`, `s`
+/// (k x nb), diagonals (k).
 #[pyfunction]
+#[pyo3(signature = (e, c, h, s, h_nn, s_nn, min_norm, root=0))]
 #[allow(clippy::too_many_arguments)]
-fn lowest_with_added<'py>(
+fn root_with_added<'py>(
     py: Python<'py>,
     e: &Bound<'py, PyAny>,
     c: &Bound<'py, PyAny>,
@@ -159,6 +162,7 @@ fn lowest_with_added<'py>(
     h_nn: &Bound<'py, PyAny>,
     s_nn: &Bound<'py, PyAny>,
     min_norm: f64,
+    root: usize,
 ) -> Result<Bound<'py, PyArray1<f64>>> {
     let (e, c) = (floats(e, "e")?, floats(c, "c")?);
     let kept = e.len();
@@ -171,7 +175,7 @@ fn lowest_with_added<'py>(
         return Err(ShapeError::new_err("eigenvectors do not fit the rows").into());
     }
     let out = py.allow_threads(|| {
-        prebo_core::secular::lowest_with_added_many(&e, &c, kept, &h, &s, &hn, &sn, min_norm)
+        prebo_core::secular::root_with_added_many(&e, &c, kept, &h, &s, &hn, &sn, min_norm, root)
     });
     Ok(numpy::ndarray::Array1::from_vec(out).into_pyarray(py))
 }
@@ -255,11 +259,11 @@ fn num_threads() -> usize {
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Engine>()?;
-    m.add_function(wrap_pyfunction!(lowest_with_added, m)?)?;
+    m.add_function(wrap_pyfunction!(root_with_added, m)?)?;
     m.add_function(wrap_pyfunction!(refine_eigenpairs, m)?)?;
     m.add_function(wrap_pyfunction!(inverse_iteration, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
-    m.add("MAX_DIM", engine::MAX_DIM)?;
+    m.add("MAX_DIM", prebo_core::ecg::MAX_DIM)?;
     m.add("OPERATORS", prebo_core::operators::names())?;
     Ok(())
 }

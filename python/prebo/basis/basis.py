@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import BasisFileError, InputError, NotPositiveDefiniteError, SeparabilityError
+from ..errors import BasisFileError, InputError, NotPositiveDefiniteError, PreboError, SeparabilityError
+from ..io import basis_json
 from ..system import System
 from ..validation import path_name
 from .families import family as family_of
@@ -158,30 +159,37 @@ class Basis:
                 raise SeparabilityError(f"function {i}: A^(r) 1 != c_A m/m_tot, the CM does not separate")
             fam.check_function(self, i)
 
-    # --- basis.json (prebo.io.basis_json; io builds on basis, so it is imported on use) ---
+    # --- basis.json (docs/basis-format.md; the format is prebo.io.basis_json) ---
     def to_dict(self, extra: dict | None = None) -> dict:
-        """The basis.json mapping of this basis (docs/basis-format.md), with `extra` keys added."""
-        from ..io import basis_json
+        """The basis.json mapping of this basis, with `extra` keys added."""
         _coefficients("Basis.to_dict", self.coefficients, len(self))  # set since construction
         return basis_json.to_dict(self, extra)
 
     def save(self, path, extra: dict | None = None) -> None:
         """Write basis.json atomically: a killed run leaves either the old or the new file."""
-        from ..io import basis_json
         _coefficients("Basis.save", self.coefficients, len(self))
         basis_json.save(self, _file("Basis.save", path), extra)
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "basis", empty: bool = False) -> "Basis":
-        """The basis of a basis.json mapping (prebo.io.basis_json.from_dict)."""
-        from ..io import basis_json
-        return basis_json.from_dict(d, where, empty)
+        """The basis of a basis.json mapping; BasisFileError naming `where` (and the function and
+        key) for anything wrong (prebo.io.basis_json.arguments, `validate`), including no functions
+        at all (unless `empty`: a checkpoint before the first one)."""
+        args = basis_json.arguments(d, where)
+        try:
+            basis = cls(**args)
+            basis.validate()
+        except PreboError as exc:
+            raise BasisFileError(f"{where}: {exc}") from exc
+        if not (empty or len(basis)):
+            raise BasisFileError(f"{where}: the basis has no functions")
+        return basis
 
     @classmethod
     def load(cls, path) -> "Basis":
         """The basis of a basis.json file; BasisFileError naming the file for anything wrong."""
-        from ..io import basis_json
-        return basis_json.load(_file("Basis.load", path))
+        path = _file("Basis.load", path)
+        return cls.from_dict(basis_json.read(path), str(path))
 
 
 def _finite(name: str, value, shape: tuple, what: str) -> np.ndarray:

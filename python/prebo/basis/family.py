@@ -12,7 +12,7 @@ centres s of floating ECGs) and supplies, for those arrays only:
   the TICC transformation of the extras) and the engine object that builds matrices, rows and
   row gradients from it (`engine`);
 - sampling: the part of a random draw that depends on the family (`draw_power`, `drawn`,
-  `powers`, `draw_learned_power`);
+  `powers`, `draw_learned_power`, `neighbours`) and its limits (`K_limit`);
 - refinement: the tail of the parameter vector θ ↔ the extras (`prepared`, `theta_tail`,
   `from_tail`, `tail_directions`; the exponent part of θ is common, optimise/parametrisation.py).
 
@@ -38,6 +38,8 @@ class Family:
     integers: frozenset = frozenset()
     #: whether the functions are eigenfunctions of the total orbital angular momentum N
     conserves_L: bool = True
+    #: the largest power K a function may hold, the bound of the setting K_max (0: no powers)
+    K_limit: int = 0
 
     @property
     def parameters(self) -> tuple[str, ...]:
@@ -89,9 +91,10 @@ class Family:
         peak of (|v|^{2K+N} peaks at |v| = (p/α)^½ with p = K + N/2; 0: no power)."""
         return 0, 0.0
 
-    def drawn(self, system, u: np.ndarray, centres: np.ndarray, K: int) -> dict:
-        """The extras of a fresh function from the sampler's global vector u (n), centres (n x 3)
-        and power K."""
+    def drawn(self, rng, system, carrier, K: int) -> dict:
+        """The extras of a fresh function of power K whose draw singled out `carrier`
+        (optimise.sampler.Carrier: the coordinate v = u^T r and particle centres displaced along
+        it); any further random numbers from `rng`, after those of the common draw."""
         return {}
 
     def powers(self, basis, idx) -> np.ndarray | None:
@@ -101,6 +104,10 @@ class Family:
     def draw_learned_power(self, rng, powers, K_max: int) -> int | None:
         """A power near the learned ones (None where the family has no powers)."""
         return None
+
+    def neighbours(self, f, K_max: int) -> list:
+        """One-function bases next to the one-function basis `f` in its power (none without powers)."""
+        return []
 
     # --- refinement: θ = (exponent part, tail) ---------------------------------------
     def prepared(self, f, x):

@@ -37,8 +37,9 @@ class FloatingECG(Family):
                                     "no translationally invariant evaluation (use --coordinates lab)")
         return (sx[:, :-1],)
 
-    def drawn(self, system, u: np.ndarray, centres: np.ndarray, K: int) -> dict:
-        return {"s": (centres - system.cm_vector @ centres)[None]}  # no CM component: μ^T s = 0
+    def drawn(self, rng, system, carrier, K: int) -> dict:
+        c = carrier.centres
+        return {"s": (c - system.cm_vector @ c)[None]}  # no CM component: μ^T s = 0
 
     # refinement: θ tail s' with s^(r) = U_x^-1 (s', μ^T s), μ^T s fixed
     def theta_tail(self, f, x) -> np.ndarray:

@@ -12,8 +12,8 @@ import numpy as np
 from ..errors import InputError, SeparabilityError
 from .family import Family
 
-#: the largest power K a function may hold (the bound of the setting K_max)
-K_LIMIT = 60
+#: the steps in K of a function's neighbours (`GlobalVectorECG.neighbours`)
+K_STEPS = (1, 2)
 #: the range of max |u_k|: a normalised function does not depend on the length of u, the sampler and
 #: the stored bases keep it near 1 (1.0-1.73), and u^T A^-1 u overflows far beyond (1e±100: not finite)
 U_SCALE = (1e-6, 1e6)
@@ -26,6 +26,7 @@ class GlobalVectorECG(Family):
     shapes = {"u": ("n",), "K": ()}
     integers = frozenset({"K"})
     conserves_L = True
+    K_limit = 60
 
     def check_state(self, state) -> None:
         if state.parity != (-1) ** state.N:
@@ -36,8 +37,8 @@ class GlobalVectorECG(Family):
         value = np.asarray(value)
         if name != "K":
             return value.astype(float)
-        if not np.all((value >= 0) & (value <= K_LIMIT) & (value == np.round(value))):
-            raise InputError(f"basis: every K must be an integer in 0..{K_LIMIT}")
+        if not np.all((value >= 0) & (value <= self.K_limit) & (value == np.round(value))):
+            raise InputError(f"basis: every K must be an integer in 0..{self.K_limit}")
         return value.astype(np.uint32)
 
     def check_function(self, basis, i: int) -> None:
@@ -62,14 +63,30 @@ class GlobalVectorECG(Family):
         K = int(rng.integers(K_max + 1))
         return K, K + 0.5 * N
 
-    def drawn(self, system, u: np.ndarray, centres: np.ndarray, K: int) -> dict:
-        return {"u": u[None], "K": [K]}
+    def drawn(self, rng, system, carrier, K: int) -> dict:
+        return {"u": carrier.u[None], "K": [K]}
 
     def powers(self, basis, idx) -> np.ndarray:
         return basis.K[idx]
 
     def draw_learned_power(self, rng, powers, K_max: int) -> int:
         return int(np.clip(rng.choice(powers) + rng.integers(-2, 3), 0, K_max))
+
+    def neighbours(self, f, K_max: int) -> list:
+        """f moved to K ± 1, K ± 2 (K_STEPS; within 0..K_max), the marginal exponent of v = u·r
+        scaled by p'/p (p = max(K + N/2, 1)) so that the peak of |v|^{2K+N} stays put:
+        A' = A + (p'/p - 1) u u^T / (u^T A^-1 u) (Sherman–Morrison: u^T A'^-1 u = u^T A^-1 u p/p')."""
+        K, N = int(f.K[0]), f.N
+        A, u = f.A[0], f.u[0]
+        p = max(K + 0.5 * N, 1.0)
+        uAu = u @ np.linalg.solve(A, u)
+        out = []
+        for K2 in (K + sign * step for step in K_STEPS for sign in (-1, 1)):
+            if 0 <= K2 <= K_max:
+                g = (max(K2 + 0.5 * N, 1.0) / p - 1.0) / uAu
+                out.append(type(f).single(f.system, A + g * np.outer(u, u), f.c_A[0], f.channels[0], self.name,
+                                          {"u": u[None], "K": [K2]}))
+        return out
 
     # refinement: θ tail u' with u^(r) = U_x^T v/|v|, v = (u', c_U), c_U fixed
     def prepared(self, f, x):

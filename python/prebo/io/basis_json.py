@@ -1,32 +1,34 @@
-"""basis.json (format "prebo-basis", version 1; docs/basis-format.md) and the atomic writers.
+"""basis.json (format "prebo-basis", version 1; docs/basis-format.md).
 
 A basis file stores the system, the state, the symmetry, the conventions and, per function, the
 full A^(r), c_A, the channel and the family's parameters (u and K, or s), plus the linear
 coefficients of the state; a run's checkpoint adds its settings and progress (prebo.optimise).
-Every writer goes through `write_atomic`: a killed writer leaves the old file or the new one.
+Every file is written by files.write_json_atomic: a killed writer leaves the old file or the new one.
 
 A file is a claim to be checked, not a source of truth (docs/basis-format.md): `read` takes at
-most MAX_BYTES, integers of at most MAX_DIGITS digits and MAX_DEPTH levels of nesting; `from_dict`
+most MAX_BYTES, integers of at most MAX_DIGITS digits and MAX_DEPTH levels of nesting; `arguments`
 refuses unknown keys, a function with keys of another family or values of the wrong type (no
 boolean for an integer, no string for a number), more than MAX_SIZE functions, a stored symmetry
 that is not the state's (`System.from_dict`) and settings out of their range.
+
+prebo.basis.basis imports this module, not the reverse: `Basis.from_dict` builds the basis of the
+checked `arguments` and validates its functions; `to_dict` reads a basis through its attributes.
 """
 from __future__ import annotations
 
 import json
-import os
 import reprlib
-import tempfile
-from glob import escape as glob_escape
 from pathlib import Path
 
 import numpy as np
 
-from ..basis import FAMILIES, Basis, Family, family
+from ..basis.families import FAMILIES, family
+from ..basis.family import Family
 from ..coordinates import by_name
-from ..errors import BasisFileError, InputError, OutputError, PreboError
+from ..errors import BasisFileError, InputError, PreboError
 from ..system import System
 from ..validation import MAX_SIZE, number
+from .files import write_json_atomic
 
 FORMAT = "prebo-basis"
 VERSION = 1
@@ -36,7 +38,7 @@ CONVENTIONS = {
     "units": "hartree atomic units; masses in electron masses",
     "cm": "A^(r) 1 = c_A m / m_tot (CM-separable); energy has the CM kinetic energy eliminated",
 }
-#: the keys of a basis file: the basis, then the energy, the settings and a run's state (checkpoint.py)
+#: the keys of a basis file: the basis, then the energy, the settings and a run's state (prebo.optimise.resume)
 KEYS = ("format", "version", "conventions", "system", "symmetry", "basis_type", "functions", "coefficients",
         "energy", "optimiser", "progress", "rng", "history", "elapsed", "schedule", "stopped", "momentum")
 #: every function's arrays beside its family's extras (name -> shape, "n": particles); and a channel
@@ -51,8 +53,8 @@ MAX_DIGITS, MAX_DEPTH = 100, 16
 TOO_DEEP = f"nested more than {MAX_DEPTH} levels deep"
 
 
-def to_dict(basis: Basis, extra: dict | None = None) -> dict:
-    """The basis.json mapping of `basis`, with the keys of `extra` added (a checkpoint's run state)."""
+def to_dict(basis, extra: dict | None = None) -> dict:
+    """The basis.json mapping of `basis` (a prebo.Basis), with the keys of `extra` added (a checkpoint's run state)."""
     d = {
         "format": FORMAT,
         "version": VERSION,
@@ -69,22 +71,22 @@ def to_dict(basis: Basis, extra: dict | None = None) -> dict:
     return d
 
 
-def _function_dict(basis: Basis, i: int) -> dict:
+def _function_dict(basis, i: int) -> dict:
     f = {"A": basis.A[i].tolist(), "c_A": float(basis.c_A[i]), "channel": basis.channels[i]}
     for name, v in basis.parameters.items():
         f[name] = v[i].tolist()
     return f
 
 
-def save(basis: Basis, path, extra: dict | None = None) -> None:
+def save(basis, path, extra: dict | None = None) -> None:
     """Write `to_dict(basis, extra)` to `path` atomically."""
     write_json_atomic(path, to_dict(basis, extra))
 
 
-def from_dict(d: dict, where: str = "basis", empty: bool = False) -> Basis:
-    """The basis of a basis.json mapping; BasisFileError naming `where` (and the function and key)
-    for anything wrong (module docstring), including no functions at all (unless `empty`: a
-    checkpoint before the first one). A run's state is checked by prebo.optimise.checkpoint."""
+def arguments(d: dict, where: str) -> dict:
+    """The prebo.Basis arguments (system, A, c_A, channels, coefficients, kind and the family's
+    extras) of a basis.json mapping; BasisFileError naming `where` (and the function and key) for
+    anything wrong in the file (module docstring). A run's state is checked by prebo.optimise.resume."""
     if not isinstance(d, dict) or d.get("format") != FORMAT:
         raise BasisFileError(f"{where}: not a prebo basis file (format must be {FORMAT!r})")
     if d.get("version") != VERSION:
@@ -118,16 +120,9 @@ def from_dict(d: dict, where: str = "basis", empty: bool = False) -> Basis:
         c_A = np.array([f["c_A"] for f in funcs], dtype=float)
         channels = [f.get("channel", "unknown") for f in funcs]
         extra = {name: np.array([f[name] for f in funcs]) for name in fam.shapes}
-        basis = Basis(system, A, c_A, channels, coef, kind, **extra)
     except PreboError as exc:
         raise BasisFileError(f"{where}: {exc}") from exc
-    if not (empty or len(A)):
-        raise BasisFileError(f"{where}: the basis has no functions")
-    try:
-        basis.validate()
-    except PreboError as exc:
-        raise BasisFileError(f"{where}: {exc}") from exc
-    return basis
+    return dict(system=system, A=A, c_A=c_A, channels=channels, coefficients=coef, kind=kind, **extra)
 
 
 def check_functions(funcs, system: System, fam: Family) -> None:
@@ -194,13 +189,8 @@ def check_settings(block) -> None:
             raise BasisFileError(str(exc)) from None
 
 
-def load(path) -> Basis:
-    """The basis of basis.json file `path`; BasisFileError naming the file for anything wrong."""
-    return from_dict(read(path), str(path))
-
-
 def read(path):
-    """The parsed content of basis.json file `path` (not yet checked: `from_dict`); BasisFileError
+    """The parsed content of basis.json file `path` (not yet checked: `arguments`, `Basis.from_dict`); BasisFileError
     naming the file when it is unreadable, larger than MAX_BYTES, not JSON, or holds an integer
     of more than MAX_DIGITS digits or more than MAX_DEPTH levels of nesting."""
     path = Path(path)
@@ -250,53 +240,3 @@ def read_text(path: Path, error: type[PreboError]) -> str:
         return data.decode()
     except UnicodeDecodeError as exc:
         raise error(f"{path}: not a text file ({exc.reason})") from exc
-
-
-def write_atomic(path, text: str | bytes) -> None:
-    """Write `text` (or bytes: an image) to a temporary file in the same folder (PATH.*.tmp), fsync,
-    then os.replace: a killed writer leaves the old file or the new one, never half of one.
-    OutputError naming the path if it cannot be written."""
-    path = Path(path)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
-    except OSError as exc:
-        raise OutputError(f"{path}: cannot write ({exc.strerror})") from exc
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 would hide results from other users
-    try:
-        with os.fdopen(fd, "wb" if isinstance(text, bytes) else "w") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException as exc:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise OutputError(f"{path}: cannot write ({exc.strerror})") from exc
-        raise
-
-
-_ENCODER = json.JSONEncoder(allow_nan=False)  # the C encoder: `indent` would select the pure-Python one
-
-
-def write_json_atomic(path, obj: dict) -> None:
-    """`write_atomic` of the mapping `obj` as strict JSON (ValueError on NaN or infinity, which
-    JSON cannot hold): a key per line and an element per line of a list of lists or mappings
-    (the functions, the history). Compact lines keep the C encoder: a checkpoint of 500
-    functions is written in 6 ms instead of the 20 ms of `indent=1`, once per step of a run."""
-    def value(v):
-        if isinstance(v, list) and v and isinstance(v[0], (list, dict)):
-            return "[\n  " + ",\n  ".join(map(_ENCODER.encode, v)) + "\n ]"
-        return _ENCODER.encode(v)
-
-    write_atomic(path, "{\n" + ",\n".join(f" {_ENCODER.encode(k)}: {value(v)}" for k, v in obj.items()) + "\n}\n")
-
-
-def remove_stale_temporaries(path) -> None:
-    """Delete the temporary files a killed `write_atomic` of `path` left behind."""
-    path = Path(path)
-    for f in path.parent.glob(glob_escape(path.name) + ".*.tmp"):
-        f.unlink(missing_ok=True)

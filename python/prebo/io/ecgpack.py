@@ -86,7 +86,8 @@ from ..system.symmetry import implied_spins
 from ..system.young import young_operator, young_product, young_string
 from ..optimise.settings import check
 from ..validation import MAX_PARTICLES, MAX_SIZE, path_name
-from .basis_json import MAX_DIGITS, read_text, write_atomic
+from .basis_json import MAX_DIGITS, read_text
+from .files import write_atomic
 
 __all__ = ["read_inout", "write_inout", "parse_inout", "InoutFile"]
 

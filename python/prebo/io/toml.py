@@ -78,7 +78,7 @@ def from_dict(d: dict) -> Job:
     settings = {BASIS_KEYS[k]: v for k, v in basis_t.items()} | opt_t
     opts = resolved(Optimiser(**{name: check(name, v, SETTINGS[name].key) for name, v in settings.items()}), system)
     family(opts.kind).check_state(system.state)
-    if "K_max" in basis_t and "K" not in family(opts.kind).shapes:
+    if "K_max" in basis_t and not family(opts.kind).K_limit:
         raise InputError(f"[basis] K_max: {opts.kind} functions have no power K (K_max is a setting of ecg-gvr)")
     coordinate_sets(system, opts.channels)
     return Job(title or system.label(), system, opts)

@@ -1,18 +1,23 @@
 """Stochastic basis optimisation, in the order a run uses it:
 
 settings (Optimiser, SETTINGS) → sampler (random functions) → expansion (the basis with its
-matrices and eigen-solution) → methods (grow, prune, sweep, refine, polish: small configs, each one
-unit of work) run by the one driver (`optimise`) → checkpoint (cursor, basis.json run state) and
-report (the live line). parametrisation, refine and polish hold the θ ↔ function mapping and the
-local and joint minimisers the methods use.
+matrices and eigen-solution; objective: the root the methods lower) → methods (grow, replace,
+refine, prune, polish, momentum: small configs, each one unit of work) run by the one driver
+(`optimise`) where the schedule says (schedule: the interface; fixed and adaptive: its two
+kinds; cursor: the next unit of work) → history and convergence (the report), checkpoint (the
+run's files), resume (a run read back), lowest (the lowest state passed through) and report
+(the live line). parametrisation, refine and polish hold the θ ↔ function mapping and the local
+and joint minimisers the methods use; momentum the move along the basis's displacement.
 """
-from .checkpoint import CHECKPOINT, Cursor, load_checkpoint
+from .checkpoint import CHECKPOINT
+from .cursor import Cursor
 from .driver import optimise, resume_from
 from .expansion import Expansion
-from .methods import Grow, Polish, Prune, Refine, Refinement, Sweep
+from .methods import Grow, Minimiser, MomentumMove, Polish, PrunePass, PruneStep, Refine, Replace
+from .resume import load_checkpoint
 from .sampler import Sampler, coordinate_sets
 from .settings import SETTINGS, Optimiser, check
 
 __all__ = ["Optimiser", "SETTINGS", "check", "optimise", "resume_from", "load_checkpoint", "CHECKPOINT", "Cursor",
-           "Expansion", "Sampler", "coordinate_sets", "Grow", "Prune", "Sweep", "Refine", "Polish",
-           "Refinement"]
+           "Expansion", "Sampler", "coordinate_sets", "Grow", "Replace", "Refine", "PruneStep", "PrunePass",
+           "Polish", "MomentumMove", "Minimiser"]

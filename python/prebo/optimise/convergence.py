@@ -1,11 +1,11 @@
 """The convergence report of a run (result.json's "convergence"), from its history of accepted
-steps [n_b, E, phase, seconds], since the last pruning (a basis grown past its size and pruned
-back starts again from a higher energy; methods.Prune):
+steps (history.Step), since the last pruning (a basis grown past its size and pruned
+back starts again from a higher energy; methods.PruneStep):
 
 - `stopped`: why the run ended, a key of STOPPED (the adaptive schedule's reasons are those of
-  schedule.py) — and `seconds` of optimisation over every segment of the run;
+  adaptive.py) — and `seconds` of optimisation over every segment of the run;
 - `advantage`: in an adaptive run at full size, how many times faster than the best kind of pass
-  growth was gaining at the end (schedule.Adaptive.advantage; above 1/RATIO a larger basis is
+  growth was gaining at the end (adaptive.Adaptive.advantage; above 1/RATIO a larger basis is
   the better use of time), else None;
 - `stalled`: where growth of an adaptive schedule stopped short of `size` (every trial refused;
   the basis kept the size it reached), with the settings to change, or None;
@@ -19,6 +19,7 @@ back starts again from a higher energy; methods.Prune):
 """
 from __future__ import annotations
 
+from .history import Step
 from .methods import stalled
 from .settings import Optimiser
 
@@ -33,31 +34,31 @@ CAVEAT = ("the gain still to be had at this basis size were the gains to keep fa
           "(as a power of the time), or where the run would still find a deeper basin")
 
 
-def energy_at(steps: list, t: float) -> float:
+def energy_at(steps: list[Step], t: float) -> float:
     """The energy of the last step taken by time `t` (seconds)."""
-    return [h[1] for h in steps if h[3] <= t][-1]
+    return [h.energy for h in steps if h.seconds <= t][-1]
 
 
-def convergence(history: list, opts: Optimiser, stopped: str | None, seconds: float,
+def convergence(history: list[Step], opts: Optimiser, stopped: str | None, seconds: float,
                 stalled_at: int | None = None, advantage: float | None = None, condition: float = 0.0,
                 sigma: float = 0.0) -> dict:
     """The report of a run with `history` (module docstring); `stalled_at`: the size at which growth
     stalled; `advantage`: that of the adaptive schedule; `condition`, `sigma`: the basis's overlap
     condition and energy uncertainty (Eh)."""
-    steps = [h for h in history if len(h) >= 4]
-    pruned = [k for k in range(1, len(steps)) if steps[k][0] < steps[k - 1][0]]
+    steps = [h for h in history if h.seconds is not None]
+    pruned = [k for k in range(1, len(steps)) if steps[k].size < steps[k - 1].size]
     steps = steps[pruned[-1]:] if pruned else steps
     report = {"stopped": stopped, "seconds": seconds, "adaptive": opts.adaptive, "advantage": advantage,
               "recent": None, "extrapolation": None,
               "stalled": None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts, condition, sigma)}}
     if len(steps) >= 2:
         last = steps[-min(RECENT + 1, len(steps)):]
-        gain, span = last[0][1] - last[-1][1], last[-1][3] - last[0][3]
+        gain, span = last[0].energy - last[-1].energy, last[-1].seconds - last[0].seconds
         report["recent"] = {"steps": len(last) - 1, "gain": gain, "seconds": span,
                             "rate": gain / span if span > 0 else None}
-    final = [h for h in steps if h[0] == steps[-1][0]] if steps else []
-    if len(final) >= 3 and final[-1][3] > final[0][3]:
-        t0, T = final[0][3], final[-1][3]
+    final = [h for h in steps if h.size == steps[-1].size] if steps else []
+    if len(final) >= 3 and final[-1].seconds > final[0].seconds:
+        t0, T = final[0].seconds, final[-1].seconds
         E1, E2, E3 = (energy_at(final, t0 + k * (T - t0) / 3) for k in (1, 2, 3))
         g1, g2 = E1 - E2, E2 - E3
         if g1 > g2:

@@ -29,7 +29,7 @@ None), from the physics of the particles:
 - refine_group: GROUP in the adaptive schedule, whose refinement passes then move each function
   with the GROUP − 1 it overlaps most (near-duplicate partners hold a lone function in place;
   benchmarks/README, "The H2 campaign" and issue 17's rows), 1 in a fixed one;
-- the schedule: adaptive (schedule.py) when none of prune, sweeps, refine, polish, cycles is
+- the schedule: adaptive (adaptive.py) when none of prune, sweeps, refine, polish, cycles is
   given, else the fixed schedule with the missing ones at 0, 0, 0, 0 and 1.
 """
 from __future__ import annotations
@@ -40,7 +40,6 @@ from dataclasses import replace
 import numpy as np
 
 from ..basis import family
-from ..basis.gvr import K_LIMIT
 from ..system import System, reduced_mass
 from .settings import Optimiser
 
@@ -76,9 +75,10 @@ def resolved(opts: Optimiser, system: System) -> Optimiser:
     K_max = opts.K_max
     if K_max is None:
         K_max = 0
-        if "K" in family(kind).shapes and bond is not None:  # a family with powers K
+        limit = family(kind).K_limit  # 0: a family without powers K
+        if limit and bond is not None:
             m = system.masses
-            K_max = min(K_LIMIT, math.ceil(np.sqrt(reduced_mass(m[bond[0]], m[bond[1]]) / m.min())))
+            K_max = min(limit, math.ceil(np.sqrt(reduced_mass(m[bond[0]], m[bond[1]]) / m.min())))
     channels = opts.channels or ("all" if bond is not None else "pairs")
     trials = opts.trials or (TRIALS if opts.adaptive else 30 if bond is not None else 20)
     schedule = {}

@@ -1,14 +1,14 @@
-"""The one driver: `optimise` runs the methods of the schedule (methods.py) one unit of work at a
-time — the fixed schedule of the settings (checkpoint.Cursor.advance) or the adaptive one
-(schedule.py) — keeps the history, stops at the wall-time budget, writes the checkpoint and
-leaves the convergence report (convergence.py) on the basis it returns; `resume_from`
-continues a run.
+"""The one driver: `optimise` runs the methods (methods.py) one unit of work at a time, where the
+schedule (schedule.py: the fixed one of the settings or the adaptive one) says, tells the
+schedule what each left, keeps the history (history.py), stops at the wall-time budget, writes
+the checkpoint (checkpoint.py) and leaves the convergence report (convergence.py) on the basis
+it returns; `resume_from` continues a run (resume.py).
 
 With an output folder, the basis, the random-number state and the position in the schedule are
 written atomically after every step: a killed run loses at most the step in flight, and
 `prebo run --resume` continues it bit for bit; every start removes the temporary files
 (basis.json.*.tmp, lowest.json.*.tmp) a write killed in flight left. The run returns the lowest
-state it passed through (checkpoint.Lowest), kept in lowest.json while it stands above it.
+state it passed through (lowest.Lowest), kept in lowest.json while it stands above it.
 """
 from __future__ import annotations
 
@@ -23,31 +23,34 @@ from .. import eigen
 from ..basis import Basis
 from ..errors import InputError, OutputError, StalledError
 from ..integrals import laboratory
-from ..io.basis_json import remove_stale_temporaries
+from ..io.files import remove_stale_temporaries
 from ..io.lock import owned
 from ..system import System
 from ..thresholds import lowest as lowest_threshold
 from ..validation import path_name
-from .checkpoint import CHECKPOINT, LOWEST, Cursor, Lowest, checkpoint_in, load_checkpoint, resumed
+from .checkpoint import CHECKPOINT, LOWEST, checkpoint_in
 from .convergence import convergence
 from .defaults import resolved
 from .expansion import Expansion
+from .history import Step
+from .lowest import Lowest
 from .methods import Run, methods
 from .momentum import Momentum
 from .report import Reporter
+from .resume import load_checkpoint, resumed
 from .sampler import Sampler
-from .schedule import Adaptive
+from .schedule import schedule_of
 from .settings import Optimiser
 
 
 def optimise(system: System, opts: Optimiser, out: Path | None = None, progress: bool = True,
              resume: dict | None = None) -> Basis:
     """Optimise a basis of `opts.kind` for the state of `system`: with the adaptive schedule
-    (schedule.py), growth to `opts.size` and refinement, replacement and joint passes chosen by
+    (adaptive.py), growth to `opts.size` and refinement, replacement and joint passes chosen by
     the energy each gains per second until the basis has converged or is exhausted; with a fixed
-    one, growth to `opts.size` by competitive selection, then `opts.cycles` times growth by
-    `opts.prune` functions and pruning back to the size, `opts.sweeps` random replacement sweeps,
-    `opts.refine` refinement sweeps and `opts.polish` joint steps (methods.py). Either stops
+    one (fixed.py), growth to `opts.size` by competitive selection, then `opts.cycles` times growth
+    by `opts.prune` functions and pruning back to the size, `opts.sweeps` random replacement
+    sweeps, `opts.refine` refinement sweeps and `opts.polish` joint steps (methods.py). Either stops
     after `opts.budget` seconds and keeps its place in the checkpoint: resumed with a larger
     budget, it goes on (a budget that ends a run while it prunes leaves a checkpoint of up to
     `opts.prune` functions more). Settings left at None are chosen for the system first
@@ -56,10 +59,10 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     out: folder of the checkpoint out/basis.json, written atomically after every step (None: no
     checkpoint; OutputError if a new run's folder holds one already), owned by the run while it
     runs (io/lock.py; OutputError if another run owns it); progress: show a live
-    line; resume: a checkpoint's content (checkpoint.load_checkpoint) to continue exactly where
+    line; resume: a checkpoint's content (resume.load_checkpoint) to continue exactly where
     it stopped.
     Returns the lowest state of at most `opts.size` functions the run passed through (with a
-    fixed schedule's pruning, not always where it stopped; checkpoint.Lowest): its basis with the
+    fixed schedule's pruning, not always where it stopped; lowest.Lowest): its basis with the
     state's coefficients and `convergence`, the report of convergence.py; its energy (hartree)
     is prebo.evaluate(basis)["energy"]. InputError for
     arguments of the wrong type, StalledError when growth rejects every trial for STALL_STEPS
@@ -86,8 +89,8 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     sampler = Sampler(system, opts, rng)
     rep = laboratory(system)
     if resume is None:
-        basis, history, elapsed, schedule, stopped = Basis.empty(system, opts.kind), [], 0.0, Adaptive(opts), None
-        cursor = schedule.first() if opts.adaptive else Cursor().advance(0, opts)
+        basis, history, elapsed, schedule, stopped = Basis.empty(system, opts.kind), [], 0.0, schedule_of(opts), None
+        cursor = schedule.first()
     else:
         basis, cursor, history, elapsed, schedule, stopped = resumed(resume, opts, rng, "checkpoint")
     if out is not None:
@@ -104,10 +107,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         return Expansion(b, rep, opts.threshold, opts.min_norm, opts.max_overlap)
 
     ex = expansion(basis)
-    if opts.adaptive and cursor.phase == "done" and stopped in ("exhausted", "budget") and opts.budget is not None:
-        # a (new) budget overrides exhaustion, and the end of the last one
-        cursor = schedule.reopen(len(ex.basis), ex.energy, elapsed)
-        stopped = schedule.stopped if cursor.phase == "done" else None
+    cursor, stopped = schedule.resume(cursor, stopped, len(ex.basis), ex.energy, elapsed)
     threshold = lowest_threshold(system).energy
     lowest = Lowest(basis, opts.size, out, {"optimiser": opts.to_dict()}, resumed=resume is not None)
     lowest.see(ex)
@@ -118,7 +118,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
 
     def checkpoint():
         if out is not None:
-            ex.basis.coefficients = ex.eig.vectors[:, 0] if ex.eig is not None else None
+            ex.basis.coefficients = ex.coefficients if ex.eig is not None else None
             energy = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
             ex.basis.save(Path(out) / CHECKPOINT, {
                 "energy": energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
@@ -135,24 +135,19 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
             try:
                 steps[cursor.phase].step(run, cursor)
             except StalledError:
-                if not opts.adaptive:
+                if not schedule.stall(len(ex.basis)):
                     raise
                 run.stalled = 0
-                schedule.stall(len(ex.basis))
             if ex.energy < old:
-                history.append([len(ex.basis), ex.energy, cursor.phase, wall()])
+                history.append(Step(len(ex.basis), ex.energy, cursor.phase, wall()))
                 run.report.step(ex, old, cursor)
                 sampler.learn(ex.basis)  # a function of the basis alone, so a resumed run learns the same
-            now = wall()
-            if opts.adaptive:
-                cursor = schedule.advance(cursor, len(ex.basis), ex.energy, now)
-            else:
-                cursor = cursor.advance(len(ex.basis), opts)
+            cursor = schedule.advance(cursor, len(ex.basis), ex.energy, wall())
             if cursor.phase == "done":
-                stopped = schedule.stopped if opts.adaptive else "schedule"
-            if opts.adaptive and phase == "grow" and schedule.restart(len(ex.basis), ex.energy, threshold - ex.sigma):
-                schedule = Adaptive(opts, restarts=schedule.restarts + 1)  # a fresh start (schedule.py)
-                cursor, stopped = schedule.first(), None
+                stopped = schedule.stopped
+            fresh = schedule.restart(phase, len(ex.basis), ex.energy, threshold - ex.sigma)
+            if fresh is not None:  # a fresh start (adaptive.py)
+                schedule, cursor, stopped = fresh, fresh.first(), None
                 ex = run.expansion = expansion(Basis.empty(system, opts.kind))
                 run.momentum = Momentum()
                 sampler.learn(ex.basis)
@@ -161,9 +156,8 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     best = lowest.basis
     if best is None:  # never at or below the size (a run resumed mid-pruning and stopped there)
         best = ex.basis
-        best.coefficients = ex.eig.vectors[:, 0]
-    best.convergence = convergence(history, opts, stopped, wall(), schedule.stalled,
-                                   schedule.advantage(len(ex.basis)) if opts.adaptive else None,
+        best.coefficients = ex.coefficients
+    best.convergence = convergence(history, opts, stopped, wall(), schedule.stalled, schedule.advantage(len(ex.basis)),
                                    ex.eig.overlap_condition, ex.sigma)
     return best
 

@@ -14,6 +14,7 @@ import numpy as np
 from .. import eigen
 from ..basis import Basis
 from ..errors import LinearDependenceError
+from .objective import LowestRoot
 
 
 #: how many times what a change adds to the uncertainty it must gain (`Expansion.keep_if_lower`)
@@ -21,18 +22,19 @@ SIGMA_PRICE = 100.0
 
 
 class Expansion:
-    """The basis `basis` with its matrices `m` (S, T, T_ti, V; hartree), eigen-solution `eig`, ground-state
-    `energy` (hartree) and `sigma`, the energy's numerical uncertainty (module docstring; inf
-    beyond eigen.FIRST_ORDER, where no change is kept: the optimiser does not take the basis where
-    its first-order uncertainty fails).
+    """The basis `basis` with its matrices `m` (S, T, T_ti, V; hartree), eigen-solution `eig`, the
+    `energy` (hartree) of the `objective` (objective.py: the lowest root) and `sigma`, the energy's
+    numerical uncertainty (module docstring; inf beyond eigen.FIRST_ORDER, where no change is
+    kept: the optimiser does not take the basis where its first-order uncertainty fails).
 
     rep: the integrals' Representation (integrals.laboratory); threshold: eigen.solve's relative
     overlap eigenvalue below which directions are dropped; min_norm, max_overlap: the
     linear-dependence guard of `candidates` (Optimiser settings of the same names)."""
 
-    def __init__(self, basis: Basis, rep, threshold: float, min_norm: float = 1e-8, max_overlap: float = 0.99):
+    def __init__(self, basis: Basis, rep, threshold: float, min_norm: float = 1e-8, max_overlap: float = 0.99,
+                 objective: LowestRoot = LowestRoot()):
         self.basis, self.rep, self.threshold = basis, rep, threshold
-        self.min_norm, self.max_overlap = min_norm, max_overlap
+        self.min_norm, self.max_overlap, self.objective = min_norm, max_overlap, objective
         if len(basis):
             self.m = rep.matrices(basis)
         else:
@@ -44,17 +46,22 @@ class Expansion:
         if len(self.basis) == 0:
             self.eig, self.energy, self.sigma = None, np.inf, 0.0
             return
-        self.eig = eigen.solve(self.m["T_ti"] + self.m["V"], self.m["S"], self.threshold)
-        self.energy = float(self.eig.energies[0])
-        self.sigma = (eigen.energy_uncertainty(self.eig.vectors[:, 0], self.energy, self.m["S"], self.m["T_ti"],
+        self.eig = self.objective.solve(self.m["T_ti"] + self.m["V"], self.m["S"], self.threshold)
+        self.energy = self.objective.value(self.eig)
+        self.sigma = (eigen.energy_uncertainty(self.coefficients, self.energy, self.m["S"], self.m["T_ti"],
                                                self.m["V"]) if eigen.first_order(self.eig) else np.inf)
 
+    @property
+    def coefficients(self) -> np.ndarray:
+        """The state's coefficients c, S-normalised (the objective's eigenvector)."""
+        return self.objective.vector(self.eig)
+
     def sound(self) -> bool:
-        """Whether the ground state's internal kinetic energy c^T T_ti c is positive beyond the
+        """Whether the state's internal kinetic energy c^T T_ti c is positive beyond the
         energy's uncertainty, as that of any wave function is: rounding that dominates an
         ill-conditioned basis's elements (integrals.py, cancellation) can make it negative, and
         its energy then means nothing (two electrons "bound" at -0.13 Eh)."""
-        c = self.eig.vectors[:, 0]
+        c = self.coefficients
         return bool(c @ self.m["T_ti"] @ c > self.sigma)
 
     def gains(self, energy: float) -> bool:
@@ -105,7 +112,7 @@ class Expansion:
         if not keep.any():
             return None
         H = self.m["T_ti"] + self.m["V"]
-        return eigen.solve(H[np.ix_(keep, keep)], self.m["S"][np.ix_(keep, keep)], self.threshold)
+        return self.objective.solve(H[np.ix_(keep, keep)], self.m["S"][np.ix_(keep, keep)], self.threshold)
 
     def independence(self, idx: list[int]) -> float:
         """The smallest eigenvalue of the part of functions `idx` orthogonal to the others, scaled
@@ -127,12 +134,12 @@ class Expansion:
         self.solve()
 
     def virial(self) -> float:
-        """|1 + <V>/(2<T_ti>)| of the ground state: 0 for an exact Coulomb eigenstate (virial theorem)."""
-        c = self.eig.vectors[:, 0]
+        """|1 + <V>/(2<T_ti>)| of the state: 0 for an exact Coulomb eigenstate (virial theorem)."""
+        c = self.coefficients
         return abs(1.0 + (c @ self.m["V"] @ c) / (2.0 * (c @ self.m["T_ti"] @ c)))
 
     def candidates(self, trials: Basis, exclude: int | None = None, eig=None):
-        """Lowest energy with each trial added (to the basis without `exclude`, where the trial
+        """The energy with each trial added (to the basis without `exclude`, where the trial
         would replace it), with the rows and diagonals for `put`. The linear-dependence guard
         gives +inf to a trial whose normalised overlap with a function exceeds `max_overlap`
         or whose part orthogonal to the basis is below `min_norm` of its norm, and so does a
@@ -147,8 +154,8 @@ class Expansion:
         if eig is None:
             eig = self.eig if exclude is None else self.without(exclude)
         E, C = (eig.energies, eig.vectors) if eig is not None else (np.zeros(0), np.zeros((0, 0)))
-        energies = eigen.lowest_with_added_many(E, C, H[:, keep], S[:, keep], diag[:, 2] + diag[:, 3],
-                                                diag[:, 0], self.min_norm)
+        energies = self.objective.with_added_many(E, C, H[:, keep], S[:, keep], diag[:, 2] + diag[:, 3],
+                                                  diag[:, 0], self.min_norm)
         if keep.any():
             with np.errstate(invalid="ignore", divide="ignore"):  # S_nn ≤ 0: refused as implausible below
                 overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(diag[:, 0], np.diag(self.m["S"])[keep]))

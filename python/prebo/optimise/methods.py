@@ -1,18 +1,19 @@
 """The optimisation methods: small config objects, each doing one unit of work of the schedule
-(checkpoint.Cursor) on a `Run` when the driver (driver.optimise) calls its `step`.
+(cursor.Cursor; schedule.py) on a `Run` when the driver (driver.optimise) calls its `step`; the
+phase of the cursor names the method (`methods`).
 
 - `Grow`: competitive selection (Suzuki & Varga, Lect. Notes Phys. m54, ch. 4, the stochastic
   variational method): `trials` random functions, each one's row against the basis from the
   core (O(N_b) integrals) and the new lowest eigenvalue from the secular equation (O(N_b^2),
   eigen.lowest_with_added_many); the best, if it lowers the energy beyond its uncertainty, is
-  appended — with `refine`, refined first.
-- `Sweep`: one step of a replacement sweep: function i competes with `trials` replacements in the
+  appended — with a `newcomer` Minimiser, refined first.
+- `Replace` ("sweep"): one step of a replacement sweep: function i competes with `trials` replacements in the
   basis without it — its neighbours in the power K (Sampler.neighbours: K ± 1, K ± 2 with the
   peak of the global-vector coordinate kept; refinement cannot change K), then the function
   perturbed at its own scale, or random functions with `near` = 0 (Sampler.replacements);
-  with `refine`, the winner is refined and kept only if it then beats the incumbent, which is
+  with `newcomer`, the winner is refined and kept only if it then beats the incumbent, which is
   refined otherwise (refine.regenerate_function).
-- `Prune`: growth past the size (as `Grow`, each grown function then refined with the functions
+- `PruneStep` ("prune", fixed schedule): growth past the size (as `Grow`, each grown function then refined with the functions
   it overlaps most, so that it joins the basis before the removals are weighed; without that the
   cheapest to remove are the newcomers themselves), then the removal of the function whose
   removal raises the energy least (eigen.lowest_without_each), one per step back to the size,
@@ -21,17 +22,17 @@
   Eh against −1.5e-11 … 7.7e-11 without; benchmarks/README, "Pruning that refines after each
   removal"): pruning a basis grown past its size keeps the functions that matter and moves the
   basis out of the basin refinement has settled in (benchmarks/README, "Grow and prune").
-- `Pruning`: the adaptive schedule's pruning, `pruned(N_b)` growth steps and the removals back to
-  N_b in one step, undone unless the energy fell: the schedule's size is a cap at every step and
-  its energy never rises.
+- `PrunePass` ("prune", adaptive schedule): a whole pruning, `pruned(N_b)` growth steps and the
+  removals back to N_b, in one step, undone unless the energy fell: the schedule's size is a cap
+  at every step and its energy never rises.
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed, or with the
-  functions it overlaps most (`refine_group`; refine.py).
+  functions it overlaps most (`refine_group`; refine.py), as `Minimiser` says.
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
-- `Extrapolate`: the basis moved on along its displacement since the last move (momentum.py;
-  adaptive schedule).
+- `MomentumMove` ("momentum"): the basis moved on along its displacement since the last move
+  (momentum.py; adaptive schedule).
 Replacements and pruning reach new basins, joint refinement converges within one; the
-prune-sweep-refine-polish block is repeated `cycles` times (Optimiser), or the adaptive schedule
-chooses among grow, sweep, refine, polish and prune and moves the basis on (schedule.py).
+prune-sweep-refine-polish block is repeated `cycles` times (fixed.py), or the adaptive schedule
+chooses among grow, sweep, refine, polish and prune and moves the basis on (adaptive.py).
 """
 from __future__ import annotations
 
@@ -39,16 +40,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import eigen
 from ..errors import StalledError, UnsupportedError
-from .checkpoint import Cursor
+from .adaptive import pruned
+from .cursor import Cursor
 from .expansion import SIGMA_PRICE, Expansion
 from .momentum import Momentum
 from .polish import polish
 from .refine import partners, refine_group, refine_newcomer, regenerate_function
 from .report import Reporter
 from .sampler import Sampler
-from .schedule import pruned
 from .settings import Optimiser
 
 STALL_STEPS = 100  # growth steps in a row without an accepted trial before the run stops (StalledError)
@@ -67,10 +67,10 @@ class Run:
 
 
 @dataclass(frozen=True)
-class Refinement:
-    """The refinement of one function: at most `evaluations` energies by `method` ("gradient":
-    L-BFGS on exact gradients, or "powell"); in a refinement sweep, together with the `group` - 1
-    functions it overlaps most (refine.refine_group)."""
+class Minimiser:
+    """The local minimiser that refines one function (refine.py): at most `evaluations` energies
+    by `method` ("gradient": L-BFGS on exact gradients, or "powell"); in a refinement sweep,
+    together with the `group` - 1 functions it overlaps most (refine.refine_group)."""
 
     evaluations: int
     method: str
@@ -79,11 +79,12 @@ class Refinement:
 
 @dataclass(frozen=True)
 class Grow:
-    """Append the best of `trials` random functions (module docstring); refine it with `refine`.
-    StalledError after STALL_STEPS steps in a row whose every trial was rejected."""
+    """Append the best of `trials` random functions (module docstring), refined first by the
+    `newcomer` minimiser if given. StalledError after STALL_STEPS steps in a row whose every
+    trial was rejected."""
 
     trials: int
-    refine: Refinement | None = None
+    newcomer: Minimiser | None = None
 
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
@@ -93,9 +94,9 @@ class Grow:
         best = int(np.argmin(energies))
         run.report.trials(len(trials))
         nb, gains = len(ex.basis), np.isfinite(energies[best]) and ex.gains(energies[best])
-        if self.refine:
-            grown = gains and refine_newcomer(ex, nb, trials.subset([best]), self.refine.evaluations,
-                                              self.refine.method)
+        if self.newcomer:
+            grown = gains and refine_newcomer(ex, nb, trials.subset([best]), self.newcomer.evaluations,
+                                              self.newcomer.method)
         else:
             grown = gains and ex.put(nb, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
         if grown:
@@ -131,13 +132,13 @@ def stalled(nb: int, opts: Optimiser, condition: float = 0.0, sigma: float = 0.0
 
 
 @dataclass(frozen=True)
-class Sweep:
+class Replace:
     """Replace function `cursor.index` by the best of `trials` functions — its neighbours in K, then
-    itself perturbed or random ones — if that lowers the energy; with `refine`, the winner is
-    refined first (module docstring)."""
+    itself perturbed or random ones — if that lowers the energy; with a `newcomer` minimiser, the
+    winner is refined first (module docstring)."""
 
     trials: int
-    refine: Refinement | None = None
+    newcomer: Minimiser | None = None
 
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
@@ -147,20 +148,20 @@ class Sweep:
         energies, rows, diag = ex.candidates(trials, exclude=i, eig=rest)
         run.report.trials(len(trials))
         best = int(np.argmin(energies))
-        if self.refine and np.isfinite(energies[best]):
-            regenerate_function(ex, i, trials.subset([best]), self.refine.evaluations, self.refine.method, rest)
+        if self.newcomer and np.isfinite(energies[best]):
+            regenerate_function(ex, i, trials.subset([best]), self.newcomer.evaluations, self.newcomer.method, rest)
         elif np.isfinite(energies[best]) and ex.gains(energies[best]):
             ex.put(i, trials.subset([best]), {k: v[best] for k, v in rows.items()}, diag[best])
 
 
 @dataclass(frozen=True)
-class Prune:
+class PruneStep:
     """At `cursor.index` 0 a `grow` step past the size, the grown function then refined with its
-    partners by `refine`; at 1 the removal of the function whose removal raises the energy least,
-    the function it overlapped most then refined with its partners (module docstring)."""
+    partners by `minimiser`; at 1 the removal of the function whose removal raises the energy
+    least, the function it overlapped most then refined with its partners (module docstring)."""
 
     grow: Grow
-    refine: Refinement
+    minimiser: Minimiser
 
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
@@ -169,7 +170,7 @@ class Prune:
             nb = len(ex.basis)
             self.grow.step(run, cursor)
             if len(ex.basis) > nb:
-                refine_group(ex, nb, self.refine.group, self.refine.evaluations, self.refine.method)
+                refine_group(ex, nb, self.minimiser.group, self.minimiser.evaluations, self.minimiser.method)
             return
         self.remove(run)
 
@@ -179,19 +180,19 @@ class Prune:
         index removed."""
         ex = run.expansion
         run.report.trials(len(ex.basis))
-        i = int(np.argmin(eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors)))
+        i = int(np.argmin(ex.objective.without_each(ex.eig.energies, ex.eig.vectors)))
         j = partners(ex, i, 1)[0]
         ex.remove(i)
-        refine_group(ex, j - (j > i), self.refine.group, self.refine.evaluations, self.refine.method)
+        refine_group(ex, j - (j > i), self.minimiser.group, self.minimiser.evaluations, self.minimiser.method)
         return i
 
 
 @dataclass(frozen=True)
-class Pruning:
+class PrunePass:
     """`prune`'s growth by `pruned(N_b)` functions (fewer if growth stalls) and its removals back to
     N_b as one step, kept only if the energy fell beyond its uncertainty (module docstring)."""
 
-    prune: Prune
+    prune: PruneStep
 
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
@@ -212,14 +213,15 @@ class Pruning:
 
 @dataclass(frozen=True)
 class Refine:
-    """Refine function `cursor.index` with all others fixed."""
+    """Refine function `cursor.index`, with its partners if `minimiser.group` > 1, all others fixed."""
 
-    refine: Refinement
+    minimiser: Minimiser
 
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
         run.report.trials(1)
-        refine_group(run.expansion, cursor.index, self.refine.group, self.refine.evaluations, self.refine.method)
+        refine_group(run.expansion, cursor.index, self.minimiser.group, self.minimiser.evaluations,
+                     self.minimiser.method)
 
 
 @dataclass(frozen=True)
@@ -234,7 +236,7 @@ class Polish:
 
 
 @dataclass(frozen=True)
-class Extrapolate:
+class MomentumMove:
     """Move the basis on along its displacement since the last move (momentum.py)."""
 
     def step(self, run: Run, cursor: Cursor) -> None:
@@ -247,10 +249,10 @@ def methods(opts: Optimiser) -> dict:
     adaptive schedule, and in a fixed one with `refine`, every grown and replacing function is
     refined; an adaptive schedule prunes a whole pass in one step and moves the basis on along its
     displacement (momentum.py)."""
-    refinement = Refinement(opts.refine_evaluations, opts.refine_method, opts.refine_group)
-    on_change = Refinement(opts.refine_evaluations, opts.refine_method) if opts.adaptive or opts.refine else None  # refine grown and replacing functions too
-    prune = Prune(Grow(opts.trials, on_change), refinement)
-    return {"grow": Grow(opts.trials, on_change), "prune": Pruning(prune) if opts.adaptive else prune,
-            "sweep": Sweep(opts.trials, on_change),
-            "refine": Refine(refinement), "polish": Polish(opts.polish_iterations)} | (
-                {"momentum": Extrapolate()} if opts.adaptive else {})
+    minimiser = Minimiser(opts.refine_evaluations, opts.refine_method, opts.refine_group)
+    newcomer = Minimiser(opts.refine_evaluations, opts.refine_method) if opts.adaptive or opts.refine else None
+    prune = PruneStep(Grow(opts.trials, newcomer), minimiser)
+    return {"grow": Grow(opts.trials, newcomer), "prune": PrunePass(prune) if opts.adaptive else prune,
+            "sweep": Replace(opts.trials, newcomer),
+            "refine": Refine(minimiser), "polish": Polish(opts.polish_iterations)} | (
+                {"momentum": MomentumMove()} if opts.adaptive else {})

@@ -2,7 +2,8 @@
 
 Refinement sweeps move one function at a time; near the optimum, where the functions' parameters
 are coupled, that coordinate descent crawls. Here θ = (θ_1, ..., θ_N) (Parametrisation of
-each function in its own channel; K fixed) and, with c the S-normalised ground-state vector,
+each function in its own channel; K fixed) and, with E and c the objective's root and its
+S-normalised eigenvector (objective.py; Hellmann–Feynman),
 
     ∂E/∂θ_i = 2 c_i Σ_{j≠i} c_j (∂H_ij − E ∂S_ij) + c_i² (∂H_ii − E ∂S_ii),
 
@@ -18,7 +19,6 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize
 
-from .. import eigen
 from ..basis import Basis
 from ..errors import PreboError
 from .parametrisation import Parametrisation
@@ -59,12 +59,12 @@ class Joint:
         if not st.rep.plausible({"S": M["S"]}, diag, np.diag(M["S"])).all():
             return fail
         try:
-            eig = eigen.solve(M["T_ti"] + M["V"], M["S"], st.threshold)
+            eig = st.objective.solve(M["T_ti"] + M["V"], M["S"], st.threshold)
         except PreboError:
             return fail
         if eig.kept < nb or eig.overlap_condition > self.max_condition:
             return fail
-        E, c = float(eig.energies[0]), eig.vectors[:, 0]
+        E, c = st.objective.value(eig), st.objective.vector(eig)
         grad = []
         for i, (rows, d) in enumerate(parts):
             dH, dS = rows["T_ti"][1:] + rows["V"][1:], rows["S"][1:]

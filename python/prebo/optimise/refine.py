@@ -2,16 +2,16 @@
 Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018), Sec. IV.E).
 
 The function moves in its parameters θ (parametrisation.py). The energy of a trial θ is the
-lowest root of the secular equation (eigen.lowest_with_added) against the basis without the
-function: one row of integrals and O(N_b^2) per evaluation.
+objective's root (objective.py: the lowest) of the secular equation (eigen.lowest_with_added)
+against the basis without the function: one row of integrals and O(N_b^2) per evaluation.
 
 Two minimisers: Powell's method on the energy (the paper's), and L-BFGS on the energy and its
 exact gradient — the row's derivatives along ∂(A, u or s)/∂θ_p by forward-mode dual numbers
 in the Rust core (Representation.row_gradient), then eigen.lowest_with_added_gradient.
 
 A group (`refine_group`): function i and the functions it overlaps most (`partners`) move
-together, L-BFGS on all their θ, the energy the lowest root of the block update against the
-basis without them (eigen.lowest_with_block). Strongly overlapping functions of an optimised
+together, L-BFGS on all their θ, the energy the root of the block update against the basis
+without them (eigen.lowest_with_block). Strongly overlapping functions of an optimised
 basis act together (a near-duplicate pair is a derivative of a Gaussian): moved one at a time,
 each is held by the other.
 """
@@ -20,14 +20,13 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize
 
-from .. import eigen
 from ..basis import Basis
 from ..errors import PreboError
 from .parametrisation import Parametrisation
 
 
-class Objective:
-    """The energy as a function of θ of function i, all others fixed: the lowest root of the
+class FunctionEnergy:
+    """The energy as a function of θ of function i, all others fixed: the objective's root of the
     secular equation against the basis without i. Remembers the best function seen. A θ that
     leaves the valid region (an ill-conditioned 𝒜, elements failing `Representation.plausible`),
     or makes the function linearly dependent on the others, scores worse than the current energy (a finite value keeps the line searches sane).
@@ -58,7 +57,7 @@ class Objective:
             self.best_E, self.best_f = e, f
 
     def energy(self, theta: np.ndarray) -> float:
-        """The lowest energy (hartree) with function i at θ (`worse` outside the valid region)."""
+        """The energy (hartree) with function i at θ (`worse` outside the valid region)."""
         st = self.expansion
         try:
             f = self.p.function(theta)
@@ -67,7 +66,7 @@ class Objective:
             return self.worse
         if not st.rep.plausible({"S": rows["S"][:, self.keep]}, diag, self.S_rest)[0]:
             return self.worse
-        e = eigen.lowest_with_added(self.E, self.C, (rows["T_ti"] + rows["V"])[0, self.keep],
+        e = st.objective.with_added(self.E, self.C, (rows["T_ti"] + rows["V"])[0, self.keep],
                                     rows["S"][0, self.keep], diag[0, 2] + diag[0, 3], diag[0, 0], st.min_norm)
         if not np.isfinite(e):
             return self.worse
@@ -87,7 +86,7 @@ class Objective:
             return self.worse, np.zeros_like(theta)
         H, S = rows["T_ti"] + rows["V"], rows["S"]
         h_nn, s_nn = diag[:, 2] + diag[:, 3], diag[:, 0]
-        e, g = eigen.lowest_with_added_gradient(self.E, self.C, H[0], S[0], h_nn[0], s_nn[0], H[1:], S[1:],
+        e, g = st.objective.with_added_gradient(self.E, self.C, H[0], S[0], h_nn[0], s_nn[0], H[1:], S[1:],
                                                 h_nn[1:], s_nn[1:], st.min_norm)
         if not (np.isfinite(e) and np.all(np.isfinite(g))):
             return self.worse, np.zeros_like(theta)
@@ -95,11 +94,11 @@ class Objective:
         return e, g
 
 
-class GroupObjective:
+class GroupEnergy:
     """The energy as a function of the θ of functions `idx` (concatenated), all others fixed: the
-    lowest root of the block update against the basis without them, and its exact gradient.
+    objective's root of the block update against the basis without them, and its exact gradient.
     Remembers the best group seen (`best_E`, `best_f`: one-function bases in the order of idx);
-    outside the valid region it scores `worse`, like `Objective`."""
+    outside the valid region it scores `worse`, like `FunctionEnergy`."""
 
     def __init__(self, expansion, idx: list[int]):
         self.expansion, self.idx = expansion, list(idx)
@@ -120,7 +119,7 @@ class GroupObjective:
         return np.concatenate([p.theta() for p in self.p])
 
     def energy_and_gradient(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
-        """The lowest energy (hartree) with the group at θ and ∂E/∂θ (eigen module docstring)."""
+        """The energy (hartree) with the group at θ and ∂E/∂θ (eigen module docstring)."""
         st, k, nr = self.expansion, len(self.p), len(self.rest)
         thetas = np.split(theta, self.split)
         try:
@@ -145,8 +144,8 @@ class GroupObjective:
                     if m < o:
                         B[m, o] = B[o, m] = X[m][0][key][0, nr + c]
             block[key] = B
-        e, a, beta, norm2 = eigen.lowest_with_block(self.E, self.C, h, s, block["H"], block["S"], st.min_norm,
-                                                  near=st.energy)
+        e, a, beta, norm2 = st.objective.with_block(self.E, self.C, h, s, block["H"], block["S"], st.min_norm,
+                                                    near=st.energy)
         if not np.isfinite(e):
             return self.worse, np.zeros_like(theta)
         c_rest = self.C @ a
@@ -185,7 +184,7 @@ def refine_group(expansion, i: int, size: int, max_evaluations: int = 200, metho
         return False
     if single:
         return refine_function(expansion, i, max_evaluations, method)
-    obj = GroupObjective(expansion, idx)
+    obj = GroupEnergy(expansion, idx)
     lbfgs(obj.energy_and_gradient, obj.theta(), max_evaluations)
     if obj.best_f is None or not expansion.gains(obj.best_E):
         return False
@@ -199,7 +198,7 @@ def lbfgs(energy_and_gradient, theta0: np.ndarray, max_evaluations: int) -> None
                       "maxcor": 20})
 
 
-def minimise(obj: Objective, max_evaluations: int, method: str) -> None:
+def minimise(obj: FunctionEnergy, max_evaluations: int, method: str) -> None:
     """Powell's method, or L-BFGS with exact gradients, from the objective's function, with at
     most `max_evaluations` energies; the best function seen is kept in the objective."""
     theta0 = obj.p.theta()
@@ -210,7 +209,7 @@ def minimise(obj: Objective, max_evaluations: int, method: str) -> None:
                  options={"maxfev": max_evaluations, "xtol": 1e-4, "ftol": 1e-14, "direc": 0.1 * np.eye(len(theta0))})
 
 
-def accept(expansion, i: int, obj: Objective) -> bool:
+def accept(expansion, i: int, obj: FunctionEnergy) -> bool:
     """Put the objective's best function in slot i if it lowers the energy beyond its numerical
     uncertainty (Expansion.put); True if it did."""
     if obj.best_f is None or not expansion.gains(obj.best_E):
@@ -223,7 +222,7 @@ def refine_function(expansion, i: int, max_evaluations: int = 200, method: str =
     """Minimise the energy over the parameters of function i — Powell, or L-BFGS with exact
     gradients — with at most `max_evaluations` energies; True if it improved. `rest`: the
     eigen-solution of the basis without i (Expansion.without), if already at hand."""
-    obj = Objective(expansion, i, rest)
+    obj = FunctionEnergy(expansion, i, rest)
     minimise(obj, max_evaluations, method)
     return accept(expansion, i, obj)
 
@@ -246,7 +245,7 @@ def refine_newcomer(expansion, i: int, f: Basis, max_evaluations: int = 200, met
     already at hand) — for i = N_b, against the whole basis — and put it there if it then lowers
     the energy beyond the uncertainty; True if it did. A grown function is refined
     before it joins, so the basis is changed and solved once per step."""
-    newcomer = Objective(expansion, i, rest, f)
+    newcomer = FunctionEnergy(expansion, i, rest, f)
     if not np.isfinite(newcomer.best_E):  # outside the valid region or linearly dependent
         return False
     minimise(newcomer, max_evaluations, method)

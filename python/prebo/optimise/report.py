@@ -5,9 +5,9 @@ import time
 
 import numpy as np
 
-from .checkpoint import Cursor
+from .adaptive import CHUNK
+from .cursor import Cursor
 from .expansion import Expansion
-from .schedule import CHUNK
 from .settings import Optimiser
 
 

@@ -6,8 +6,11 @@ distributions learned from the functions selected so far.
   Bohr radius, bare and in the screened charge, from its reduced mass and charges);
 - a coordinate set x (coordinates.all_sets): 𝒜 = diag(1/b_k^2) in x, b_k drawn in the same way
   for the two particles the coordinate joins, then A^(r) = U_x^T blockdiag(𝒜, c_A) U_x.
-The family adds its own parameters (Family.draw_power, Family.drawn): ECG-GVR a power K and the
-global vector along the pair or coordinate drawn, floating ECGs centres displaced along it.
+The family draws its own parameters: its power before the exponents (Family.draw_power, which
+scales the exponent of one pair or coordinate), the rest from that coordinate and a random
+displacement of it (a `Carrier`, Family.drawn): ECG-GVR the power K and the coordinate's vector as
+u, floating ECGs centres displaced along it. The displacement is drawn for every family, as every
+recorded run drew it, so that fixed-schedule runs repeat bit for bit.
 After `learn_after` functions of a channel, a share `learned` of the trials is drawn from the
 normal distribution of the parameters θ (parametrisation.py) selected so far in that channel.
 Trials near the basis (`perturbed`, a share `near` of them): a function perturbed at its own
@@ -16,7 +19,7 @@ and strict lower part z, z normal with spread PERTURBATION: each direction's exp
 factor around e^{±1} and the directions mixed, where a fresh draw samples the whole length range
 (the family's u, s and K kept). Growth perturbs functions of the basis chosen at random; with
 `near` > 0 a replacement sweep tries moves of the function it may replace only: its neighbours in
-K (`neighbours`, the only moves in K besides a fresh draw: refinement changes θ only), then
+K (Family.neighbours, the only moves in K besides a fresh draw: refinement changes θ only), then
 perturbations of it. On an optimised He basis of 700 functions, replacements by the best of 50
 perturbations gained 3.0e-10 Eh in 140 s, 20× what refinement gained per second there
 (benchmarks/README, "Trials near the basis").
@@ -34,8 +37,6 @@ from ..system import System, reduced_mass
 from .parametrisation import Parametrisation
 from .settings import Optimiser
 
-#: the steps in K of a function's neighbours (`Sampler.neighbours`)
-K_STEPS = (1, 2)
 #: the spread of the logarithmic scale factors and mixings of `Sampler.perturbed`
 PERTURBATION = 1.0
 
@@ -85,6 +86,17 @@ def pair_lengths(system: System) -> tuple[np.ndarray, np.ndarray]:
             a[i, j] = a[j, i] = lo
             outer[i, j] = outer[j, i] = hi
     return a, outer
+
+
+@dataclass(frozen=True)
+class Carrier:
+    """The coordinate v = u^T r a fresh draw singled out (its exponent carries the family's power)
+    and a random displacement of it of its drawn length: u (n, laboratory frame) and the particles'
+    centres (n x 3, bohr; pairs: particle j displaced from particle i; a coordinate set: that
+    coordinate displaced, the others and the CM at 0)."""
+
+    u: np.ndarray
+    centres: np.ndarray
 
 
 @dataclass
@@ -140,22 +152,8 @@ class Sampler:
         self._thetas = seen
 
     def neighbours(self, f: Basis) -> list:
-        """Function f of power K moved to K ± 1, K ± 2 (K_STEPS; within 0..K_max), the marginal exponent of
-        v = u·r scaled by p'/p (p = max(K + N/2, 1)) so that the peak of |v|^{2K+N} stays put:
-        A' = A + (p'/p - 1) u u^T / (u^T A^-1 u) (Sherman–Morrison: u^T A'^-1 u = u^T A^-1 u p/p')."""
-        Ks = f.family.powers(f, [0])
-        if Ks is None:
-            return []
-        K, N = int(Ks[0]), self.system.state.N
-        A, u = f.A[0], f.u[0]
-        p = max(K + 0.5 * N, 1.0)
-        out = []
-        for K2 in (K + sign * step for step in K_STEPS for sign in (-1, 1)):
-            if 0 <= K2 <= self.opts.K_max:
-                g = (max(K2 + 0.5 * N, 1.0) / p - 1.0) / (u @ np.linalg.solve(A, u))
-                out.append(Basis.single(self.system, A + g * np.outer(u, u), f.c_A[0], f.channels[0], f.kind,
-                                        {"u": u[None], "K": [K2]}))
-        return out
+        """The one-function basis f moved in its power, within 0..K_max (Family.neighbours)."""
+        return f.family.neighbours(f, self.opts.K_max)
 
     def perturbed(self, f: Basis, k: int) -> list:
         """`k` functions near f, its exponent matrix perturbed at its own scale (module docstring);
@@ -213,7 +211,7 @@ class Sampler:
         cm = s.cm_vector
         fam = family(self.opts.kind)
         # |v|^{2K+N} exp(-α v²) peaks at |v| = sqrt((K + N/2)/α): for the coordinate that carries
-        # the global vector, the drawn length b is that peak, α = (K + N/2)/b² (K + N/2 > 0)
+        # the power, the drawn length b is that peak, α = (K + N/2)/b² (K + N/2 > 0)
         K, power = fam.draw_power(self.rng, self.opts.K_max, s.state.N)
         if not self.sets:
             i0, j0 = self.pairs[self.rng.integers(len(self.pairs))]
@@ -222,10 +220,9 @@ class Sampler:
                 w = self._pair_vector(i, j)
                 b = self._b(i, j)
                 A += np.outer(w, w) * (max(power, 1.0) if (i, j) == (i0, j0) else 1.0) / b**2
-            u = self._pair_vector(i0, j0)
-            # centres: particle j displaced from particle i by a random vector of its pair length
             centres = np.zeros((n, 3))
             centres[j0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(i0, j0)
+            carrier = Carrier(self._pair_vector(i0, j0), centres)
             channel = "pairs"
         else:
             x = self.sets[self.rng.integers(len(self.sets))]
@@ -238,10 +235,8 @@ class Sampler:
             A = x.to_lab(np.diag(alpha), c_A)
             ux = np.zeros(n)
             ux[k0] = 1.0  # one internal coordinate, c_U = 0
-            u = x.U.T @ ux
-            # centres in x: coordinate k0 displaced by a random vector of its drawn length, CM at rest
             sx = np.zeros((n, 3))
             sx[k0] = self.rng.normal(size=3) / np.sqrt(3) * self._b(*joined[k0])
-            centres = x.U_inv @ sx
+            carrier = Carrier(x.U.T @ ux, x.U_inv @ sx)
             channel = x.name
-        return Basis.single(s, A, c_A, channel, fam.name, fam.drawn(s, u, centres, K))
+        return Basis.single(s, A, c_A, channel, fam.name, fam.drawn(self.rng, s, carrier, K))

@@ -7,8 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 
-from ..basis import FAMILIES
-from ..basis.gvr import K_LIMIT
+from ..basis.families import FAMILIES
 from ..eigen import THRESHOLD
 from ..errors import InputError
 from ..validation import (MATRICES, MAX_SIZE, Automatic, Channels, Choice, Integer, Lengths, Real, checked,
@@ -50,7 +49,8 @@ SETTINGS = {
                             "[optimiser] length_range"),
     "c_A": Setting(C_A, "exponent of the centre-of-mass coordinate in bohr⁻²", "[basis] c_A"),
     "kind": Setting(Automatic(Choice(tuple(FAMILIES))), "basis type", "[basis] type"),
-    "K_max": Setting(Automatic(Integer(0, K_LIMIT)), "largest power K of an ECG-GVR function", "[basis] K_max"),
+    "K_max": Setting(Automatic(Integer(0, max(f.K_limit for f in FAMILIES.values()))),
+                     "largest power K of a function of a family with powers", "[basis] K_max"),
     "refine": Setting(Automatic(Integer(0)), "refinement sweeps per cycle", "[optimiser] refine"),
     "refine_evaluations": Setting(Automatic(Integer(1)), "energies per refinement of one function",
                                   "[optimiser] refine_evaluations"),
@@ -95,7 +95,7 @@ class Optimiser:
 
     Basis: size — functions to grow to (≤ MAX_SIZE, what memory allows); kind — the basis
     family ("pecg", "ecg-gvr", "fecg"); c_A — exponent of the CM coordinate in bohr⁻², shared by
-    every function (1e-2..1e3, `C_A`); K_max — largest power K of an ECG-GVR function (0..60).
+    every function (1e-2..1e3, `C_A`); K_max — largest power K of a function (ECG-GVR: 0..60, its K_limit).
     Sampling: trials — competitive trials per step; seed — of the random numbers; channels —
     "pairs", "all" or a list of coordinate-set names the functions are drawn in; length_range —
     [lo, hi] of the drawn lengths in units of each pair's Bohr radius (sampler.pair_lengths; within
@@ -106,7 +106,7 @@ class Optimiser:
     sweep's trials all move the function replaced (sampler.py; chosen by the schedule when not
     given).
     Schedule: with none of prune, sweeps, refine, polish and cycles given, the schedule chooses itself
-    (schedule.py: growth, refinement, replacement, joint and pruning passes by the energy each
+    (adaptive.py: growth, refinement, replacement, joint and pruning passes by the energy each
     gains per second), stopping at `budget` seconds, or when every kind of pass gains less than
     `tolerance` Eh. Given any of them, the fixed schedule of methods.py: prune — functions grown
     past `size` and then removed, those whose removal costs least, at the start of each cycle; sweeps — replacement

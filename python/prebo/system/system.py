@@ -16,7 +16,7 @@ from .particles import Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
 
 #: N: bound few-body states have far smaller ones (H₂'s last rotational level has N = 31); the
-#: ECG-GVR quadrature holds 2 K + N ≤ 1021 (crates/prebo-core/src/gvr.rs)
+#: ECG-GVR quadrature holds 2 K + N ≤ 1021 (crates/prebo-core/src/families/gvr/)
 N_RANGE = Integer(0, 1000)
 #: a given dissociation threshold (Eh): fragments (bound: < 0) and free particles at rest (0) lie at
 #: or below 0 (prebo.thresholds)

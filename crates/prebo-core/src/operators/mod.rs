@@ -7,8 +7,8 @@
 //! (`Engine.operator(name, params, w)`).
 use crate::ecg::Vector;
 use crate::error::{CoreError, Result};
-use crate::family::Family;
-use crate::plain::PlainEcg;
+use crate::families::plain::PlainEcg;
+use crate::families::Family;
 
 pub mod r2;
 

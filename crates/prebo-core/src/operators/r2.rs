@@ -7,7 +7,7 @@
 use nalgebra::{Const, U1};
 
 use crate::ecg::Vector;
-use crate::family::Family;
+use crate::families::Family;
 use crate::gradient::{seed, Dual};
 
 pub const NAME: &str = "r2";
@@ -32,10 +32,11 @@ mod tests {
     //! plain ECGs, and for K, N > 0 against central differences of the damped overlap in α.
     use super::*;
     use crate::ecg::{Gaussian, Mat, Operators};
-    use crate::fecg::{Centres, Fecg, FloatingEcg};
-    use crate::gvr::{EcgGvr, Gvr, GvrOps};
-    use crate::pecg;
-    use crate::plain::PlainEcg;
+    use crate::families::floating::fecg::{self, Centres, Fecg};
+    use crate::families::floating::FloatingEcg;
+    use crate::families::gvr::gvr_element::{Gvr, GvrOps};
+    use crate::families::gvr::EcgGvr;
+    use crate::families::plain::{pecg, PlainEcg};
 
     const D: usize = 3;
 
@@ -84,7 +85,7 @@ mod tests {
         let b = (fi.a + fj.a).try_inverse().unwrap();
         let rbar = b * (fi.a * fi.s + fj.a * fj.s);
         let m = w().transpose() * rbar;
-        let s = crate::fecg::element(&fi, &fj, &ops).s;
+        let s = fecg::element(&fi, &fj, &ops).s;
         let want = (1.5 * (w().transpose() * b * w())[(0, 0)] + m.norm_squared()) * s;
         let got = element::<D, FloatingEcg>(&fi, &fj, &ops, &w());
         assert!(close(got, want, 1e-12), "{got} vs {want}");

@@ -1,8 +1,8 @@
 //! The ECG-GVR row gradient by hand-derived reverse mode (issue 15): one trial function (the
 //! bra, un-transformed) against every basis image, with the derivatives along P directions
-//! `(dA_p, du_p)` of its `A` and `u`. Same layout as `path::row_gradient`.
+//! `(dA_p, du_p)` of its `A` and `u`. Same layout as `path::row_gradient`'s row.
 //!
-//! # Derivation (notation of `gvr` and docs/gvr.md)
+//! # Derivation (notation of `gvr_element` and docs/gvr.md)
 //! Every output `O ∈ {S, T, T_TI, V}` of one image is `O = e^{ln S_0 − n_I − n_J} F_O`, where
 //! `F_O` depends on the bra through `x, y, z`, `g_I = B⁻¹u_I`, `g_J = B⁻¹u_J`, `A_I` and `u_I`.
 //! With `M = B⁻¹`, `dM = −M dA M`, `d ln|B| = Tr(M dA)`, and the adjoints `x̄, ȳ, z̄` (of the
@@ -20,34 +20,34 @@
 //! each direction once per symmetrised element; `dn_I` (the bra's normalisation) once per call.
 //!
 //! - `S = e^{...} Ω`: `x̄ = s ω_x` etc. (`s` the element's `scale`, `ω_· = Ω_·/e^L`).
-//! - `T = e^{...} (c_Ω Ω + c_x Ω_x + c_y Ω_y + c_z Ω_z)` (`gvr` module docs): `x̄ = s(c_Ω ω_x +
+//! - `T = e^{...} (c_Ω Ω + c_x Ω_x + c_y Ω_y + c_z Ω_z)` (`gvr_element` module docs): `x̄ = s(c_Ω ω_x +
 //!   c_x ω_xx + c_y ω_xy + c_z ω_xz)` etc. with Ω's second derivatives (`hessian`); the scalars of
 //!   the `c`'s are bilinear in `g_I, g_J, u_I, A_I` (`kinetic`), and `Tr(A_IΛA_J M)` has the full
 //!   gradient `M A_J Λ A_J M` (explicit `M A_J Λ` plus `−M A_J Λ A_I M` through `M`).
 //! - `T_TI = T − T_cm`: the `c`'s of `cm_kinetic` subtracted, and `c_UI = 1ᵀu_I` adds to `ū`.
 //! - `V = s Σ_w 2q/√(πc) Q(x, y, z, γ_I, γ_J)` with `Q` the τ-integral over `e^L` and its
-//!   partials (`gvr::coulomb_partials`): `x̄ = V L_x + s Σ 2q/√(πc) Q_x` (`L_x = (K_I+N/2)/x`),
+//!   partials (`gvr_build::coulomb_partials`): `x̄ = V L_x + s Σ 2q/√(πc) Q_x` (`L_x = (K_I+N/2)/x`),
 //!   `γ = g·w/√(2c)` gives `ḡ += γ̄ w/√(2c)`, and `c = wᵀMw`, `dc = −(Mw)ᵀdA(Mw)`, with
 //!   `c̄ = −s 2q/√(πc) Q/(2c) − (γ̄_Iγ_I + γ̄_Jγ_J)/(2c)`.
 //!
 //! The algebra of one image runs on [`MAX_LANES`] symmetry images of a ket at once, structure of
 //! arrays (`lanes`, as `gvr_kernel::elements`; each lane with the bits of the one-image path),
-//! compiled per instruction set (`gvr_build::gradient_kernel`). The trial's diagonal (both sides
-//! move) stays on the dual-number path (one element).
+//! compiled per instruction set (`kernel`). The trial's diagonal (both sides move) stays on the
+//! dual-number path (`EcgGvr::row_gradient`).
 use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
+use super::gvr_element::{functions, series_coefficients, Gvr, GvrOps, GvrParams};
+use super::gvr_kernel::{derivative_series, dot, integral_partials, inverse_log_det, mat_vec, padded_rule, Ket, Prepared, Side, MAX_LANES, MAX_PAIRS};
+use super::gvr_series::{horner, omega, Coefficients};
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Vector};
 use crate::error::Result;
-use crate::family::{check, matrices_of, Directions, Family, Params, Symmetry};
-use crate::gvr::{series_coefficients, Coefficients, EcgGvr, Gvr, GvrOps};
-use crate::gvr_build::{self, Side};
-use crate::gvr_kernel::{self as kernel, derivative_series, dot, integral_partials, inverse_log_det, mat_vec, padded_rule, Ket, Prepared, MAX_LANES, MAX_PAIRS};
+use crate::families::{check, matrices_of, Directions, Parameters, Symmetry};
+use crate::isa::{process_isa, Isa};
 use crate::lanes::{array as vector, matrix, Lane, Lanes};
 use crate::matrices::Matrices;
-use crate::path;
 
 type V<T, const D: usize> = [T; D];
 type M<T, const D: usize> = [[T; D]; D];
@@ -155,22 +155,15 @@ impl Series {
         Self { coef, c, dc, h, ki, kj, n, tau2, weight }
     }
 
-    /// The series as the kernel's `gvr_kernel::omega` takes it.
-    fn kernel(&self) -> kernel::Series<'_> {
-        let s = &self.coef;
-        let (c, cx, cy, cz) = (&s.c[..], &s.cx[..], &s.cy[..], &s.cz[..]);
-        kernel::Series { ki: self.ki, kj: self.kj, n: self.n, c, cx, cy, cz, tau2: &self.tau2, weight: &self.weight }
-    }
-
     /// `e^{-L}` times Ω's second derivatives, `[ω_xx, ω_xy, ω_yy, ω_xz, ω_yz, ω_zz]`: from
     /// `Ω = Σ ĉ_k x^{a} y^{b} z^{n}` (`a = K_I−k`, `b = K_J−k`, `n = N+2k`),
     /// `e^{-L} x^{a−i} y^{b−j} z^{n−l} = ρ^{n−l} x^{−i} y^{−j} (xy)^{−l/2}`.
     #[inline(always)]
     fn hessian<T: Lane>(&self, x: T, y: T, z: T) -> [T; 6] {
-        let rt = (x * y).map(f64::sqrt);
-        let rho = (z / rt).map(|v| v.clamp(-1.0, 1.0));
+        let rt = T::sqrt(x * y);
+        let rho = T::clamp_unit(z / rt);
         let r = rho * rho;
-        let s: [T; 6] = vector(|k| kernel::horner(&self.h[k].0, r) * kernel::power(rho, self.h[k].1));
+        let s: [T; 6] = vector(|k| horner(&self.h[k].0, r) * T::powu(rho, self.h[k].1));
         [s[0] / (x * x), s[1] / (x * y), s[2] / (y * y), s[3] / (x * rt), s[4] / (y * rt), s[5] / (x * y)]
     }
 }
@@ -207,13 +200,13 @@ fn images<const D: usize, const W: usize, T: Lane>(
     let y = dot(uj, &gj) * 0.5;
     let z = dot(&ui, &gj) * 0.5;
     let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
-    let (l, om, ox, oy, oz) = kernel::omega(&ser.kernel(), x, y, z);
+    let (l, om, ox, oy, oz) = omega(&ser.coef.terms(), x, y, z);
     let scale = (log_s0 + l - bra.log_norm - ket.log_norm).map(f64::exp);
     let hess = ser.hessian(x, y, z);
     let first = [ox, oy, oz];
     let s = scale * om;
 
-    // kinetic (gvr::element): T/scale = λ ω_z − 4 p2 ω_x − 2 p3 ω_z − 4 p4 ω_y − 2 p5 ω_z
+    // kinetic (`gvr_element::element`): T/scale = λ ω_z − 4 p2 ω_x − 2 p3 ω_z − 4 p4 ω_y − 2 p5 ω_z
     //                                    + 12 tr ω + 8 p7 ω_x + 4 p8 ω_z + 8 p9 ω_y
     let lam_uj = &ket.lambda_u;
     let zl = mat_vec(&ket.a, &vector(|i| T::splat(bra.lambda_u[i]))); // A_J Λ u_I
@@ -245,7 +238,7 @@ fn images<const D: usize, const W: usize, T: Lane>(
     let mut adj_t = kin;
     adj_t.xyz = xyz_bar(c_t, first, &hess, scale);
 
-    // T_TI = T − T_cm: T_cm/scale = Σ c_cm · (ω, ω_x, ω_y, ω_z) (gvr::cm_kinetic)
+    // T_TI = T − T_cm: T_cm/scale = Σ c_cm · (ω, ω_x, ω_y, ω_z) (`gvr_series::cm_kinetic`)
     let (t_ti, adj_ti) = match go.ops.cm_mass {
         Some(mt) => {
             let (ci, cj, cui, cuj) = (T::splat(bra.c_a), ket.c_a, T::splat(bra.c_u), ket.c_u);
@@ -435,6 +428,54 @@ pub(crate) fn symmetrised<const D: usize, const W: usize>(
     (o, g)
 }
 
+/// `symmetrised` compiled for one instruction set (lanes `W`, target feature), in module `$isa`.
+macro_rules! isa_kernels {
+    ($isa:ident, $w:literal $(, $feature:literal)?) => {
+        mod $isa {
+            use super::*;
+
+            /// Safety: callers must pass only to a CPU with the feature (checked in `kernel`).
+            $(#[target_feature(enable = $feature)])?
+            pub(super) unsafe fn gradient<const D: usize>(
+                bra: &Prepared<D>,
+                images: &[Prepared<D>],
+                coef: &[f64],
+                series: &Series,
+                lambda: &[[f64; D]; D],
+                go: &GvrOps<D>,
+            ) -> ([f64; 4], [Grad<D>; 4]) {
+                symmetrised::<D, $w>(bra, images, coef, series, lambda, go)
+            }
+        }
+    };
+}
+
+isa_kernels!(plain, 4);
+#[cfg(target_arch = "x86_64")]
+isa_kernels!(avx2, 4, "avx2");
+#[cfg(target_arch = "x86_64")]
+isa_kernels!(avx512, 8, "avx512f");
+
+/// The values `[S, T, T_TI, V]` of one trial against the images of one function and their
+/// gradients (`symmetrised`).
+type GradientFn<const D: usize> =
+    unsafe fn(&Prepared<D>, &[Prepared<D>], &[f64], &Series, &[[f64; D]; D], &GvrOps<D>) -> ([f64; 4], [Grad<D>; 4]);
+
+/// `symmetrised` on the best instruction set (`isa::process_isa`).
+fn kernel<const D: usize>() -> GradientFn<D> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let isa = process_isa();
+        if isa == Isa::Avx512 && std::arch::is_x86_feature_detected!("avx512f") {
+            return avx512::gradient::<D>;
+        }
+        if isa == Isa::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            return avx2::gradient::<D>;
+        }
+    }
+    plain::gradient::<D>
+}
+
 /// `(G_n, g_n)` of the bra's `n_I = ln <φ|φ>^{1/2}` (`Gvr::new`): with `h = A⁻¹u`,
 /// `x_n = uᵀh/4`, `n_I = −3/4 ln|A| + (K + N/2) ln x_n + const`.
 fn log_norm_gradient<const D: usize>(bra: &Gvr<D>, n_ang: u32) -> Grad<D> {
@@ -445,24 +486,22 @@ fn log_norm_gradient<const D: usize>(bra: &Gvr<D>, n_ang: u32) -> Grad<D> {
     Grad { a: ainv * -0.75 - h * h.transpose() * (kn / (8.0 * xn)), u: h * (kn / (4.0 * xn)) }
 }
 
-/// `EcgGvr::row_gradient` (module docs): the `(1 + P) x nb` row and its derivatives, and the
-/// `1 + P` diagonal (dual numbers, `path::row_gradient` against no basis); the prepared basis
-/// kept in `cache` (shared with `gvr_build::rows`).
+/// The row of `EcgGvr::row_gradient` (module docs): the `(1 + P) x nb` row and its derivatives;
+/// the prepared basis kept in `cache` (shared with `gvr_build::rows`).
 pub fn row_gradient<const D: usize>(
     go: &GvrOps<D>,
     sym: &Symmetry<D>,
-    trial: &Params,
+    trial: &GvrParams,
     dir: &Directions,
-    basis: &Params,
+    basis: &GvrParams,
     cache: &Cache,
-) -> Result<(Matrices, Vec<Element>)> {
+) -> Result<Matrices> {
     check(trial.len(), 1, "trial functions")?;
-    let trial_fn = <EcgGvr as Family<D>>::functions(trial, go)?.remove(0);
+    let trial_fn = functions(trial, go)?.remove(0);
     let bra = Prepared::new(&trial_fn, &go.ops);
     let b = cache.get(basis, || Side::new(go, sym, basis))?;
     let (da, _) = dir.exponents::<D>()?;
     let du = matrices_of::<D, 1>(dir.v, da.len(), "global-vector directions")?;
-    let (_, diag) = path::row_gradient::<D, EcgGvr>(go, sym, trial, dir, &Params::default(), &Cache::default())?;
     let k_max = b.functions.iter().map(|f| f.k).max().unwrap_or(0) as usize;
     let mut series: Vec<Option<Series>> = (0..=k_max).map(|_| None).collect();
     for f in &b.functions {
@@ -471,12 +510,12 @@ pub fn row_gradient<const D: usize>(
     let gn = log_norm_gradient(&trial_fn, go.n_ang);
     let dn: Vec<f64> = da.iter().zip(&du).map(|(a, u)| gn.along(a, u)).collect();
     let lambda: M<f64, D> = matrix(|i, j| go.ops.lambda[(i, j)]);
-    let kernel = gvr_build::gradient_kernel::<D>();
+    let kernel = kernel::<D>();
     let rows: Vec<Vec<Element>> = (0..b.functions.len())
         .into_par_iter()
         .map(|j| {
             let ser = series[b.functions[j].k as usize].as_ref().expect("every K prepared");
-            // Safety: `gradient_kernel` chose an instruction set this CPU has.
+            // Safety: `kernel` chose an instruction set this CPU has.
             let (o, g) = unsafe { kernel(&bra, &b.images[j], &b.coef, ser, &lambda, go) };
             let el = |x: [f64; 4]| Element { s: x[0], t: x[1], t_ti: x[2], v: x[3] };
             std::iter::once(el(o))
@@ -490,7 +529,7 @@ pub fn row_gradient<const D: usize>(
             out.set(i, j, e);
         }
     }
-    Ok((out, diag))
+    Ok(out)
 }
 
 #[cfg(test)]

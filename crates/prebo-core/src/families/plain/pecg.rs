@@ -1,6 +1,6 @@
 //! Plain ECG matrix elements (paper section "pECG"; Suzuki & Varga, Lect. Notes Phys. m54, ch. 6).
 //!
-//! With `phi = exp(-r^T A r)` (no 1/2, see `ecg.rs`), `A_IJ = A_I + A_J`, `B = A_IJ^{-1}`:
+//! With `phi = exp(-r^T A r)` (no 1/2, see `ecg`), `A_IJ = A_I + A_J`, `B = A_IJ^{-1}`:
 //! - overlap      `S = (2^D |A_I|^{1/2} |A_J|^{1/2} / |A_IJ|)^{3/2}`           (normalised functions)
 //! - kinetic      `T = 6 Tr(B A_I Λ A_J) S`                                      (paper: `6 R`)
 //! - Coulomb      `<1/|w^T r|> = 2 / sqrt(pi w^T B w) S`
@@ -15,7 +15,7 @@
 //!
 //! # The kernel
 //! [`lanes`] evaluates `W` elements at once, lane by lane in structure-of-arrays form, so that
-//! the compiler vectorises it (build.rs instantiates it for AVX-512, AVX2 and plain x86-64 and
+//! the compiler vectorises it (`pecg_build` instantiates it for AVX-512, AVX2 and plain x86-64 and
 //! picks one at run time): one bra against `W` kets (full builds, rows after the trial) or `W`
 //! bras against one ket (rows before it). Either side is a scalar or `W` lanes ([`Lane`]) with
 //! the same operations in the same order, so an element has the same bits either way. Per
@@ -38,7 +38,7 @@ use std::f64::consts::{LN_2, PI};
 
 use nalgebra::Cholesky;
 
-use crate::ecg::{Element, Gaussian, Operators};
+use crate::ecg::{CoulombTerms, Element, Gaussian, Operators};
 
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised plain ECGs.
 #[inline]
@@ -61,8 +61,7 @@ pub fn element<const D: usize>(bra: &Gaussian<D>, ket: &Gaussian<D>, ops: &Opera
 #[derive(Clone, Debug)]
 pub struct Prepared<const D: usize> {
     pub lambda: [[f64; D]; D],
-    /// per pair: `2 q` and the terms `(a, b, f)` with `a <= b`, `f = w_a w_b` (doubled off the diagonal)
-    pub pairs: Vec<(f64, Vec<(usize, usize, f64)>)>,
+    pub pairs: CoulombTerms,
     pub cm_mass: Option<f64>,
 }
 
@@ -74,25 +73,9 @@ impl<const D: usize> Prepared<D> {
                 *x = ops.lambda[(a, b)];
             }
         }
-        let pairs = ops
-            .pairs
-            .iter()
-            .map(|(w, q)| {
-                let mut terms = Vec::new();
-                for a in 0..D {
-                    for b in a..D {
-                        let f = if a == b { w[a] * w[a] } else { 2.0 * w[a] * w[b] };
-                        if f != 0.0 {
-                            terms.push((a, b, f));
-                        }
-                    }
-                }
-                (2.0 * q, terms)
-            })
-            .collect();
         Self {
             lambda,
-            pairs,
+            pairs: ops.coulomb_terms(),
             cm_mass: ops.cm_mass,
         }
     }
@@ -289,9 +272,9 @@ pub fn lanes<const D: usize, const W: usize>(
     // Safety of the casts: the types are identical when D is the matched value.
     unsafe {
         match D {
-            2 => unrolled::lanes_d2::<W>(bra.dim(), ket.dim(), cast(ops), cm, coef, acc),
-            3 => unrolled::lanes_d3::<W>(bra.dim(), ket.dim(), cast(ops), cm, coef, acc),
-            4 => unrolled::lanes_d4::<W>(bra.dim(), ket.dim(), cast(ops), cm, coef, acc),
+            2 => lanes_d2::<W>(bra.dim(), ket.dim(), cast(ops), cm, coef, acc),
+            3 => lanes_d3::<W>(bra.dim(), ket.dim(), cast(ops), cm, coef, acc),
+            4 => lanes_d4::<W>(bra.dim(), ket.dim(), cast(ops), cm, coef, acc),
             _ => lanes_generic::<D, W>(bra, ket, ops, cm, coef, acc),
         }
     }
@@ -523,8 +506,7 @@ fn recip<const W: usize>(x: &[f64; W]) -> [f64; W] {
     std::array::from_fn(|l| 1.0 / x[l])
 }
 
-#[path = "pecg_unrolled.rs"]
-mod unrolled;
+include!("pecg_unrolled.rs");
 
 #[cfg(test)]
 #[path = "pecg_tests.rs"]

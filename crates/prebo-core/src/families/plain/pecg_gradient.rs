@@ -2,7 +2,7 @@
 //! kernel: the trial `phi_I` as bra against `W` basis images `P phi_J` at a time, derivatives
 //! along directions `dA_p` (symmetric) of `A_I` (issue 15).
 //!
-//! With `B = (A_I + A_J)^{-1}` (pecg.rs, same factorisation) and `Z = B A_J`:
+//! With `B = (A_I + A_J)^{-1}` (`pecg`, same factorisation) and `Z = B A_J`:
 //! - `ln S = ¾ ln|A_I| + ¾ ln|A_J| − (3/2) ln|A_I + A_J| + const`, so
 //!   `dS = ¾ Tr(A_I^{-1} dA) S − (3/2) Tr(B dA) S` (the first term once per trial and direction);
 //! - `T = 6 τ S`, `τ = Tr(B A_I Λ A_J) = Σ_ac Z_ac (A_I Λ)_ac`; as `B A_I = 1 − Z`,
@@ -16,7 +16,7 @@
 //! `G_S = −(3/2) Σ c S B`, `G_T = 6 Σ c S (Z Λ Z^T − (3/2) τ B)`,
 //! `G_V = Σ c S (Σ_w 2 q / sqrt(π c_w) / (2 c_w) h_w h_w^T − (3/2) v B)` with `v = V / S`,
 //! contracted once per element and direction. The operations are the same, in the same order,
-//! on every instruction set (module `build`), so every path gives the same bits.
+//! on every instruction set (`pecg_build`), so every path gives the same bits.
 // index loops read best in these small dense kernels
 #![allow(clippy::needless_range_loop)]
 use std::f64::consts::PI;
@@ -24,11 +24,11 @@ use std::f64::consts::PI;
 use nalgebra::Cholesky;
 use rayon::prelude::*;
 
-use crate::build::{isa_available, Isa};
+use super::pecg::{self, Accumulator, Bra, KetLanes, Prepared};
 use crate::ecg::{Element, Gaussian, Mat, Operators};
 use crate::images::Images;
+use crate::isa::{isa_available, Isa};
 use crate::matrices::Matrices;
-use crate::pecg::{self, Accumulator, Bra, KetLanes, Prepared};
 
 /// `W` lanes of each entry of a symmetric `D x D` matrix (upper triangle used).
 type Sym<const D: usize, const W: usize> = [[[f64; W]; D]; D];

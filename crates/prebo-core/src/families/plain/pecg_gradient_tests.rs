@@ -2,10 +2,11 @@
 //! and the same bits on every instruction set.
 use super::*;
 use crate::cache::Cache;
-use crate::family::{Directions, Family, Params};
+use crate::families::plain::pecg::tests::{gaussian, operators, Rng};
+use crate::families::plain::{diagonal, PlainEcg};
+use crate::families::{Directions, Exponents, Family};
+use crate::isa::best_isa;
 use crate::path;
-use crate::pecg::tests::{gaussian, operators, Rng};
-use crate::plain::PlainEcg;
 
 /// Identity, (D > 1) a swap of coordinates 0 and 1, and (D > 2) a cyclic shift, with Young-like coefficients.
 fn symmetry<const D: usize>() -> Vec<(Mat<D>, f64)> {
@@ -68,16 +69,8 @@ impl<const D: usize> Case<D> {
             .iter()
             .flat_map(|d| d.transpose().iter().copied().collect::<Vec<_>>())
             .collect();
-        let trial = Params {
-            a: &ta,
-            c_a: &tc,
-            ..Default::default()
-        };
-        let basis = Params {
-            a: &ba,
-            c_a: &bc,
-            ..Default::default()
-        };
+        let trial = Exponents { a: &ta, c_a: &tc };
+        let basis = Exponents { a: &ba, c_a: &bc };
         let dir = Directions { a: &da, v: &[] };
         let ctx = <PlainEcg as Family<D>>::context(self.ops.clone(), 0, &[]).unwrap();
         (
@@ -177,7 +170,7 @@ fn row_gradient_matches_the_dual_path() {
 fn against_finite_differences<const D: usize>() {
     for lab in [true, false] {
         let case = Case::<D>::new(21 ^ D as u64, lab, 6, 3);
-        let basis = Kets::new(&case.images(), crate::build::best_isa());
+        let basis = Kets::new(&case.images(), best_isa());
         let m = row_gradient(&case.trial, &case.da, &basis, &case.ops);
         let scales = case.scales();
         for (p, d) in case.da.iter().enumerate() {
@@ -262,12 +255,12 @@ fn the_diagonal_from_the_kernel_matches_the_dual_path() {
         case.ops = ops.clone();
         case.sym = sym;
         case.trial = gaussian::<D>(&mut rng, 1.0);
-        let diag = crate::plain::diagonal(&case.trial, &case.da, &case.sym, &ops).unwrap().expect("commuting operations");
+        let diag = diagonal(&case.trial, &case.da, &case.sym, &ops).unwrap().expect("commuting operations");
         let ((_, _), (_, dual)) = case.both();
         case.same_diagonal(&diag, &dual);
         let mut other = ops.clone();
         other.lambda[(0, 0)] *= 1.5; // particle 0 no longer identical to the one it is exchanged with
-        assert!(crate::plain::diagonal(&case.trial, &case.da, &case.sym, &other).unwrap().is_none());
+        assert!(diagonal(&case.trial, &case.da, &case.sym, &other).unwrap().is_none());
     }
     let perm = |p: [usize; 4]| Mat::<4>::from_fn(|i, j| if p[i] == j { 1.0 } else { 0.0 });
     let h2 = vec![(perm([0, 1, 2, 3]), 1.0), (perm([1, 0, 2, 3]), -1.0), (perm([0, 1, 3, 2]), 1.0), (perm([1, 0, 3, 2]), -1.0)];

@@ -1,7 +1,8 @@
 //! The row gradient of a floating ECG by hand-derived derivatives (issue 15): one reverse pass
 //! per element gives the gradients of `S`, `T`, `T_TI` and `V` with respect to the bra's `A_I`
-//! and `s_I`, which are then contracted with every direction `(dA_p, ds_p)`. Same output as
-//! `path::row_gradient` (the dual-number path, kept as the reference and for the diagonal).
+//! and `s_I`, which are then contracted with every direction `(dA_p, ds_p)`. The same row as
+//! `path::row_gradient` (the dual-number path, kept as the reference and for the diagonal,
+//! `FloatingEcg::row_gradient`).
 //!
 //! Notation of `fecg` (module docs, docs/gvr.md "Floating ECGs"): `B = A_I + A_J`,
 //! `v = A_I s_I + A_J s_J`, `r̄ = B⁻¹v`, `d_I = r̄ - s_I`, `d_J = r̄ - s_J`, `W = A_I Λ A_J`,
@@ -25,13 +26,13 @@ use std::f64::consts::PI;
 use nalgebra::Cholesky;
 use rayon::prelude::*;
 
+use super::fecg::{cm_shift, coulomb_factor, coulomb_moments, functions, kinetic, pair, Centres, Fecg, FecgParams};
 use crate::cache::Cache;
 use crate::ecg::{mul, Element, Mat, Operators};
 use crate::error::{CoreError, Result};
-use crate::family::{check, matrices_of, Directions, Family, Params, Symmetry};
-use crate::fecg::{cm_shift, coulomb_factor, coulomb_moments, kinetic, pair, Centres, Fecg, FloatingEcg};
+use crate::families::{check, matrices_of, Directions, Parameters, Symmetry};
+use crate::images::Images;
 use crate::matrices::Matrices;
-use crate::path;
 
 /// A gradient with respect to the bra's parameters: `⟨dA, a⟩ + ⟨ds, s⟩` along `(dA, ds)`.
 #[derive(Clone, Copy)]
@@ -160,21 +161,21 @@ fn add_element<const D: usize>(
     }
 }
 
-/// The row of one floating ECG against a basis and its diagonal, with their derivatives along
-/// the directions `dir`: the layout of `path::row_gradient` (`(1 + P) x nb` matrices, row 0 the
-/// values with the function as bra, the function un-transformed), the row by `add_element`,
-/// the diagonal by dual numbers; the basis images kept in `cache`.
+/// The row of one floating ECG against a basis with its derivatives along the directions `dir`:
+/// the row of `path::row_gradient` (`(1 + P) x nb` matrices, row 0 the values with the function
+/// as bra, the function un-transformed) by `add_element`; the basis images kept in `cache` (as
+/// `path::basis_images`).
 pub fn row_gradient<const D: usize>(
     ops: &Operators<D>,
     sym: &Symmetry<D>,
-    trial: &Params,
+    trial: &FecgParams,
     dir: &Directions,
-    basis: &Params,
+    basis: &FecgParams,
     cache: &Cache,
-) -> Result<(Matrices, Vec<Element>)> {
+) -> Result<Matrices> {
     check(trial.len(), 1, "trial functions")?;
-    let f = <FloatingEcg as Family<D>>::functions(trial, ops)?.remove(0);
-    let b = path::basis_images::<D, FloatingEcg>(ops, sym, basis, cache)?;
+    let f = functions::<D>(trial)?.remove(0);
+    let b = cache.get(basis, || Images::new(functions::<D>(basis)?, sym, ops))?;
     let (da, _) = dir.exponents::<D>()?;
     let ds = matrices_of::<D, 3>(dir.v, da.len(), "centre directions")?;
     let a_inv = Cholesky::new(f.a).ok_or(CoreError::NotPositiveDefinite { function: 0 })?.inverse();
@@ -201,8 +202,7 @@ pub fn row_gradient<const D: usize>(
             m.set(k, j, x);
         }
     }
-    let (_, diag) = path::row_gradient::<D, FloatingEcg>(ops, sym, trial, dir, &Params::default(), &Cache::default())?;
-    Ok((m, diag))
+    Ok(m)
 }
 
 #[cfg(test)]

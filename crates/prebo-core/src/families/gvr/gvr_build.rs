@@ -6,21 +6,22 @@
 //! function `i` as bra and the images of `j >= i` as kets; a trial's row has `(b_j, trial)` for
 //! `j < position` and `(trial, b_j)` after, so rows patched into the matrices give the bits of a
 //! full build. The kernel is compiled per instruction set (`isa_kernels!`, lanes of 8 for
-//! AVX-512, 4 otherwise) and chosen by `build::best_isa`; all give the same bits.
+//! AVX-512, 4 otherwise) and chosen by `isa::best_isa`; all give the same bits.
 use rayon::prelude::*;
 
+use super::gvr_element::{GvrOps, GvrParams};
+use super::gvr_kernel::{symmetrised, Pairs, Prepared, Side, Table};
+#[cfg(test)]
+use super::{gvr_kernel::{derivative_series, integral_partials, padded_rule}, gvr_series::Coefficients};
 use crate::assemble;
-use crate::build::Isa;
 use crate::cache::Cache;
 use crate::ecg::Element;
 use crate::error::Result;
-use crate::family::{Params, Symmetry};
-use crate::gvr::{EcgGvr, Gvr, GvrOps};
-use crate::gvr_gradient::{self, Grad, Series};
-use crate::gvr_kernel::{symmetrised, Pairs, Prepared, Table};
-use crate::images::Images;
+use crate::families::Symmetry;
+#[cfg(test)]
+use crate::isa::process_isa;
+use crate::isa::Isa;
 use crate::matrices::Matrices;
-use crate::path;
 
 /// One symmetrised element `Σ_P c_P <bra| O |P ket>` from the images of the ket.
 type ElementFn<const D: usize> =
@@ -56,20 +57,7 @@ macro_rules! isa_kernels {
                 inputs: &[[f64; 5]],
                 out: &mut [(f64, [f64; 5])],
             ) {
-                crate::gvr_kernel::integral_partials::<$w>(c, k, tau2, weight, inputs, out)
-            }
-
-            /// Safety: as `element`.
-            $(#[target_feature(enable = $feature)])?
-            pub(super) unsafe fn gradient<const D: usize>(
-                bra: &Prepared<D>,
-                images: &[Prepared<D>],
-                coef: &[f64],
-                series: &Series,
-                lambda: &[[f64; D]; D],
-                go: &GvrOps<D>,
-            ) -> ([f64; 4], [Grad<D>; 4]) {
-                gvr_gradient::symmetrised::<D, $w>(bra, images, coef, series, lambda, go)
+                integral_partials::<$w>(c, k, tau2, weight, inputs, out)
             }
         }
     };
@@ -96,34 +84,8 @@ fn kernel<const D: usize>(isa: Isa) -> ElementFn<D> {
     plain::element::<D>
 }
 
-/// The values `[S, T, T_TI, V]` of one trial against the images of one function and their
-/// gradients (`gvr_gradient::symmetrised`).
-pub(crate) type GradientFn<const D: usize> =
-    unsafe fn(&Prepared<D>, &[Prepared<D>], &[f64], &Series, &[[f64; D]; D], &GvrOps<D>) -> ([f64; 4], [Grad<D>; 4]);
-
-/// The row-gradient kernel on the best instruction set (`build::best_isa`, read once per process).
-pub(crate) fn gradient_kernel<const D: usize>() -> GradientFn<D> {
-    #[cfg(target_arch = "x86_64")]
-    {
-        let isa = best();
-        if isa == Isa::Avx512 && std::arch::is_x86_feature_detected!("avx512f") {
-            return avx512::gradient::<D>;
-        }
-        if isa == Isa::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            return avx2::gradient::<D>;
-        }
-    }
-    plain::gradient::<D>
-}
-
-/// `build::best_isa`, read once per process.
-fn best() -> Isa {
-    static ISA: std::sync::OnceLock<Isa> = std::sync::OnceLock::new();
-    *ISA.get_or_init(crate::build::best_isa)
-}
-
 /// The Coulomb τ-integrals with their partial derivatives (`gvr_kernel::integral_partials`) for
-/// each of `inputs`, on the best instruction set (`build::best_isa`, read once per process): the
+/// each of `inputs`, on the best instruction set (`isa::best_isa`, read once per process): the
 /// tests' entry point (the row gradient calls them inside its kernel).
 #[cfg(test)]
 pub(crate) fn partials(
@@ -134,7 +96,7 @@ pub(crate) fn partials(
     inputs: &[[f64; 5]],
     out: &mut [(f64, [f64; 5])],
 ) {
-    partials_with(best(), c, k, tau2, weight, inputs, out)
+    partials_with(process_isa(), c, k, tau2, weight, inputs, out)
 }
 
 /// `partials` on a chosen instruction set (plain code where this CPU lacks it).
@@ -165,31 +127,24 @@ pub(crate) fn partials_with(
     }
 }
 
-/// Functions with their images, prepared for the kernel.
-pub(crate) struct Side<const D: usize> {
-    pub(crate) functions: Vec<Prepared<D>>,
-    pub(crate) images: Vec<Vec<Prepared<D>>>,
-    pub(crate) coef: Vec<f64>,
+/// The Coulomb τ-integral `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ / e^L` of one pair
+/// (K_I, K_J) for each of `inputs` = `[x, y, z, γ_I, γ_J]` (`gvr_element::quadrature`), with its partial
+/// derivatives with respect to the five inputs (the maths of `gvr_element::quadrature_partials`), into
+/// `out`: nodes in lanes of the f64 kernel (`gvr_kernel::integral_partials`, `partials`).
+/// The tests' entry point; the row gradient keeps its rules per pair (`gvr_gradient`).
+#[cfg(test)]
+pub(crate) fn coulomb_partials<const D: usize>(
+    go: &GvrOps<D>,
+    ki: u32,
+    kj: u32,
+    inputs: &[[f64; 5]],
+    out: &mut [(f64, [f64; 5])],
+) {
+    let c = Coefficients::new(ki, kj, go.n_ang).c;
+    let (tau2, weight) = padded_rule(go.rule(ki + kj + go.n_ang));
+    partials((&c, &derivative_series(&c)), (ki, kj, go.n_ang), &tau2, &weight, inputs, out);
 }
 
-impl<const D: usize> Side<D> {
-    pub(crate) fn new(go: &GvrOps<D>, sym: &Symmetry<D>, p: &Params) -> Result<Self> {
-        let f: Images<Gvr<D>> = path::images::<D, EcgGvr>(go, sym, p)?;
-        let prep = |g: &Gvr<D>| Prepared::new(g, &go.ops);
-        Ok(Self {
-            functions: f.functions.iter().map(prep).collect(),
-            images: f.images.iter().map(|im| im.iter().map(prep).collect()).collect(),
-            coef: f.coef,
-        })
-    }
-
-    fn powers(&self) -> Vec<u32> {
-        let mut k: Vec<u32> = self.functions.iter().map(|f| f.k).collect();
-        k.sort_unstable();
-        k.dedup();
-        k
-    }
-}
 
 /// Everything an element needs beside its two functions.
 struct Kernel<'a, const D: usize> {
@@ -208,7 +163,7 @@ impl<const D: usize> Kernel<'_, D> {
 }
 
 /// The symmetrised matrices of a basis (upper triangle evaluated, mirrored).
-pub fn matrices<const D: usize>(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &Params, isa: Isa) -> Result<Matrices> {
+pub fn matrices<const D: usize>(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &GvrParams, isa: Isa) -> Result<Matrices> {
     let b = Side::new(go, sym, basis)?;
     let k = b.powers();
     let table = Table::new(go, k.iter().flat_map(|&ki| k.iter().map(move |&kj| (ki, kj))));
@@ -221,8 +176,8 @@ pub fn matrices<const D: usize>(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &Param
 pub fn rows<const D: usize>(
     go: &GvrOps<D>,
     sym: &Symmetry<D>,
-    trials: &Params,
-    basis: &Params,
+    trials: &GvrParams,
+    basis: &GvrParams,
     position: Option<usize>,
     isa: Isa,
     cache: &Cache,

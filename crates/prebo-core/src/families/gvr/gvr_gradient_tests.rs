@@ -6,8 +6,10 @@
 //! `‖A_I⁻¹‖‖dA‖ + (2K_I + N + 1)‖du‖/‖u_I‖` (the relative change of φ_I per unit step).
 use super::*;
 use crate::ecg::Operators;
-use crate::gvr_build::Side;
-use crate::gvr::element;
+use crate::families::gvr::gvr_element::element;
+use crate::families::gvr::EcgGvr;
+use crate::families::{Exponents, Family};
+use crate::path;
 
 /// xorshift64*: deterministic numbers in [0, 1) without a dependency.
 struct Rng(u64);
@@ -66,8 +68,8 @@ impl Flat {
         f
     }
 
-    fn params(&self) -> Params<'_> {
-        Params { a: &self.a, c_a: &self.c_a, v: &self.v, k_pow: &self.k }
+    fn params(&self) -> GvrParams<'_> {
+        GvrParams { e: Exponents { a: &self.a, c_a: &self.c_a }, u: &self.v, k: &self.k }
     }
 
     /// This (one) function moved by `h (dA, du)`.

@@ -1,26 +1,32 @@
-//! The plain-ECG family. Its matrices and rows come from the SIMD kernel (`build`, `pecg`), its
-//! row gradients from the hand-derived kernel in the same lanes (`pecg_gradient`); its generic
-//! elements (the diagonal of a row gradient by dual numbers, extra operators) from the ECG-GVR
-//! kernel at K = N = 0 with `u = e_1`, where `u` drops out and the elements are those of plain
-//! ECGs (gvr.rs: "For K = N = 0 this is the plain-ECG ...").
+//! The plain-ECG family. Its matrices and rows come from the SIMD kernel (`pecg`, with the
+//! builds of `pecg_build`), its row gradients from the hand-derived kernel in the same lanes
+//! (`pecg_gradient`). Its generic elements (the diagonal of a row gradient by dual numbers where
+//! `diagonal` does not apply, extra operators) are the ECG-GVR elements at K = N = 0 with
+//! `u = e_1` (`gvr::gvr_element`), where `u` drops out and the elements are those of plain ECGs
+//! (`gvr_element` module docs: "For K = N = 0 this is the plain-ECG ..."): one generic element
+//! for both families, so the dual-number values stay those of that one code.
 use nalgebra::SMatrix;
 
-use crate::build;
+use super::gvr::gvr_element::{self, Gvr, GvrOps};
 use crate::cache::Cache;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::family::{check, Directions, Family, Params, Symmetry};
+use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Parameters, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
-use crate::gvr::{EcgGvr, Gvr, GvrOps};
 use crate::images::Images;
+use crate::isa::best_isa;
 use crate::matrices::Matrices;
-use crate::{path, pecg_gradient};
+use crate::path;
 
-/// The plain-ECG family: parameters `A` (`k x n x n`) and `c_A`.
+pub mod pecg;
+pub mod pecg_build;
+pub mod pecg_gradient;
+
+/// The plain-ECG family: parameters `A` (`k x n x n`) and `c_A` (`Exponents`).
 pub struct PlainEcg;
 
 /// The plain ECGs of `p` with their images under `sym`, for the SIMD kernel.
-fn gaussians<const D: usize>(p: &Params, sym: &Symmetry<D>) -> Result<Images<Gaussian<D>>> {
+fn gaussians<const D: usize>(p: &Exponents, sym: &Symmetry<D>) -> Result<Images<Gaussian<D>>> {
     let a = p.exponents::<D>()?;
     let f = a
         .into_iter()
@@ -33,16 +39,23 @@ fn gaussians<const D: usize>(p: &Params, sym: &Symmetry<D>) -> Result<Images<Gau
 
 impl<const D: usize> Family<D> for PlainEcg {
     const NAME: &'static str = "pecg";
-    /// Rows in full-build orientation from the SIMD kernel (`build::rows`).
+    const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("c_A")];
+    /// Rows in full-build orientation from the SIMD kernel (`pecg_build::rows`).
     const ORIENTED: bool = true;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
+    type Params<'a> = Exponents<'a>;
 
-    fn context(ops: Operators<D>, _: u32, _: &[&Params]) -> Result<GvrOps<D>> {
+    fn params(c: &[Column]) -> Result<Exponents<'_>> {
+        let c = columns(<Self as Family<D>>::NAME, <Self as Family<D>>::FIELDS, c)?;
+        Ok(Exponents { a: c[0].floats()?, c_a: c[1].floats()? })
+    }
+
+    fn context(ops: Operators<D>, _: u32, _: &[&Exponents]) -> Result<GvrOps<D>> {
         GvrOps::new(ops, 0, 0)
     }
 
-    fn functions(p: &Params, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
+    fn functions(p: &Exponents, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
         let a = p.exponents::<D>()?;
         let u = Vector::<D>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 });
         a.into_iter()
@@ -53,7 +66,7 @@ impl<const D: usize> Family<D> for PlainEcg {
     }
 
     fn element<T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
-        <EcgGvr as Family<D>>::element(bra, ket, go)
+        gvr_element::element(bra, ket, go)
     }
 
     fn cast<T: Real>(f: &Gvr<D>) -> Gvr<D, T> {
@@ -66,23 +79,23 @@ impl<const D: usize> Family<D> for PlainEcg {
     }
 
     fn damped<T: Real>(f: &Gvr<D>, m: &SMatrix<T, D, D>) -> Gvr<D, T> {
-        <EcgGvr as Family<D>>::damped(f, m)
+        f.damped(m)
     }
 
-    fn matrices(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &Params) -> Result<Matrices> {
-        Ok(build::matrices(&gaussians(basis, sym)?, &go.ops))
+    fn matrices(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &Exponents) -> Result<Matrices> {
+        Ok(pecg_build::matrices(&gaussians(basis, sym)?, &go.ops))
     }
 
     fn rows(
         go: &GvrOps<D>,
         sym: &Symmetry<D>,
-        trials: &Params,
-        basis: &Params,
+        trials: &Exponents,
+        basis: &Exponents,
         position: Option<usize>,
         cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
         let b = cache.get(basis, || gaussians(basis, sym))?;
-        Ok(build::rows(&gaussians(trials, sym)?, &b, &go.ops, position))
+        Ok(pecg_build::rows(&gaussians(trials, sym)?, &b, &go.ops, position))
     }
 
     /// The row from `pecg_gradient` (directions of `A` only, as `seeded`), the basis in its lanes
@@ -91,9 +104,9 @@ impl<const D: usize> Family<D> for PlainEcg {
     fn row_gradient(
         go: &GvrOps<D>,
         sym: &Symmetry<D>,
-        trial: &Params,
+        trial: &Exponents,
         dir: &Directions,
-        basis: &Params,
+        basis: &Exponents,
         cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
         check(trial.len(), 1, "trial functions")?;
@@ -101,10 +114,10 @@ impl<const D: usize> Family<D> for PlainEcg {
         let (da, _) = dir.exponents::<D>()?;
         let diag = match diagonal(&f, &da, sym, &go.ops)? {
             Some(diag) => diag,
-            None => path::row_gradient::<D, Self>(go, sym, trial, dir, &Params::default(), &Cache::default())?.1,
+            None => path::row_gradient::<D, Self>(go, sym, trial, dir, &Exponents::default(), &Cache::default())?.1,
         };
         let kets = cache.get(basis, || {
-            Ok(pecg_gradient::Kets::new(&*cache.get(basis, || gaussians(basis, sym))?, build::best_isa()))
+            Ok(pecg_gradient::Kets::new(&*cache.get(basis, || gaussians(basis, sym))?, best_isa()))
         })?;
         Ok((pecg_gradient::row_gradient(&f, &da, &kets, &go.ops), diag))
     }
@@ -139,7 +152,7 @@ pub(crate) fn diagonal<const D: usize>(
         return Ok(None);
     };
     let mut own = Images::new(vec![f.clone()], sym, &())?;
-    let isa = build::best_isa();
+    let isa = best_isa();
     let bra = pecg_gradient::row_gradient(f, da, &pecg_gradient::Kets::new(&own, isa), ops);
     own.coef = inverse;
     let ket = pecg_gradient::row_gradient(f, da, &pecg_gradient::Kets::new(&own, isa), ops);

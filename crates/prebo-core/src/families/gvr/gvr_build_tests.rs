@@ -1,9 +1,12 @@
-//! The f64 kernel against `gvr::element` (the generic path), the same bits on every instruction
+//! The f64 kernel against `gvr_element::element` (the generic path), the same bits on every instruction
 //! set, and rows patched into matrices with the bits of a full build.
 use super::*;
 use crate::ecg::{Mat, Operators, Vector};
-use crate::build;
-use crate::family::Family;
+use crate::families::gvr::gvr_kernel;
+use crate::families::gvr::EcgGvr;
+use crate::families::{Exponents, Family};
+use crate::isa::best_isa;
+use crate::path;
 
 struct Rng(u64);
 
@@ -36,8 +39,8 @@ impl Basis {
         b
     }
 
-    fn params(&self) -> Params<'_> {
-        Params { a: &self.a, c_a: &self.c_a, v: &self.u, k_pow: &self.k }
+    fn params(&self) -> GvrParams<'_> {
+        GvrParams { e: Exponents { a: &self.a, c_a: &self.c_a }, u: &self.u, k: &self.k }
     }
 
     /// Function `i` alone, and the others.
@@ -166,10 +169,10 @@ fn rows_patched_into_matrices_give_the_full_build() {
     let nb = 11;
     let basis = Basis::random::<4>(&mut rng, nb, 30);
     let go = <EcgGvr as Family<4>>::context(ops, 0, &[&basis.params()]).unwrap();
-    let full = matrices(&go, &sym, &basis.params(), build::best_isa()).unwrap();
+    let full = matrices(&go, &sym, &basis.params(), best_isa()).unwrap();
     for p in [0, 5, nb - 1] {
         let (trial, rest) = basis.split::<4>(p);
-        let (r, d) = rows(&go, &sym, &trial.params(), &rest.params(), Some(p), build::best_isa(), &Cache::default()).unwrap();
+        let (r, d) = rows(&go, &sym, &trial.params(), &rest.params(), Some(p), best_isa(), &Cache::default()).unwrap();
         for (x, row) in [(&full.s, &r.s), (&full.t, &r.t), (&full.t_ti, &r.t_ti), (&full.v, &r.v)] {
             for j in 0..nb - 1 {
                 let col = if j < p { j } else { j + 1 };
@@ -201,9 +204,9 @@ fn images_in_lanes_have_the_bits_of_one_by_one() {
         for (bra, (ket, coef)) in side.functions.iter().zip(side.images.iter().zip(std::iter::repeat(&side.coef))) {
             let mut one_by_one = Element::zero();
             for (k, c) in ket.iter().zip(coef) {
-                one_by_one += (*c, crate::gvr_kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass));
+                one_by_one += (*c, gvr_kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass));
             }
-            let lanes = crate::gvr_kernel::symmetrised::<4, 4>(bra, ket, coef, &table, &pairs, go.ops.cm_mass);
+            let lanes = gvr_kernel::symmetrised::<4, 4>(bra, ket, coef, &table, &pairs, go.ops.cm_mass);
             assert_eq!(bits(lanes), bits(one_by_one), "{images} images");
         }
     }
@@ -212,12 +215,12 @@ fn images_in_lanes_have_the_bits_of_one_by_one() {
     images[2].a = std::array::from_fn(|i| std::array::from_fn(|j| -2.0 * side.functions[0].a[i][j]));
     let bra = &side.functions[0];
     let each: Vec<Element> =
-        images.iter().map(|k| crate::gvr_kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass)).collect();
+        images.iter().map(|k| gvr_kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass)).collect();
     assert!(each[2].s.is_nan() && each.iter().enumerate().all(|(i, e)| i == 2 || e.s.is_finite()));
     let mut one_by_one = Element::zero();
     for (e, c) in each.into_iter().zip(&side.coef) {
         one_by_one += (*c, e);
     }
-    let lanes = crate::gvr_kernel::symmetrised::<4, 4>(bra, &images, &side.coef, &table, &pairs, go.ops.cm_mass);
+    let lanes = gvr_kernel::symmetrised::<4, 4>(bra, &images, &side.coef, &table, &pairs, go.ops.cm_mass);
     assert_eq!(bits(lanes), bits(one_by_one));
 }

@@ -1,34 +1,38 @@
-//! The f64 ECG-GVR kernel of `EcgGvr::matrices` and `EcgGvr::rows`: the maths of `gvr::element`
-//! (module docs there, docs/gvr.md) without allocation, logarithms of the series or `powi`
-//! libcalls per element.
+//! The f64 ECG-GVR kernel of `EcgGvr::matrices` and `EcgGvr::rows`: the maths of
+//! `gvr_element::element` (module docs there, docs/gvr.md) without allocation, logarithms of the
+//! series or `powi` libcalls per element.
 //!
 //! - Per call, once: every function and symmetry image as a [`Prepared`] (`A`, `u`, `AΛ`, `Λu`,
 //!   its normalisation), and a [`Table`] with, for every pair (K_I, K_J) the call meets, the
-//!   series ĉ_k and the coefficients of G_x, G_y, G_z (`gvr::Coefficients`), and the even
+//!   series ĉ_k and the coefficients of G_x, G_y, G_z (`gvr_series::Coefficients`), and the even
 //!   Gauss–Legendre rule of degree K_I + K_J + N as `τ²` and weights, padded with zero weights to
 //!   a multiple of [`MAX_W`] nodes.
 //! - Per element: `B = A_I + A_J = L D Lᵀ` (root-free Cholesky), `B⁻¹ = L⁻ᵀ D⁻¹ L⁻¹`,
-//!   `ln|B| = ln Π d_k`; `x, y, z`, Ω and its derivatives by Horner in `ρ²`, the kinetic
-//!   scalars of the gvr.rs formula; per Coulomb pair `c = wᵀB⁻¹w` and `γ_I, γ_J`. This algebra
+//!   `ln|B| = ln Π d_k`; `x, y, z`, Ω and its derivatives by Horner in `ρ²` (`gvr_series`), the
+//!   kinetic scalars of the `gvr_element` formula; per Coulomb pair `c = wᵀB⁻¹w` and `γ_I, γ_J`. This algebra
 //!   runs on [`MAX_LANES`] symmetry images of a ket at once, structure of arrays (`lanes`), each
 //!   lane with the bits of the one-image kernel.
 //! - The Coulomb τ-quadrature (`integrals`) in lanes of `W` nodes, several pairs and node
 //!   blocks at once: at a node,
 //!   with `α_I = γ_I²/x`, `α_J = γ_J²/y`, `β = z/√(xy)`, `δ = γ_Iγ_J/√(xy)`,
 //!   `a = 1 − α_I τ²`, `b = 1 − α_J τ²`, `ζ = β − δ τ²`, the integrand is
-//!   `a^{K_I} b^{K_J} ζ^N G(ζ²/(ab))` (`gvr::quadrature_partials`); the integer powers by
+//!   `a^{K_I} b^{K_J} ζ^N G(ζ²/(ab))` (`gvr_element::quadrature_partials`); the integer powers by
 //!   binary exponentiation ([`pow`]), the same squarings and products in every lane. The lane
 //!   values are summed node by node in order, so the integral has the same bits for every `W`.
 //! - The row gradient's τ-quadrature with partial derivatives (`integral_partials`) has `W`
 //!   inputs (pairs and images) in lanes instead, each lane summing its nodes in order.
 //!
 //! The lanes are `[f64; W]` arrays (no fused multiply-add), instantiated per instruction set
-//! (`kernels`, chosen with `build::best_isa`): every path gives the same bits.
+//! (`gvr_build`, chosen with `isa::best_isa`): every path gives the same bits.
 #![allow(clippy::needless_range_loop)]
 use std::f64::consts::PI;
 
-use crate::ecg::{Element, Operators};
-use crate::gvr::{Coefficients, Gvr, GvrOps};
+use super::gvr_element::{functions, Gvr, GvrOps, GvrParams};
+use super::gvr_series::{cm_kinetic, omega, Coefficients, Terms};
+use crate::ecg::{Element, Operators, MAX_DIM};
+use crate::error::Result;
+use crate::families::Symmetry;
+use crate::images::Images;
 use crate::lanes::{Lane, Lanes};
 
 /// The widest lane count (AVX-512); rules are padded to a multiple of it.
@@ -57,6 +61,33 @@ impl<const D: usize> Prepared<D> {
         let a_lambda = std::array::from_fn(|i| std::array::from_fn(|j| (0..D).map(|k| a[i][k] * lam[(k, j)]).sum()));
         let lambda_u = std::array::from_fn(|i| (0..D).map(|k| lam[(i, k)] * u[k]).sum());
         Self { a, u, a_lambda, lambda_u, k: f.k, log_norm: f.log_norm, c_a: f.c_a, c_u: f.c_u }
+    }
+}
+
+/// Functions with their images (as `path::images`), prepared for the kernel: the basis side of
+/// builds, rows and row gradients.
+pub(crate) struct Side<const D: usize> {
+    pub(crate) functions: Vec<Prepared<D>>,
+    pub(crate) images: Vec<Vec<Prepared<D>>>,
+    pub(crate) coef: Vec<f64>,
+}
+
+impl<const D: usize> Side<D> {
+    pub(crate) fn new(go: &GvrOps<D>, sym: &Symmetry<D>, p: &GvrParams) -> Result<Self> {
+        let f: Images<Gvr<D>> = Images::new(functions(p, go)?, sym, go)?;
+        let prep = |g: &Gvr<D>| Prepared::new(g, &go.ops);
+        Ok(Self {
+            functions: f.functions.iter().map(prep).collect(),
+            images: f.images.iter().map(|im| im.iter().map(prep).collect()).collect(),
+            coef: f.coef,
+        })
+    }
+
+    pub(crate) fn powers(&self) -> Vec<u32> {
+        let mut k: Vec<u32> = self.functions.iter().map(|f| f.k).collect();
+        k.sort_unstable();
+        k.dedup();
+        k
     }
 }
 
@@ -106,6 +137,14 @@ pub struct Series<'a> {
     pub cz: &'a [f64],
     pub tau2: &'a [f64],
     pub weight: &'a [f64],
+}
+
+impl Series<'_> {
+    /// The series of Ω (`gvr_series::omega`).
+    #[inline(always)]
+    pub(crate) fn terms(&self) -> Terms<'_> {
+        Terms { ki: self.ki, kj: self.kj, n: self.n, c: self.c, cx: self.cx, cy: self.cy, cz: self.cz }
+    }
 }
 
 impl Table {
@@ -168,11 +207,10 @@ pub struct Pairs<const D: usize> {
 
 impl<const D: usize> Pairs<D> {
     pub fn new(ops: &Operators<D>) -> Self {
-        let pre = crate::pecg::Prepared::new(ops);
         let pairs = ops
             .pairs
             .iter()
-            .zip(pre.pairs)
+            .zip(ops.coulomb_terms())
             .map(|((w, _), (q2, terms))| (q2, std::array::from_fn(|i| w[i]), terms))
             .collect::<Vec<_>>();
         assert!(pairs.len() <= MAX_PAIRS, "at most {MAX_PAIRS} Coulomb pairs");
@@ -205,7 +243,7 @@ pub fn pow<const W: usize, const B: usize>(x: [[f64; W]; B], k: u32) -> [[f64; W
     }
 }
 
-/// `r = ζ²/(ab)`, at most 1, and 1 where `ab` vanishes (`gvr::quadrature`): the quotient is
+/// `r = ζ²/(ab)`, at most 1, and 1 where `ab` vanishes (`gvr_element::quadrature`): the quotient is
 /// taken in every lane and selected (no `f64::min`, whose NaN rule keeps lanes scalar).
 #[inline(always)]
 fn ratio(a: f64, b: f64, zeta: f64) -> f64 {
@@ -219,8 +257,8 @@ fn positive(v: f64) -> f64 {
     if v > 0.0 { v } else { 0.0 }
 }
 
-/// Most Coulomb pairs of a call (stack storage): the pairs of `engine::MAX_DIM` particles.
-pub const MAX_PAIRS: usize = crate::engine::MAX_DIM * (crate::engine::MAX_DIM - 1) / 2;
+/// Most Coulomb pairs of a call (stack storage): the pairs of `MAX_DIM` particles.
+pub const MAX_PAIRS: usize = MAX_DIM * (MAX_DIM - 1) / 2;
 
 /// Block `c` of `W` lanes of `v` (one bounds check, so the block's loops stay in vector lanes).
 #[inline(always)]
@@ -370,28 +408,6 @@ pub(crate) fn mat_vec<T: Lane, const D: usize>(m: &[[T; D]; D], v: &[T; D]) -> [
     std::array::from_fn(|i| dot(&m[i], v))
 }
 
-/// `Σ_k coef_k r^k` (Horner, as `gvr::horner`).
-#[inline(always)]
-pub(crate) fn horner<T: Lane>(coef: &[f64], r: T) -> T {
-    coef.iter().rev().fold(T::splat(0.0), |acc, &ck| acc * r + ck)
-}
-
-/// `x^k` by binary exponentiation ([`pow`] in the kernel's values).
-#[inline(always)]
-pub(crate) fn power<T: Lane>(x: T, k: u32) -> T {
-    let (mut r, mut base, mut k) = (T::splat(1.0), x, k);
-    loop {
-        if k & 1 == 1 {
-            r = r * base;
-        }
-        k >>= 1;
-        if k == 0 {
-            return r;
-        }
-        base = base * base;
-    }
-}
-
 /// The fields of `T::L` kets (symmetry images of one function) in lanes.
 pub(crate) struct Ket<T, const D: usize> {
     pub(crate) a: [[T; D]; D],
@@ -418,7 +434,7 @@ impl<T: Lane, const D: usize> Ket<T, D> {
 }
 
 /// `<φ_I| 1, T, T_TI, V |φ_J>` of `bra` with each of `kets` (`T::L` of them, one power K), in
-/// lanes (`gvr::element`'s formulas); `None` where some `A_I + A_J` is not positive definite.
+/// lanes (`gvr_element::element`'s formulas); `None` where some `A_I + A_J` is not positive definite.
 #[inline(always)]
 fn elements<const D: usize, const W: usize, T: Lane>(
     bra: &Prepared<D>,
@@ -438,10 +454,10 @@ fn elements<const D: usize, const W: usize, T: Lane>(
     let z = dot(&bra_u, &gj) * 0.5;
     let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
     let s = table.series(bra.k, kets[0].k);
-    let (l, om, ox, oy, oz) = omega(&s, x, y, z);
+    let (l, om, ox, oy, oz) = omega(&s.terms(), x, y, z);
     let scale = (log_s0 + l - bra.log_norm - ket.log_norm).map(f64::exp);
 
-    // kinetic with Λ (gvr.rs module docs)
+    // kinetic with Λ (`gvr_element` module docs)
     let zl = mat_vec(&ket.a, &bra.lambda_u.map(T::splat)); // A_J Λ u_I
     let zr = mat_vec(&bra.a.map(|r| r.map(T::splat)), &ket.lambda_u); // A_I Λ u_J
     let w: [[T; D]; D] = std::array::from_fn(|i| {
@@ -492,29 +508,6 @@ fn elements<const D: usize, const W: usize, T: Lane>(
     }
     let v = (0..np).fold(T::splat(0.0), |acc, p| acc + factor[p] * T::from_lanes(|l| integral[l][p]));
     Some(Element { s: scale * om, t, t_ti, v: scale * v })
-}
-
-/// `gvr::omega` from the tabulated series: `(L, ω, ω_x, ω_y, ω_z)`.
-#[inline(always)]
-pub(crate) fn omega<T: Lane>(s: &Series, x: T, y: T, z: T) -> (T, T, T, T, T) {
-    let nf = s.n as f64;
-    let rt = (x * y).map(f64::sqrt);
-    let rho = (z / rt).map(|v| v.clamp(-1.0, 1.0));
-    let r2 = rho * rho;
-    let (g, gx, gy, gz) = (horner(s.c, r2), horner(s.cx, r2), horner(s.cy, r2), horner(s.cz, r2));
-    let rho_n = power(rho, s.n);
-    let l = x.map(f64::ln) * (s.ki as f64 + 0.5 * nf) + y.map(f64::ln) * (s.kj as f64 + 0.5 * nf);
-    let omega_z = if s.n == 0 { rho * gz / rt } else { power(rho, s.n - 1) * gz / rt };
-    (l, rho_n * g, rho_n * gx / x, rho_n * gy / y, omega_z)
-}
-
-/// `gvr::cm_kinetic` in the kernel's values.
-#[inline(always)]
-fn cm_kinetic<T: Lane>(ci: T, cj: T, ui: T, uj: T, m: f64, w: (T, T, T, T)) -> T {
-    let (om, ox, oy, oz) = w;
-    let s = ci + cj;
-    om * (ci * 3.0 * cj / (s * m)) - (ui * ui * cj * ox + uj * uj * ci * oy) / (s * m)
-        + (ui * ui * ox + ui * uj * oz + uj * uj * oy) * (ci * cj) / (s * m * s)
 }
 
 /// Images of one ket evaluated together in lanes.
@@ -568,7 +561,7 @@ pub fn symmetrised<const D: usize, const W: usize>(
 }
 
 /// `∫_0^1 P dτ` with its partial derivatives with respect to `[x, y, z, γ_I, γ_J]`
-/// (`gvr::quadrature_partials`: the same chain rule through `a`, `b`, `ζ`) for each of `inputs`,
+/// (`gvr_element::quadrature_partials`: the same chain rule through `a`, `b`, `ζ`) for each of `inputs`,
 /// into `out`, `W` inputs at a time in lanes (`partial_sums`); `tau2`, `weight` = the padded rule
 /// (`padded_rule`), `c` = the series `ĉ_k` and its derivative's (`derivative_series`). The
 /// series of `P_a`, `P_b`, `P_ζ` come from G and G' alone: `Σ ĉ_k(K_I−k) r^k = K_I G − r G'`,
@@ -621,7 +614,7 @@ const NODES: usize = 4;
 
 /// The node sums of `integral_partials` for `W` inputs in lanes (`[x, y, z, γ_I, γ_J]`, each a
 /// lane vector): `[Σ P, Σ P_a τ², Σ P_b τ², Σ P_ζ, Σ P_ζ ζ, Σ P_ζ τ²]` (weights included), node by
-/// node in order, `a`, `b`, `ζ` rounded as in `gvr::quadrature_partials`. G and G' are two
+/// node in order, `a`, `b`, `ζ` rounded as in `gvr_element::quadrature_partials`. G and G' are two
 /// Horner chains (`c` and `dc`, `dc_k = (k+1) ĉ_{k+1}`) over `NODES` nodes at once; the rule's
 /// length is a multiple of `NODES`.
 #[inline(always)]

@@ -4,7 +4,9 @@
 //! branch (`|m|` tiny) to `erf = 1`.
 use super::*;
 use crate::ecg::Vector;
-use crate::fecg;
+use crate::families::floating::{fecg, FloatingEcg};
+use crate::families::{Exponents, Family};
+use crate::path;
 
 /// xorshift64*: deterministic numbers in [0, 1) without a dependency.
 struct Rng(u64);
@@ -44,8 +46,8 @@ impl Set {
         Self { a, c_a, s }
     }
 
-    fn params(&self) -> Params<'_> {
-        Params { a: &self.a, c_a: &self.c_a, v: &self.s, k_pow: &[] }
+    fn params(&self) -> FecgParams<'_> {
+        FecgParams { e: Exponents { a: &self.a, c_a: &self.c_a }, s: &self.s }
     }
 
     fn function<const D: usize>(&self, i: usize) -> Fecg<D> {
@@ -167,8 +169,8 @@ fn against_dual<const D: usize>(n_dir: usize) -> (f64, f64) {
                 let set = Set::new::<D>(&mut rng, 7, spread, jitter);
                 let (da, ds) = directions::<D>(&mut rng, n_dir);
                 let p = set.params();
-                let trial = Params { a: &p.a[..D * D], c_a: &p.c_a[..1], v: &p.v[..3 * D], k_pow: &[] };
-                let basis = Params { a: &p.a[D * D..], c_a: &p.c_a[1..], v: &p.v[3 * D..], k_pow: &[] };
+                let trial = FecgParams { e: Exponents { a: &p.e.a[..D * D], c_a: &p.e.c_a[..1] }, s: &p.s[..3 * D] };
+                let basis = FecgParams { e: Exponents { a: &p.e.a[D * D..], c_a: &p.e.c_a[1..] }, s: &p.s[3 * D..] };
                 let dir = Directions { a: &da, v: &ds };
                 let (hand, hand_diag) = <FloatingEcg as Family<D>>::row_gradient(&ops, &sym, &trial, &dir, &basis, &Cache::default()).unwrap();
                 let (dual, dual_diag) = path::row_gradient::<D, FloatingEcg>(&ops, &sym, &trial, &dir, &basis, &Cache::default()).unwrap();
@@ -208,14 +210,14 @@ fn agrees_with_central_differences() {
     let set = Set::new::<D>(&mut rng, 5, 1.0, 0.4);
     let (da, ds) = directions::<D>(&mut rng, 4);
     let p = set.params();
-    let basis = Params { a: &p.a[D * D..], c_a: &p.c_a[1..], v: &p.v[3 * D..], k_pow: &[] };
+    let basis = FecgParams { e: Exponents { a: &p.e.a[D * D..], c_a: &p.e.c_a[1..] }, s: &p.s[3 * D..] };
     let trial = |h: f64, k: usize| -> Matrices {
-        let a: Vec<f64> = (0..D * D).map(|i| p.a[i] + h * da[k * D * D + i]).collect();
-        let s: Vec<f64> = (0..3 * D).map(|i| p.v[i] + h * ds[k * 3 * D + i]).collect();
-        let t = Params { a: &a, c_a: &p.c_a[..1], v: &s, k_pow: &[] };
+        let a: Vec<f64> = (0..D * D).map(|i| p.e.a[i] + h * da[k * D * D + i]).collect();
+        let s: Vec<f64> = (0..3 * D).map(|i| p.s[i] + h * ds[k * 3 * D + i]).collect();
+        let t = FecgParams { e: Exponents { a: &a, c_a: &p.e.c_a[..1] }, s: &s };
         <FloatingEcg as Family<D>>::rows(&ops, &sym, &t, &basis, Some(0), &Cache::default()).unwrap().0
     };
-    let t0 = Params { a: &p.a[..D * D], c_a: &p.c_a[..1], v: &p.v[..3 * D], k_pow: &[] };
+    let t0 = FecgParams { e: Exponents { a: &p.e.a[..D * D], c_a: &p.e.c_a[..1] }, s: &p.s[..3 * D] };
     let (hand, _) = <FloatingEcg as Family<D>>::row_gradient(&ops, &sym, &t0, &Directions { a: &da, v: &ds }, &basis, &Cache::default()).unwrap();
     let h = 1e-5;
     let fi = set.function::<D>(0);

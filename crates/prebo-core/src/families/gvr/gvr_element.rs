@@ -35,7 +35,7 @@
 //!
 //! CM elimination (paper eq. GENCONSTR:ecggvr, generalised to c_U ≠ 0 and unequal c_A):
 //! the same expression with `Λ = 1 1^T/(2 m_tot)`; with `A 1 = c_A m/m_tot`, `1^T u = c_U`,
-//! `s = c_I + c_J` it collapses to the closed form of `cm_kinetic`.
+//! `s = c_I + c_J` it collapses to the closed form of `gvr_series::cm_kinetic`.
 //!
 //! Coulomb `<1/|w^T r|>`: `1/r = (2/√π)∫exp(-t²r²)dt` and `τ² = t²c/(1+t²c)`, `c = w^T B^{-1} w`:
 //!
@@ -51,16 +51,11 @@ use std::f64::consts::PI;
 
 use nalgebra::{Cholesky, SMatrix, SVector};
 
-use crate::cache::Cache;
-use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real, Vector};
+use super::gvr_series::{cm_kinetic, horner, omega, series_at_one, Coefficients};
+use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real};
 use crate::error::{CoreError, Result};
-use crate::build::best_isa;
-use crate::family::{check, matrices_of, Family, Params, Symmetry};
-use crate::gvr_build;
-#[cfg(test)]
-use crate::gvr_kernel::{derivative_series, padded_rule};
-use crate::matrices::Matrices;
-use crate::gradient::{seed_matrix, Dual};
+use crate::cache::Keyed;
+use crate::families::{check, matrices_of, Exponents, Parameters};
 use crate::images::Transform;
 
 /// One ECG-GVR function: exponent `A`, global vector `u`, power `K`, and its CM parameters.
@@ -149,59 +144,45 @@ impl<const D: usize, T: Real> Gvr<D, T> {
     }
 }
 
-/// `ĉ_k`, k = 0..=min(K_I, K_J) (module docs), and the coefficients of the series of Ω's
-/// derivatives (`omega`, `quadrature_partials`), for one pair (K_I, K_J) and N; all non-negative.
-/// At `r = ρ²`: `G = Σ ĉ_k r^k`, `G_x = Σ ĉ_k (K_I−k) r^k`, `G_y = Σ ĉ_k (K_J−k) r^k`,
-/// `G_z = Σ ĉ_k (N+2k) r^k`, for N = 0 divided by r (its k = 0 term vanishes).
-pub(crate) struct Coefficients {
-    ki: u32,
-    kj: u32,
-    n: u32,
-    /// `ĉ_k`
-    pub(crate) c: Vec<f64>,
-    /// `ĉ_k (K_I − k)`, `ĉ_k (K_J − k)`
-    pub(crate) cx: Vec<f64>,
-    pub(crate) cy: Vec<f64>,
-    /// `ĉ_k (N + 2k)`; for N = 0 shifted by one, `ĉ_{k+1} 2(k+1)` (G_z / r)
-    pub(crate) cz: Vec<f64>,
-}
-
-impl Coefficients {
-    pub(crate) fn new(ki: u32, kj: u32, n: u32) -> Self {
-        let alpha = n as f64 + 0.5;
-        let mut c = Vec::with_capacity(ki.min(kj) as usize + 1);
-        let mut ck = 1.0;
-        for k in 0..=ki.min(kj) {
-            c.push(ck);
-            ck *= ((ki - k) as f64) * ((kj - k) as f64) / (((k + 1) as f64) * (k as f64 + 1.0 + alpha));
-        }
-        let scaled = |f: &dyn Fn(u32) -> f64| c.iter().enumerate().map(|(k, ck)| ck * f(k as u32)).collect::<Vec<_>>();
-        let (cx, cy) = (scaled(&|k| (ki - k) as f64), scaled(&|k| (kj - k) as f64));
-        let cz = if n == 0 { scaled(&|k| (2 * k) as f64)[1..].to_vec() } else { scaled(&|k| (n + 2 * k) as f64) };
-        Self { ki, kj, n, c, cx, cy, cz }
+impl<const D: usize> Gvr<D> {
+    /// `phi(r) exp(-r^T (M ⊗ I_3) r)` with the normalisation constants of `phi` kept
+    /// (`Family::damped`): `A → A + M`.
+    pub fn damped<T: Real>(&self, m: &SMatrix<T, D, D>) -> Gvr<D, T> {
+        let mut g: Gvr<D, T> = self.cast();
+        g.a += m;
+        g
     }
 }
 
-/// `G(1) = Σ_k ĉ_k` of the pair (K, K) (`Coefficients`), summed from the top as `horner` at 1,
-/// without allocation for K < 64.
-fn series_at_one(k: u32, n: u32) -> f64 {
-    if k >= 64 {
-        return horner(&Coefficients::new(k, k, n).c, 1.0);
-    }
-    let alpha = n as f64 + 0.5;
-    let mut c = [0.0f64; 64];
-    let mut ck = 1.0;
-    for i in 0..=k {
-        c[i as usize] = ck;
-        ck *= ((k - i) as f64) * ((k - i) as f64) / (((i + 1) as f64) * (i as f64 + 1.0 + alpha));
-    }
-    horner(&c[..=k as usize], 1.0)
+/// The parameters of `k` ECG-GVR functions: `A` and `c_A` (`e`), the global vectors `u`
+/// (`k x n`) and the powers `K` (`k`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GvrParams<'a> {
+    pub e: Exponents<'a>,
+    pub u: &'a [f64],
+    pub k: &'a [u32],
 }
 
-/// `Σ_k coef_k r^k` (Horner).
-#[inline]
-fn horner<T: Real>(coef: &[f64], r: T) -> T {
-    coef.iter().rev().fold(T::zero(), |acc, ck| acc * r + *ck)
+impl Parameters for GvrParams<'_> {
+    fn len(&self) -> usize {
+        self.e.len()
+    }
+}
+
+impl Keyed for GvrParams<'_> {
+    fn key(&self) -> Vec<u64> {
+        let lengths = [self.u.len(), self.k.len()].map(|n| n as u64);
+        let values = self.u.iter().map(|x| x.to_bits()).chain(self.k.iter().map(|&k| k as u64));
+        self.e.bits().chain(lengths).chain(values).collect()
+    }
+}
+
+/// The functions of `p`, checked by `Gvr::new`.
+pub fn functions<const D: usize>(p: &GvrParams, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
+    let a = p.e.exponents::<D>()?;
+    let u = matrices_of::<D, 1>(p.u, p.len(), "global vectors")?;
+    check(p.k.len(), p.len(), "powers K")?;
+    (0..p.len()).map(|i| Gvr::new(a[i], u[i], p.k[i], p.e.c_a[i], go, i)).collect()
 }
 
 /// `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ / e^L` (module docs) for the inputs
@@ -268,53 +249,6 @@ pub(crate) fn series_coefficients<const D: usize>(go: &GvrOps<D>, ki: u32, kj: u
     Coefficients::new(ki, kj, go.n_ang).c
 }
 
-/// The Coulomb τ-integral `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ / e^L` of one pair
-/// (K_I, K_J) for each of `inputs` = `[x, y, z, γ_I, γ_J]` (`quadrature`), with its partial
-/// derivatives with respect to the five inputs (the maths of `quadrature_partials`), into
-/// `out`: nodes in lanes of the f64 kernel (`gvr_kernel::integral_partials`, `gvr_build::partials`).
-/// The tests' entry point; the row gradient keeps its rules per pair (`gvr_gradient`).
-#[cfg(test)]
-pub(crate) fn coulomb_partials<const D: usize>(
-    go: &GvrOps<D>,
-    ki: u32,
-    kj: u32,
-    inputs: &[[f64; 5]],
-    out: &mut [(f64, [f64; 5])],
-) {
-    let c = Coefficients::new(ki, kj, go.n_ang).c;
-    let (tau2, weight) = padded_rule(go.rule(ki + kj + go.n_ang));
-    gvr_build::partials((&c, &derivative_series(&c)), (ki, kj, go.n_ang), &tau2, &weight, inputs, out);
-}
-
-/// Ω and its derivatives divided by `e^L`, `L = (K_I+N/2) ln x + (K_J+N/2) ln y`:
-/// returns `(L, ω, ω_x, ω_y, ω_z)`.
-#[inline]
-pub(crate) fn omega<T: Real>(series: &Coefficients, x: T, y: T, z: T) -> (T, T, T, T, T) {
-    let (ki, kj, n) = (series.ki, series.kj, series.n);
-    let nf = n as f64;
-    let rt = (x * y).sqrt();
-    let rho = (z / rt).clamp(re(-1.0), re(1.0));
-    let r2 = rho * rho;
-    let (g, gx, gy, gz) =
-        (horner(&series.c, r2), horner(&series.cx, r2), horner(&series.cy, r2), horner(&series.cz, r2));
-    let rho_n = rho.powi(n as i32);
-    let l = x.ln() * (ki as f64 + 0.5 * nf) + y.ln() * (kj as f64 + 0.5 * nf);
-    // Ω_z = x^{K_I} y^{K_J} Σ ĉ_k (N+2k) z^{N+2k-1} (xy)^{-k} = e^L Σ ĉ_k (N+2k) ρ^{N+2k-1} / √(xy);
-    // for N = 0, G_z is stored divided by ρ² (`Coefficients::cz`), so ρ^{2k-1} = ρ · ρ^{2(k-1)}.
-    let omega_z = if n == 0 { rho * gz / rt } else { rho.powi(n as i32 - 1) * gz / rt };
-    (l, rho_n * g, rho_n * gx / x, rho_n * gy / y, omega_z)
-}
-
-/// Closed form of the kinetic element with `Λ = 1 1^T/(2 m_tot)` over `e^L S_0` (docs/gvr.md):
-/// `3 c_I c_J/(m s) Ω − (c_UI² c_J Ω_x + c_UJ² c_I Ω_y)/(m s) + c_I c_J (c_UI² Ω_x + c_UI c_UJ Ω_z + c_UJ² Ω_y)/(m s²)`.
-#[inline]
-fn cm_kinetic<T: Real>(ci: f64, cj: f64, ui: T, uj: T, m: f64, w: (T, T, T, T)) -> T {
-    let (om, ox, oy, oz) = w;
-    let s = ci + cj;
-    om * (3.0 * ci * cj / (m * s)) - (ui * ui * cj * ox + uj * uj * ci * oy) / (m * s)
-        + (ui * ui * ox + ui * uj * oz + uj * uj * oy) * (ci * cj) / (m * s * s)
-}
-
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised ECG-GVR functions.
 pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
     let ops = &go.ops;
@@ -331,7 +265,7 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     let z = bra.u.dot(&gj) * 0.5;
     let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
     let series = Coefficients::new(bra.k, ket.k, n);
-    let (l, om, ox, oy, oz) = omega(&series, x, y, z);
+    let (l, om, ox, oy, oz) = omega(&series.terms(), x, y, z);
     let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
     let s = scale * om;
 
@@ -386,75 +320,6 @@ impl<const D: usize, T: Real> Transform<D, GvrOps<D>> for Gvr<D, T> {
     }
 }
 
-/// The ECG-GVR family: parameters `A` (`k x n x n`), `u` (`k x n`), `K`, `c_A`; N is the context's.
-pub struct EcgGvr;
-
-impl<const D: usize> Family<D> for EcgGvr {
-    const NAME: &'static str = "ecg-gvr";
-
-    /// The f64 kernel (`gvr_build`, `gvr_kernel`).
-    fn matrices(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &Params) -> Result<Matrices> {
-        gvr_build::matrices(go, sym, basis, best_isa())
-    }
-
-    /// The f64 kernel, oriented as `path::rows` (`gvr_build`).
-    fn rows(
-        go: &GvrOps<D>,
-        sym: &Symmetry<D>,
-        trials: &Params,
-        basis: &Params,
-        position: Option<usize>,
-        cache: &Cache,
-    ) -> Result<(Matrices, Vec<Element>)> {
-        gvr_build::rows(go, sym, trials, basis, position, best_isa(), cache)
-    }
-    type Function<T: Real> = Gvr<D, T>;
-    type Context = GvrOps<D>;
-
-    fn context(ops: Operators<D>, n_ang: u32, sets: &[&Params]) -> Result<GvrOps<D>> {
-        let k_max = sets.iter().flat_map(|p| p.k_pow.iter()).copied().max().unwrap_or(0);
-        GvrOps::new(ops, n_ang, k_max)
-    }
-
-    fn functions(p: &Params, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
-        let a = p.exponents::<D>()?;
-        let u = matrices_of::<D, 1>(p.v, p.len(), "global vectors")?;
-        check(p.k_pow.len(), p.len(), "powers K")?;
-        (0..p.len()).map(|i| Gvr::new(a[i], u[i], p.k_pow[i], p.c_a[i], go, i)).collect()
-    }
-
-    fn element<T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
-        element(bra, ket, go)
-    }
-
-    fn cast<T: Real>(f: &Gvr<D>) -> Gvr<D, T> {
-        f.cast()
-    }
-
-    fn seeded<const W: usize>(f: &Gvr<D>, da: &[Mat<D>], du: &[f64], go: &GvrOps<D>) -> Result<Gvr<D, Dual<W>>> {
-        let du: Vec<Vector<D>> = matrices_of::<D, 1>(du, da.len(), "global-vector directions")?;
-        Gvr::new(seed_matrix(&f.a, da), seed_matrix(&f.u, &du), f.k, f.c_a, go, 0)
-    }
-
-    fn damped<T: Real>(f: &Gvr<D>, m: &SMatrix<T, D, D>) -> Gvr<D, T> {
-        let mut g: Gvr<D, T> = f.cast();
-        g.a += m;
-        g
-    }
-
-    /// Hand-derived reverse mode (`gvr_gradient`) instead of dual numbers.
-    fn row_gradient(
-        go: &GvrOps<D>,
-        sym: &crate::family::Symmetry<D>,
-        trial: &Params,
-        dir: &crate::family::Directions,
-        basis: &Params,
-        cache: &Cache,
-    ) -> Result<(crate::matrices::Matrices, Vec<Element>)> {
-        crate::gvr_gradient::row_gradient(go, sym, trial, dir, basis, cache)
-    }
-}
-
 /// The m positive nodes of the 2m-point Gauss–Legendre rule on [−1, 1] with their weights:
 /// `Σ w f(τ) = ∫_0^1 f(τ) dτ` for every even polynomial f of degree ≤ 4m − 1.
 pub fn even_rule(m: usize) -> Vec<(f64, f64)> {
@@ -491,6 +356,9 @@ pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::families::gvr::gvr_build::{self, coulomb_partials};
+    use crate::families::gvr::gvr_kernel::{derivative_series, padded_rule};
+    use crate::isa::Isa;
 
     #[test]
     fn legendre_integrates_polynomials_exactly() {
@@ -574,7 +442,7 @@ mod tests {
                 }
                 // the same bits on every instruction set
                 let (tau2, weight) = padded_rule(rule);
-                for isa in [crate::build::Isa::Plain, crate::build::Isa::Avx2, crate::build::Isa::Avx512] {
+                for isa in [Isa::Plain, Isa::Avx2, Isa::Avx512] {
                     let mut o = vec![(0.0, [0.0; 5]); inputs.len()];
                     gvr_build::partials_with(isa, (&series.c, &derivative_series(&series.c)), (ki, kj, n), &tau2, &weight, &inputs, &mut o);
                     assert_eq!(o, out, "{isa:?}");

@@ -20,13 +20,11 @@ use std::f64::consts::PI;
 
 use nalgebra::SMatrix;
 
-use crate::cache::Cache;
-use crate::ecg::{dot_f, inverse_log_det, mul, re, Element, Mat, Operators, Real, Vector};
+use crate::ecg::{dot_f, inverse_log_det, log_det_pd, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
-use crate::family::{matrices_of, Directions, Family, Params, Symmetry};
-use crate::gradient::{seed_matrix, Dual};
+use crate::cache::Keyed;
+use crate::families::{matrices_of, Exponents, Parameters};
 use crate::images::Transform;
-use crate::matrices::Matrices;
 
 pub type Centres<const D: usize, T = f64> = SMatrix<T, D, 3>;
 
@@ -46,7 +44,7 @@ pub struct Fecg<const D: usize, T: Real = f64> {
 
 impl<const D: usize, T: Real> Fecg<D, T> {
     pub fn new(a: SMatrix<T, D, D>, s: Centres<D, T>, c_a: f64, index: usize) -> Result<Self> {
-        let log_det = crate::ecg::log_det_pd(&a).ok_or(CoreError::NotPositiveDefinite { function: index })?;
+        let log_det = log_det_pd(&a).ok_or(CoreError::NotPositiveDefinite { function: index })?;
         let a_s = a * s;
         let s_a_s = s.component_mul(&a_s).sum();
         Ok(Self { a, s, c_a, log_det, a_s, s_a_s })
@@ -68,68 +66,48 @@ impl<const D: usize, T: Real> Fecg<D, T> {
     }
 }
 
+impl<const D: usize> Fecg<D> {
+    /// `(r-s)^T A (r-s) + r^T M r = r^T (A+M) r - 2 r^T A s + s^T A s`: `A` grows, `A s`, `s^T A s`
+    /// and `ln|A|` (the normalisation) stay (`Family::damped`).
+    pub fn damped<T: Real>(&self, m: &SMatrix<T, D, D>) -> Fecg<D, T> {
+        let mut g: Fecg<D, T> = self.cast();
+        g.a += m;
+        g
+    }
+}
+
+/// The parameters of `k` floating ECGs: `A` and `c_A` (`e`) and the centres `s` (`k x n x 3`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FecgParams<'a> {
+    pub e: Exponents<'a>,
+    pub s: &'a [f64],
+}
+
+impl Parameters for FecgParams<'_> {
+    fn len(&self) -> usize {
+        self.e.len()
+    }
+}
+
+impl Keyed for FecgParams<'_> {
+    fn key(&self) -> Vec<u64> {
+        self.e.bits().chain([self.s.len() as u64]).chain(self.s.iter().map(|x| x.to_bits())).collect()
+    }
+}
+
+/// The functions of `p`, checked by `Fecg::new`.
+pub fn functions<const D: usize>(p: &FecgParams) -> Result<Vec<Fecg<D>>> {
+    let a = p.e.exponents::<D>()?;
+    let s = matrices_of::<D, 3>(p.s, p.len(), "centres")?;
+    (0..p.len()).map(|i| Fecg::new(a[i], s[i], p.e.c_a[i], i)).collect()
+}
+
 impl<const D: usize, T: Real, Ctx> Transform<D, Ctx> for Fecg<D, T> {
     /// `phi(T r)`: `A -> T^T A T`, `s -> T^{-1} s`.
     fn transformed(&self, t: &Mat<D>, _: &Ctx, index: usize) -> Result<Self> {
         let t_inv = t.try_inverse().ok_or_else(|| CoreError::Unsupported("singular symmetry operation".into()))?;
         let (t, t_inv): (SMatrix<T, D, D>, SMatrix<T, D, D>) = (t.map(re), t_inv.map(re));
         Self::new(t.transpose() * self.a * t, t_inv * self.s, self.c_a, index)
-    }
-}
-
-/// The floating-ECG family: parameters `A` (`k x n x n`), centres `s` (`k x n x 3`), `c_A`.
-pub struct FloatingEcg;
-
-impl<const D: usize> Family<D> for FloatingEcg {
-    const NAME: &'static str = "fecg";
-    type Function<T: Real> = Fecg<D, T>;
-    type Context = Operators<D>;
-
-    fn context(ops: Operators<D>, _: u32, _: &[&Params]) -> Result<Operators<D>> {
-        Ok(ops)
-    }
-
-    fn functions(p: &Params, _: &Operators<D>) -> Result<Vec<Fecg<D>>> {
-        let a = p.exponents::<D>()?;
-        let s = matrices_of::<D, 3>(p.v, p.len(), "centres")?;
-        (0..p.len()).map(|i| Fecg::new(a[i], s[i], p.c_a[i], i)).collect()
-    }
-
-    fn element<T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops: &Operators<D>) -> Element<T> {
-        element(bra, ket, ops)
-    }
-
-    fn overlap<T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, _: &Operators<D>) -> T {
-        pair(bra, ket).map_or(re(f64::NAN), |(s, _, _)| s)
-    }
-
-    fn cast<T: Real>(f: &Fecg<D>) -> Fecg<D, T> {
-        f.cast()
-    }
-
-    fn seeded<const W: usize>(f: &Fecg<D>, da: &[Mat<D>], ds: &[f64], _: &Operators<D>) -> Result<Fecg<D, Dual<W>>> {
-        let ds: Vec<Centres<D>> = matrices_of::<D, 3>(ds, da.len(), "centre directions")?;
-        Fecg::new(seed_matrix(&f.a, da), seed_matrix(&f.s, &ds), f.c_a, 0)
-    }
-
-    /// The hand-derived row gradient (`fecg_gradient`); the diagonal by dual numbers.
-    fn row_gradient(
-        ops: &Operators<D>,
-        sym: &Symmetry<D>,
-        trial: &Params,
-        dir: &Directions,
-        basis: &Params,
-        cache: &Cache,
-    ) -> Result<(Matrices, Vec<Element>)> {
-        crate::fecg_gradient::row_gradient(ops, sym, trial, dir, basis, cache)
-    }
-
-    /// `(r-s)^T A (r-s) + r^T M r = r^T (A+M) r - 2 r^T A s + s^T A s`: `A` grows, `A s`, `s^T A s`
-    /// and `ln|A|` (the normalisation) stay.
-    fn damped<T: Real>(f: &Fecg<D>, m: &SMatrix<T, D, D>) -> Fecg<D, T> {
-        let mut g: Fecg<D, T> = f.cast();
-        g.a += m;
-        g
     }
 }
 

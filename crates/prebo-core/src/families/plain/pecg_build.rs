@@ -1,13 +1,14 @@
-//! Symmetrised matrices and candidate rows, parallel over rows with rayon.
+//! Symmetrised plain-ECG matrices and candidate rows with the SIMD kernel (`pecg`), parallel
+//! over rows with rayon: the overrides of `Family::matrices` and `Family::rows` for `PlainEcg`.
 //!
 //! A symmetrised element is `Σ_P c_P <phi_I| O |P phi_J>` with the Young-operator
-//! coefficients `c_P` (python/prebo/symmetry.py) and `P phi_J` represented by the
+//! coefficients `c_P` (python/prebo/system/symmetry.py) and `P phi_J` represented by the
 //! transformed exponent `P^T A_J P`, precomputed once per function and permutation.
 //!
 //! The builds evaluate one bra against `W` kets at a time with `pecg::lanes`: the images
 //! `P^T A_J P` are stored in structure-of-arrays blocks of `W` functions, and each row is
 //! computed by a function compiled for the best instruction set the CPU has (AVX-512:
-//! `W = 8`, AVX2: `W = 4`, otherwise plain x86-64 / other targets: `W = 4`), chosen
+//! `W = 8`, AVX2: `W = 4`, otherwise plain x86-64 / other targets: `W = 4`; `isa`), chosen
 //! once per build. All of them give the same bits (see `pecg`).
 //!
 //! Element `(i, j)`, `i <= j`, of a full build has function `i` as bra and the images of `j` as
@@ -16,13 +17,22 @@
 //! (`row`). Patched into the matrices they give the bits of a full build.
 use rayon::prelude::*;
 
-use crate::ecg::{Element, Gaussian, Operators};
-use crate::images::Images;
+use super::pecg::{self, bra_lanes, Accumulator, Bra, Ket, KetLanes, Prepared};
+use crate::ecg::{Element, Gaussian, Mat, Operators};
+use crate::error::Result;
+use crate::images::{Images, Transform};
+use crate::isa::{best_isa, isa_available, Isa};
 use crate::matrices::Matrices;
-use crate::pecg::{self, bra_lanes, Accumulator, Bra, Ket, KetLanes, Prepared};
 
 /// Plain ECGs with their images under every symmetry operation.
 pub type Symmetrised<const D: usize> = Images<Gaussian<D>>;
+
+impl<const D: usize, Ctx> Transform<D, Ctx> for Gaussian<D> {
+    /// The permuted (or otherwise linearly transformed) function `phi(T r)`: `A -> T^T A T`.
+    fn transformed(&self, t: &Mat<D>, _: &Ctx, index: usize) -> Result<Self> {
+        Self::new(t.transpose() * self.a * t, self.c_a, index)
+    }
+}
 
 /// The kets of a build: every image of the functions from block `first` on in blocks of `W`,
 /// and the coefficients.
@@ -156,30 +166,6 @@ isa_kernels!(avx2, 4, "avx2");
 #[cfg(target_arch = "x86_64")]
 isa_kernels!(avx512, 8, "avx512f");
 
-/// The instruction sets a build can use, best first.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Isa {
-    Avx512,
-    Avx2,
-    Plain,
-}
-
-/// The best instruction set of this CPU (`PREBO_ISA=avx512|avx2|plain` caps it, for tests).
-pub fn best_isa() -> Isa {
-    let cap = std::env::var("PREBO_ISA").unwrap_or_default().to_ascii_lowercase();
-    #[cfg(target_arch = "x86_64")]
-    {
-        if cap != "avx2" && cap != "plain" && std::arch::is_x86_feature_detected!("avx512f") {
-            return Isa::Avx512;
-        }
-        if cap != "plain" && std::arch::is_x86_feature_detected!("avx2") {
-            return Isa::Avx2;
-        }
-    }
-    let _ = cap;
-    Isa::Plain
-}
-
 macro_rules! dispatch {
     ($isa:expr, $f:ident :: <$d:ident> ( $($arg:expr),* )) => {{
         match $isa {
@@ -201,19 +187,6 @@ pub fn matrices<const D: usize>(basis: &Symmetrised<D>, ops: &Operators<D>) -> M
 pub fn matrices_with<const D: usize>(basis: &Symmetrised<D>, ops: &Operators<D>, isa: Isa) -> Matrices {
     let isa = if isa_available(isa) { isa } else { Isa::Plain };
     dispatch!(isa, matrices_w::<D>(basis, ops))
-}
-
-/// Whether this CPU has `isa`.
-pub(crate) fn isa_available(isa: Isa) -> bool {
-    match isa {
-        Isa::Plain => true,
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => std::arch::is_x86_feature_detected!("avx512f"),
-        #[cfg(not(target_arch = "x86_64"))]
-        _ => false,
-    }
 }
 
 fn matrices_w<const D: usize, const W: usize>(
@@ -406,5 +379,5 @@ fn lane<const W: usize>(a: &Accumulator<W>, l: usize) -> Element {
 }
 
 #[cfg(test)]
-#[path = "build_tests.rs"]
+#[path = "pecg_build_tests.rs"]
 mod tests;

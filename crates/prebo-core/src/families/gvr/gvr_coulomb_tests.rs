@@ -1,8 +1,9 @@
-//! The closed form against the Gauss–Legendre quadrature of `gvr.rs` (the oracle), hand values,
+//! The closed form against the Gauss–Legendre quadrature of `gvr_element` (the oracle), hand values,
 //! and (ignored) the timing of both per pair.
 use super::*;
 use crate::ecg::{Mat, Operators};
-use crate::gvr::{coulomb_partials, even_rule};
+use crate::families::gvr::gvr_build::coulomb_partials;
+use crate::families::gvr::gvr_element::even_rule;
 
 const D: usize = 3;
 
@@ -116,7 +117,7 @@ fn cpu_ns() -> f64 {
     t.sec as f64 * 1e9 + t.nsec as f64
 }
 
-/// Today's `gvr::quadrature` in `f64` (the element's value path), line for line.
+/// Today's `gvr_element::quadrature` in `f64` (the element's value path), line for line.
 fn quadrature_value(inputs: [f64; 5], rule: &[(f64, f64)], c: &[f64], ki: i32, kj: i32, n: i32) -> f64 {
     let [x, y, z, gam_i, gam_j] = inputs;
     let rt = (x * y).sqrt();

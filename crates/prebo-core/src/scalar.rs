@@ -1,0 +1,110 @@
+//! The one scalar interface of the generic elements' values (`ecg::Real`: `f64`, dual numbers)
+//! and the f64 kernels' values (`lanes::Lane`: `f64`, lanes), for maths written once for both:
+//! a formula generic over [`Scalar`] (e.g. `families::gvr::gvr_series::omega`) performs the same
+//! operations in the same order on each, so every instance has the bits of the others' values.
+use std::ops::{Add, Div, Mul, Sub};
+
+use nalgebra::{ComplexField, RealField};
+use num_dual::DualSVec64;
+
+/// Arithmetic with itself and with `f64` constants, and the few functions of one value the shared
+/// formulas need. The functions are associated functions (`T::sqrt(x)`), not methods, so they do
+/// not compete with nalgebra's in code generic over `Real`.
+pub trait Scalar:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Add<f64, Output = Self>
+    + Mul<f64, Output = Self>
+{
+    /// The constant `x` (zero derivatives).
+    fn of(x: f64) -> Self;
+    fn sqrt(x: Self) -> Self;
+    fn ln(x: Self) -> Self;
+    /// `x` clamped to `[−1, 1]`.
+    fn clamp_unit(x: Self) -> Self;
+    /// `x^k`: binary exponentiation for `f64` and lanes (the operations of `f64::powi`), the dual
+    /// numbers' own `powi`.
+    fn powu(x: Self, k: u32) -> Self;
+}
+
+/// `x^k` by binary exponentiation, the same squarings and products as `f64::powi`.
+#[inline(always)]
+pub fn binary_power<T: Copy + Mul<Output = T>>(x: T, k: u32, one: T) -> T {
+    let (mut r, mut base, mut k) = (one, x, k);
+    loop {
+        if k & 1 == 1 {
+            r = r * base;
+        }
+        k >>= 1;
+        if k == 0 {
+            return r;
+        }
+        base = base * base;
+    }
+}
+
+impl Scalar for f64 {
+    #[inline(always)]
+    fn of(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn sqrt(x: Self) -> Self {
+        f64::sqrt(x)
+    }
+    #[inline(always)]
+    fn ln(x: Self) -> Self {
+        f64::ln(x)
+    }
+    #[inline(always)]
+    fn clamp_unit(x: Self) -> Self {
+        x.clamp(-1.0, 1.0)
+    }
+    #[inline(always)]
+    fn powu(x: Self, k: u32) -> Self {
+        binary_power(x, k, 1.0)
+    }
+}
+
+impl<const W: usize> Scalar for DualSVec64<W> {
+    #[inline(always)]
+    fn of(x: f64) -> Self {
+        Self::from(x)
+    }
+    #[inline(always)]
+    fn sqrt(x: Self) -> Self {
+        ComplexField::sqrt(x)
+    }
+    #[inline(always)]
+    fn ln(x: Self) -> Self {
+        ComplexField::ln(x)
+    }
+    #[inline(always)]
+    fn clamp_unit(x: Self) -> Self {
+        RealField::clamp(x, Self::from(-1.0), Self::from(1.0))
+    }
+    #[inline(always)]
+    fn powu(x: Self, k: u32) -> Self {
+        ComplexField::powi(x, k as i32)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lanes::Lanes;
+
+    #[test]
+    fn powers_have_the_bits_of_powi() {
+        let mut x = 0.3f64;
+        for k in 0..200u32 {
+            x = (x * 7.31 + 0.17).fract() * 2.0 - 1.0;
+            assert_eq!(<f64 as Scalar>::powu(x, k).to_bits(), x.powi(k as i32).to_bits(), "{x}^{k}");
+            let lanes = Lanes::<2>::powu(Lanes([x, -x]), k).0;
+            assert_eq!(lanes.map(f64::to_bits), [x.powi(k as i32), (-x).powi(k as i32)].map(f64::to_bits));
+        }
+    }
+}

@@ -1,0 +1,82 @@
+"""A run read back from its checkpoint (checkpoint.py), for `prebo run --resume`, which continues
+it (bit for bit in a fixed schedule): every part is checked as a claim (`resumed`, `check_rng`,
+history.check_history, the schedule's and the momentum's own checks), and a malformed part is
+refused in one line naming the file and the key.
+"""
+from __future__ import annotations
+
+import reprlib
+from pathlib import Path
+
+import numpy as np
+
+from ..basis import Basis
+from ..errors import BasisFileError, PreboError
+from ..io import basis_json
+from ..system import System
+from ..validation import number
+from .checkpoint import CHECKPOINT
+from .convergence import STOPPED
+from .cursor import Cursor
+from .history import Step, check_history
+from .momentum import Momentum
+from .schedule import schedule_of
+from .settings import Optimiser
+
+
+def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> tuple:
+    """The basis, cursor, history (history.Step), elapsed seconds, schedule (schedule.schedule_of)
+    and stop reason of checkpoint content `d` (`rng` takes its state); BasisFileError naming
+    `where` for anything that does not fit."""
+    basis = Basis.from_dict(d, where, empty=True)
+    if basis.kind != opts.kind:
+        raise BasisFileError(f"{where}: a {basis.kind} basis, but the optimiser's kind is {opts.kind}")
+    try:
+        cursor = Cursor(**d["progress"])
+        rng.bit_generator.state = check_rng(d["rng"])
+        history, elapsed = [Step(*row) for row in check_history(d["history"])], number(d.get("elapsed", 0.0), "elapsed")
+        if elapsed < 0:
+            raise ValueError(f"elapsed = {elapsed!r}: must be the seconds of the run so far (≥ 0)")
+        schedule, stopped = schedule_of(opts, d.get("schedule")), d.get("stopped")
+        if stopped not in STOPPED:
+            raise ValueError(f"stopped = {reprlib.repr(stopped)}: must be one of {tuple(STOPPED)}")
+    except (KeyError, TypeError, ValueError) as exc:
+        raise BasisFileError(f"{where}: malformed run state ({exc})") from exc
+    nb = len(basis)
+    if (cursor.phase != "grow" and nb == 0) or (cursor.phase in ("sweep", "refine") and cursor.index >= nb):
+        raise BasisFileError(f"{where}: progress {vars(cursor)} does not fit a basis of {nb} functions")
+    return basis, cursor, history, elapsed, schedule, stopped
+
+
+def check_rng(block) -> dict:
+    """A checkpoint's "rng" block: the state of numpy's PCG64 generator, {bit_generator: "PCG64",
+    state: {state, inc}, has_uint32, uinteger} with integers in their ranges (numpy itself takes
+    booleans and truncates floats); ValueError otherwise."""
+    def count(k, bits):
+        return type(k) is int and 0 <= k < 1 << bits
+
+    ok = isinstance(block, dict) and set(block) == {"bit_generator", "state", "has_uint32", "uinteger"}
+    state = block.get("state") if ok else None
+    if not (ok and block["bit_generator"] == "PCG64" and isinstance(state, dict) and set(state) == {"state", "inc"}
+            and count(state["state"], 128) and count(state["inc"], 128) and count(block["has_uint32"], 1)
+            and count(block["uinteger"], 32)):
+        raise ValueError(f"rng = {reprlib.repr(block)}: must be the state of numpy's PCG64 generator")
+    return block
+
+
+def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
+    """The content of folder/basis.json with its system and settings, checked as a whole: the
+    basis, the settings, the run state and the momentum block (BasisFileError naming the file)."""
+    path = Path(folder) / CHECKPOINT
+    if not path.exists():
+        raise BasisFileError(f"{path}: no checkpoint to resume")
+    d = basis_json.read(path)
+    if not (isinstance(d, dict) and {"optimiser", "progress", "rng", "history"} <= set(d)):
+        raise BasisFileError(f"{path}: not a run checkpoint (no optimiser state)")
+    try:
+        opts = Optimiser.from_dict(d["optimiser"])
+    except PreboError as exc:
+        raise BasisFileError(f"{path}: {exc}") from exc
+    basis, *_ = resumed(d, opts, np.random.default_rng(), str(path))
+    Momentum.from_dict(d.get("momentum"), basis, str(path))
+    return d, basis.system, opts
