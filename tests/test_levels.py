@@ -11,20 +11,18 @@ from prebo.cli import main
 from prebo.errors import InputError, LinearDependenceError
 from prebo.results import HARTREE_CM
 
-from conftest import ROOT
+from conftest import ROOT, pair_A
 
 BASES = ROOT / "examples" / "bases"
 
 
 def hydrogen(size: int = 50, ratio: float = 1.45, widest: float = 3e-4):
     """H (finite proton mass) in `size` even-tempered s Gaussians exp(-a r²), a = widest × ratio^k,
-    of r = r_e − r_p, each times the CM Gaussian exp(−c_A X²), c_A = 1: A = a w wᵀ + c_A μ μᵀ with
-    w = (1, −1), μ = m/M (prebo's CM-separable form). Returns (basis, μ_red)."""
+    of r = r_e − r_p, each times a CM Gaussian (c_A = 1; conftest.pair_A). Returns (basis, μ)."""
     d = json.loads((BASES / "h" / "basis.json").read_text())
     system = prebo.Basis.from_dict(d, "h").system
     d = {k: d[k] for k in ("format", "version", "conventions", "system", "symmetry", "basis_type")}
-    w, mu = np.array([1.0, -1.0]), system.cm_vector
-    d["functions"] = [{"A": (a * np.outer(w, w) + np.outer(mu, mu)).tolist(), "c_A": 1.0, "channel": "pairs"}
+    d["functions"] = [{"A": pair_A(system, {(0, 1): a}, 1.0).tolist(), "c_A": 1.0, "channel": "pairs"}
                       for a in widest * ratio ** np.arange(size)]
     m = system.masses
     return prebo.Basis.from_dict(d, "even-tempered H"), m[0] * m[1] / (m[0] + m[1])
