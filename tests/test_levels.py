@@ -49,14 +49,15 @@ def test_the_ground_state_keys_are_those_of_one_root():
     """Asking for several roots leaves root 0's result as it was, bit for bit (the main job and every
     stored basis keep their energies)."""
     basis = prebo.Basis.load(BASES / "he" / "basis.json")
-    one, three = prebo.evaluate(basis), prebo.evaluate(basis, roots=3)
+    one, three = prebo.evaluate(basis, operators=["r2"]), prebo.evaluate(basis, operators=["r2"], roots=3)
     assert "levels" not in one and "transitions" not in one
     for key in ("energy", "energy_uncertainty", "energy_lab", "virial", "kinetic", "potential", "bound",
-                "binding_energy", "overlap_condition", "kept"):
+                "binding_energy", "overlap_condition", "kept", "expectation"):
         assert three[key] == one[key], key
     assert np.array_equal(three["coefficients"], one["coefficients"])
     assert three["levels"][0] == {k: one[k] for k in three["levels"][0] if k != "root"} | {"root": 0}
     assert three["levels"][1]["energy"] < three["levels"][2]["energy"]
+    assert three["levels"][1]["expectation"]["r2"]["e-e"] > one["expectation"]["r2"]["e-e"]  # 1s2s is larger
 
 
 def test_a_level_above_the_threshold_is_reported_not_bound(capsys):

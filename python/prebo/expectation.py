@@ -55,16 +55,21 @@ def operator(name: str) -> PairOperator:
     return OPERATORS[name]
 
 
-def expectation(rep, basis, c: np.ndarray, name: str) -> dict[str, float]:
-    """⟨Ψ|O|Ψ⟩ of the registered operator `name` for Ψ = Σ_k c_k Yφ_k with cᵀSc = 1.
+def expectation(rep, basis, C: np.ndarray, name: str) -> list[dict[str, float]]:
+    """⟨Ψ|O|Ψ⟩ of the registered operator `name` for each state Ψ = Σ_k c_k Yφ_k, c a column of `C`
+    with cᵀSc = 1 (the operator's matrices are built once for all of them).
 
     rep: the representation (integrals.laboratory or translationally_invariant) whose matrices gave
-    c; basis: a prebo.Basis. Returns {pair class "a-b": the class average, in the operator's unit}."""
+    C; basis: a prebo.Basis. Returns, per column, {pair class "a-b": the class average, in the
+    operator's unit}."""
     op = operator(name)
     classes = op.classes(basis.system)
     O = rep.operator(op.name, basis, np.concatenate(list(classes.values())))
-    values, k = {}, 0
-    for label, w in classes.items():
-        values[label] = float(np.mean([c @ O[k + m] @ c for m in range(len(w))]))
-        k += len(w)
-    return values
+    states = []
+    for c in C.T:
+        values, k = {}, 0
+        for label, w in classes.items():
+            values[label] = float(np.mean([c @ O[k + m] @ c for m in range(len(w))]))
+            k += len(w)
+        states.append(values)
+    return states

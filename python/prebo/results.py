@@ -106,8 +106,9 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     ti = eigen.solve(m["T_ti"] + m["V"], m["S"], threshold, roots)
     low = lowest(system)
     n2 = None if basis.family.conserves_L else laboratory(system).angular(basis, system.cm_vector)
-    levels = [level(ti, k, m, low.energy, threshold, n2, {name: expectation(rep, basis, ti.vectors[:, k], name)
-                                                        for name in operators}) for k in range(roots)]
+    values = {name: expectation(rep, basis, ti.vectors[:, :roots], name) for name in operators}
+    levels = [level(ti, k, m, low.energy, threshold, n2, {name: v[k] for name, v in values.items()})
+              for k in range(roots)]
     ground = levels[0]
     if energy_lab is None:
         energy_lab = ground["energy"] + 1.5 * c_A / system.m_total
