@@ -3,7 +3,7 @@ removal"): `--grow N` growth steps past the size as methods.PruneStep makes them
 run's trials, refined, then refined with its partners), then the removals back to the size, each
 of the function whose removal raises the energy least — as PruneStep.remove (the function it
 overlapped most then refined with its partners), or with `--plain` removed only (the code before
-session 26). First, what removing each function alone would cost (eigen.lowest_without_each);
+session 26). First, what removing each function alone would cost (eigen.root_without_each);
 then per seed: each growth step's gain and seconds, each removal's cost, the net gain and the
 seconds.
 
@@ -42,7 +42,7 @@ def main() -> None:
             ex = Expansion(basis.subset(slice(None)), laboratory(system), opts.threshold, opts.min_norm,
                            opts.max_overlap)
             if k == 0:
-                alone = eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors) - ex.energy
+                alone = eigen.root_without_each(ex.eig.energies, ex.eig.vectors) - ex.energy
                 print(f"removing one function alone costs {alone.min():.2e} Eh at least, median "
                       f"{np.median(alone):.2e}; {int(np.sum(alone < 1e-10))} below 1e-10")
             run = Run(ex, Sampler(system, opts, np.random.default_rng(seed)), report)
@@ -57,7 +57,7 @@ def main() -> None:
             while len(ex.basis) > nb:
                 before = ex.energy
                 if a.plain:
-                    ex.remove(int(np.argmin(eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors))))
+                    ex.remove(int(np.argmin(eigen.root_without_each(ex.eig.energies, ex.eig.vectors))))
                 else:
                     prune.remove(run)
                 costs.append(ex.energy - before)

@@ -1,4 +1,5 @@
 import itertools
+import json
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +28,19 @@ def pair_A(system, alpha: dict, c_A: float) -> np.ndarray:
         w[i], w[j] = 1.0, -1.0
         A += a * np.outer(w, w)
     return A
+
+
+def hydrogen_s(exponents):
+    """H (finite proton mass) in s Gaussians exp(-a r²) of r = r_e − r_p, one per exponent a, each
+    times a CM Gaussian (c_A = 1; `pair_A`), as a basis of examples/bases/h's system. Returns
+    (basis, μ)."""
+    d = json.loads((ROOT / "examples" / "bases" / "h" / "basis.json").read_text())
+    system = prebo.Basis.from_dict(d, "h").system
+    d = {k: d[k] for k in ("format", "version", "conventions", "system", "symmetry", "basis_type")}
+    d["functions"] = [{"A": pair_A(system, {(0, 1): a}, 1.0).tolist(), "c_A": 1.0, "channel": "pairs"}
+                      for a in exponents]
+    m = system.masses
+    return prebo.Basis.from_dict(d, "H in s Gaussians"), m[0] * m[1] / (m[0] + m[1])
 
 
 def random_pair_A(system, rng, c_A: float) -> np.ndarray:

@@ -43,7 +43,7 @@ def test_secular_update_equals_full_solve(problem):
     keep = slice(0, 9)
     H, S = m["T_ti"] + m["V"], m["S"]
     sub = eigen.solve(H[keep, keep], S[keep, keep])
-    e = eigen.lowest_with_added(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9], S[9, 9])
+    e = eigen.root_with_added(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9], S[9, 9])
     full = eigen.solve(H, S).energies[0]
     assert e == pytest.approx(full, rel=1e-12)
     assert e <= sub.energies[0]  # adding a function never raises the lowest eigenvalue
@@ -65,7 +65,7 @@ def test_block_update_equals_full_solve(problem, k):
     assert c @ S @ c == pytest.approx(norm2, rel=1e-12)
     assert np.allclose(H @ c, e * S @ c, atol=1e-9 * np.sqrt(norm2))
     if k == 1:
-        assert e == pytest.approx(eigen.lowest_with_added(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9],
+        assert e == pytest.approx(eigen.root_with_added(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9],
                                                           S[9, 9]), rel=1e-14)
     if n:
         dup = [0] + list(range(n + 1, 10))  # function 0 again, with the others of the block
@@ -100,6 +100,50 @@ def test_block_root_is_a_flip_of_the_inertia_wherever_newton_starts(problem, k):
         assert abs(root - e) <= 8 * np.spacing(abs(e))
 
 
+@pytest.mark.parametrize("root", [1, 2, 5])
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_higher_roots_of_the_updates_equal_the_full_solve(problem, root, k):
+    """Eigenvalue `root` with k functions added at once (the inertia count, eigen.root_with_block),
+    its eigenvector, and for k = 1 the secular root and its gradient (eigen.root_with_added_gradient,
+    against central differences of a dense solve along a random direction of the new row), and
+    root `root` without each function (eigen.root_without_each), all against dense solves."""
+    _, _, _, m = problem
+    H, S = m["T_ti"] + m["V"], m["S"]
+    n = 10 - k
+    sub = eigen.solve(H[:n, :n], S[:n, :n])
+    full = scipy.linalg.eigh(H, S, eigvals_only=True)
+    e, a, beta, norm2 = eigen.root_with_block(sub.energies, sub.vectors, H[n:, :n], S[n:, :n], H[n:, n:],
+                                              S[n:, n:], root=root)
+    assert e == pytest.approx(full[root], rel=1e-12)
+    c = np.concatenate([sub.vectors @ a, beta])
+    assert c @ S @ c == pytest.approx(norm2, rel=1e-10)
+    assert np.allclose(H @ c, e * S @ c, atol=1e-8 * np.sqrt(norm2))
+    if k == 1:
+        rng = np.random.default_rng(root)
+        dh, ds = rng.normal(size=(1, n)) * 1e-2, rng.normal(size=(1, n)) * 1e-3
+        dh_nn, ds_nn = np.array([2e-2]), np.array([1e-3])
+        e1, g = eigen.root_with_added_gradient(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9], S[9, 9],
+                                               dh, ds, dh_nn, ds_nn, root=root)
+        assert e1 == pytest.approx(full[root], rel=1e-12)
+
+        def moved(t):
+            Ht, St = H.copy(), S.copy()
+            Ht[9, :9] = Ht[:9, 9] = H[9, :9] + t * dh[0]
+            St[9, :9] = St[:9, 9] = S[9, :9] + t * ds[0]
+            Ht[9, 9], St[9, 9] = H[9, 9] + t * dh_nn[0], S[9, 9] + t * ds_nn[0]
+            return scipy.linalg.eigh(Ht, St, eigvals_only=True)[root]
+
+        assert g[0] == pytest.approx((moved(1e-5) - moved(-1e-5)) / 2e-5, rel=1e-6, abs=1e-10)  # FD rounding
+    whole = eigen.solve(H, S)
+    without = eigen.root_without_each(whole.energies, whole.vectors, root)
+    for i in range(10):
+        keep = np.arange(10) != i
+        assert without[i] == pytest.approx(scipy.linalg.eigh(H[np.ix_(keep, keep)], S[np.ix_(keep, keep)],
+                                                             eigvals_only=True)[root], rel=1e-12)
+    assert eigen.root_with_block(sub.energies[:root], sub.vectors[:, :root], H[n:, :n], S[n:, :n], H[n:, n:],
+                                 S[n:, n:], root=root)[0] == np.inf  # the basis does not hold the root
+
+
 def test_rows_from_core_agree_with_matrices(problem):
     _, basis, rep, m = problem
     rows, diag = rep.rows(basis.subset([3, 4]), basis)
@@ -124,7 +168,7 @@ def test_duplicate_function_is_handled_without_inverse(problem):
     # and the update refuses the duplicate as linearly dependent
     base = eigen.solve(m["T_ti"] + m["V"], m["S"])
     H, S = md["T_ti"] + md["V"], md["S"]
-    assert eigen.lowest_with_added(base.energies, base.vectors, H[-1, :-1], S[-1, :-1], H[-1, -1], S[-1, -1]) == np.inf
+    assert eigen.root_with_added(base.energies, base.vectors, H[-1, :-1], S[-1, :-1], H[-1, -1], S[-1, -1]) == np.inf
 
 
 def test_indefinite_overlap_is_refused():

@@ -262,7 +262,7 @@ def test_corrupted_checkpoints_on_resume(checkpoints, tmp_path, capsys, data):
     assert_clean(rc, out, err)
 
 
-TOML_KEYS = {"system": ["particles"], "state": ["N", "parity", "spin", "threshold"],
+TOML_KEYS = {"system": ["particles"], "state": ["N", "parity", "spin", "threshold", "root", "roots", "weights"],
              "basis": ["type", "size", "c_A", "K_max"],
              "optimiser": sorted(s.key.partition(" ")[2] for s in SETTINGS.values() if s.key.startswith("[optimiser]"))}
 
@@ -307,7 +307,8 @@ def test_optimiser_arguments(name, value):
 @FUZZ
 @given(particles=st.lists(st.sampled_from(["p", "e", "e+", "alpha", "mu"]) | st.dictionaries(
     st.sampled_from(["name", "mass", "charge", "spin", "x"]), SCALARS, max_size=4), max_size=4),
-    state=st.dictionaries(st.sampled_from(["N", "parity", "spin", "threshold", "L"]), JSON, max_size=3))
+    state=st.dictionaries(st.sampled_from(["N", "parity", "spin", "threshold", "root", "roots", "weights", "L"]), JSON,
+                          max_size=3))
 def test_system_arguments(particles, state):
     try:
         system = prebo.System(particles, **state)
@@ -315,6 +316,9 @@ def test_system_arguments(particles, state):
         return
     assert all(np.isfinite([p.mass, p.charge]).all() and p.mass > 0 for p in system.particles)
     assert system.state.threshold is None or np.isfinite(system.state.threshold)
+    roots, weights = system.state.levels
+    assert list(roots) == sorted(set(roots)) and roots[0] >= 0 and len(weights) == len(roots)
+    assert all(np.isfinite(w) and w > 0 for w in weights)
 
 
 # --- real processes ---------------------------------------------------------------------

@@ -131,7 +131,7 @@ def test_each_cycle_grows_past_the_size_and_prunes_back_first():
 
 
 def test_pruning_removes_the_function_that_costs_least():
-    """eigen.lowest_without_each against the basis without each function solved afresh, and a
+    """eigen.root_without_each against the basis without each function solved afresh, and a
     prune step removes the cheapest, then refines the function that overlapped it most: only that
     one moves, and the energy falls below that of the basis without the cheapest."""
     from prebo import eigen
@@ -141,7 +141,7 @@ def test_pruning_removes_the_function_that_costs_least():
     from prebo.optimise.report import Reporter
     basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json").subset(np.arange(40))
     ex = Expansion(basis, laboratory(basis.system), 1e-13)
-    without = eigen.lowest_without_each(ex.eig.energies, ex.eig.vectors)
+    without = eigen.root_without_each(ex.eig.energies, ex.eig.vectors)
     fresh = np.array([ex.without(i).energies[0] for i in range(40)])
     assert np.all(without >= ex.energy) and np.allclose(without, fresh, rtol=1e-13, atol=0)
     cheapest = int(np.argmin(fresh))
@@ -446,8 +446,8 @@ def test_a_run_that_stops_above_its_lowest_state_returns_that_state_and_keeps_it
     from prebo import eigen
     from prebo.optimise import optimise, resume_from
 
-    without = eigen.lowest_without_each
-    monkeypatch.setattr(eigen, "lowest_without_each", lambda E, C: -without(E, C))
+    without = eigen.root_without_each
+    monkeypatch.setattr(eigen, "root_without_each", lambda E, C, root=0: -without(E, C, root))
     system = prebo.System(["p", "e"])
     basis = optimise(system, Optimiser(size=3, prune=2, cycles=1, trials=5, seed=3), out=tmp_path, progress=False)
     checkpoint = json.loads((tmp_path / "basis.json").read_text())

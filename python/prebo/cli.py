@@ -24,7 +24,7 @@ from .validation import path_name
 RESULT = "result.json"
 
 
-def _result(basis, where, threshold: float, coordinates: str = "lab", operators=(), roots: int = 1) -> dict:
+def _result(basis, where, threshold: float, coordinates: str = "lab", operators=(), roots: int | None = None) -> dict:
     """The JSON-ready result of `basis` (overlap directions below `threshold` dropped, with the
     expectation values of `operators` and the lowest `roots` levels; results.evaluate);
     NonFiniteError naming the keys that are not finite numbers, and every error prefixed with
@@ -97,13 +97,15 @@ def _print_levels(r: dict) -> None:
 
     from .results import HARTREE_CM
 
-    levels = Table("root", "energy (Eh)", "σ (Eh)", "η_TI", "E − E_0 (cm⁻¹)", "bound", title="levels",
-                   caption="bound: below the lowest dissociation threshold by more than σ")
+    levels = Table("root", "energy (Eh)", "σ (Eh)", "η_TI", "E − E_0 (cm⁻¹)", "bound", "optimised", title="levels",
+                   caption="bound: below the lowest dissociation threshold by more than σ; optimised: a level the "
+                           "basis was optimised for")
     gaps = {(d["lower"], d["upper"]): d for d in r["transitions"]}
+    targets = r.get("targets", [0])
     for v in r["levels"]:
         gap = gaps[(0, v["root"])]["cm-1"] if v["root"] else 0.0
         levels.add_row(str(v["root"]), f"{v['energy']:.12f}", f"{v['energy_uncertainty']:.1e}", f"{v['virial']:.1e}",
-                       f"{gap:.6f}", "yes" if v["bound"] else "no")
+                       f"{gap:.6f}", "yes" if v["bound"] else "no", "yes" if v["root"] in targets else "")
     Console().print(levels)
     steps = Table("transition", "ΔE (Eh)", "ΔE (cm⁻¹)", "uncertainty (cm⁻¹)", title="between neighbouring levels")
     for v in r["levels"][1:]:
@@ -169,7 +171,10 @@ def cmd_run(args) -> int:
             raise StalledError(f"{source}: {exc}") from exc
         title = title or basis.system.label()
         where = out / LOWEST if (out / LOWEST).exists() else out / CHECKPOINT  # the file of the state returned
-        r = _result(basis, where, opts.threshold)  # the energy the run optimised
+        levels = basis.convergence.get("levels")  # where the targeted levels stand, if followed
+        r = _result(basis, where, opts.threshold, roots=None if levels is None else max(levels) + 1)
+        if levels is not None:
+            r["targets"] = levels
         r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
               "convergence": basis.convergence}
         write_json_atomic(out / RESULT, r)
@@ -182,6 +187,11 @@ def cmd_run(args) -> int:
     if basis.convergence["stalled"]:
         print(f"prebo: warning: growth stalled short of the basis size: {basis.convergence['stalled']['why']}",
               file=sys.stderr)
+    if basis.convergence.get("followed"):
+        seconds, before, after = basis.convergence["followed"][-1]
+        print(f"prebo: note: the targeted levels were followed by overlap to other roots "
+              f"{len(basis.convergence['followed'])} time(s), last from roots {before} to {after} after {seconds:.0f} s; "
+              f"they end at roots {basis.convergence['levels']} (convergence.followed in {RESULT})", file=sys.stderr)
     return 0
 
 
@@ -385,9 +395,10 @@ def parser() -> argparse.ArgumentParser:
                     help="relative overlap eigenvalue below which directions are dropped (default: the "
                          "threshold of the run that wrote the file; else 4 x 2^-53, every direction the "
                          "elements resolve, as ecgpack solves its files)")
-    en.add_argument("--roots", type=positive_integer, default=1, metavar="K",
+    en.add_argument("--roots", type=positive_integer, default=None, metavar="K",
                     help="report the lowest K levels of the state's symmetry (each an upper bound to its exact "
-                         "level) and the transition energies between them, in Eh and cm⁻¹")
+                         "level) and the transition energies between them, in Eh and cm⁻¹ (default: up to the "
+                         "highest root the basis was optimised for)")
     en.add_argument("--json", action="store_true", help="print one JSON object")
     en.set_defaults(func=cmd_energy)
     im = sub.add_parser("import", help="convert an ecgpack / ATOM-MOL-nonBO FILE.inout.txt to basis.json")

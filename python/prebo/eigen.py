@@ -9,13 +9,15 @@ with S-orthonormal eigenvectors C and eigenvalues E_k of the current basis and a
 function n with rows h, s and diagonal h_nn, s_nn, let d = C^T s, b = C^T h. The part
 of n orthogonal to the basis has norm^2 ν = s_nn - d·d, couplings γ_k = (b_k - E_k d_k)/√ν
 and energy h' = (h_nn - 2 b·d + Σ E_k d_k^2)/ν. The new lowest eigenvalue is the root
-below E_0 of f(x) = h' - x - Σ γ_k^2 / (E_k - x), strictly decreasing there.
+below E_0 of f(x) = h' - x - Σ γ_k^2 / (E_k - x), strictly decreasing there; root r of the grown
+basis is its root in (E_{r-1}, E_r), the roots interlacing (Hylleraas–Undheim–MacDonald), which is
+how the objective of several levels (optimise/objective.py) evaluates each (`root_*` functions).
 
 Gradient (Hellmann–Feynman for the augmented problem): at the root e the eigenvector is
 c = (C a, 1) with a_k = -(b_k - e d_k)/(E_k - e); when only the new function's parameters move,
 de = [2 (C a)·(dh - e ds) + dh_nn - e ds_nn] / (|a|^2 + 2 a·d + s_nn).
 
-Block update (a few functions at once, `lowest_with_block`): with rows h, s (k x N) of k new
+Block update (a few functions at once, `lowest_with_block`; higher roots `root_with_block`): with rows h, s (k x N) of k new
 functions and their k x k blocks H_ff, S_ff, the Schur complement of the eigenbasis in H - x S is
 M(x) = H_ff - x S_ff - G diag(1/(E - x)) G^T, G = (h - x s) C. Below E_0 the block E - x is
 positive, so by Sylvester's law of inertia the number of eigenvalues below x is the number of
@@ -218,16 +220,18 @@ def uncertainty(eig: Eigen, S: np.ndarray, *terms: np.ndarray, threshold: float 
     return float(np.max(np.abs(np.array(energies) - eig.energies[root])))
 
 
-def lowest_with_added(E, C, h, s, h_nn, s_nn, min_norm: float = 1e-10) -> float:
-    """Lowest eigenvalue after adding one function (secular equation, in the Rust core); +inf if
-    it is linearly dependent on the basis (orthogonal remainder below `min_norm` of its norm)."""
-    return float(lowest_with_added_many(E, C, np.atleast_2d(h), np.atleast_2d(s), [h_nn], [s_nn], min_norm)[0])
+def root_with_added(E, C, h, s, h_nn, s_nn, min_norm: float = 1e-10, root: int = 0) -> float:
+    """Eigenvalue `root` (0: the lowest) after adding one function (secular equation, in the Rust
+    core); +inf if it is linearly dependent on the basis (orthogonal remainder below `min_norm` of
+    its norm)."""
+    return float(root_with_added_many(E, C, np.atleast_2d(h), np.atleast_2d(s), [h_nn], [s_nn], min_norm, root)[0])
 
 
-def lowest_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float = 1e-10):
-    """`lowest_with_added` and its gradient with respect to parameters of the new function, given the
-    derivatives dh, ds (P x nb) and dh_nn, ds_nn (P) of its rows and diagonal (module docstring)."""
-    e = lowest_with_added(E, C, h, s, h_nn, s_nn, min_norm)
+def root_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float = 1e-10, root: int = 0):
+    """`root_with_added` and its gradient with respect to parameters of the new function, given the
+    derivatives dh, ds (P x nb) and dh_nn, ds_nn (P) of its rows and diagonal (module docstring;
+    the eigenvector (C a, 1) holds at any root e of the augmented problem that is not an E_k)."""
+    e = root_with_added(E, C, h, s, h_nn, s_nn, min_norm, root)
     if not np.isfinite(e):
         return e, np.zeros(len(dh_nn))
     if len(E) == 0:
@@ -237,6 +241,56 @@ def lowest_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min
     c_old = C @ a
     norm2 = a @ a + 2.0 * a @ d + s_nn
     return e, (2.0 * (dh - e * ds) @ c_old + dh_nn - e * ds_nn) / norm2
+
+
+def root_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: float | None = None, root: int = 0):
+    """Eigenvalue `root` after adding k functions at once, with its eigenvector (module docstring,
+    block update): the lowest by `lowest_with_block`; a higher one by bisection on the inertia
+    count, the number of eigenvalues below x being #{E_j < x} + the number of negative eigenvalues
+    of M(x) (Sylvester's law of inertia for x not an E_j), to adjacent doubles, its eigenvector
+    from the eigenvalue of M nearest zero. By interlacing it lies at or below E_root: (inf, None,
+    None, None) where it does not lie below (the block lowers nothing) or the block is linearly
+    dependent on the basis (as `lowest_with_block`)."""
+    if root == 0:
+        return lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm, near)
+    if len(E) <= root:
+        return np.inf, None, None, None
+    D, B = s @ C, h @ C
+    scale = 1.0 / np.sqrt(np.diag(S_ff))
+    orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
+    if not np.all(np.isfinite(orthogonal)) or np.linalg.eigvalsh(orthogonal)[0] < min_norm:
+        return np.inf, None, None, None
+
+    def schur(x):
+        G = B - x * D
+        return H_ff - x * S_ff - (G / (E - x)) @ G.T, G
+
+    def count(x):  # the number of eigenvalues of the augmented pencil below x
+        if np.any(E == x):
+            x = np.nextafter(x, -np.inf)
+        return int(np.searchsorted(E, x)) + int((np.linalg.eigvalsh(schur(x)[0]) < 0).sum())
+
+    hi, lo = np.nextafter(E[root], -np.inf), E[0] - 1.0
+    for _ in range(64):  # a lower bound: below every eigenvalue (M(lo) positive definite, lo < E_0)
+        if count(lo) == 0:
+            break
+        lo -= 2.0 * abs(lo) + 1.0
+    else:
+        return np.inf, None, None, None
+    if count(hi) <= root:
+        return np.inf, None, None, None
+    for _ in range(2100):  # bisection to adjacent doubles: count(lo) <= root < count(hi)
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        lo, hi = (lo, mid) if count(mid) > root else (mid, hi)
+    e = hi
+    M, G = schur(e)
+    w, V = np.linalg.eigh(M)
+    beta = V[:, int(np.argmin(np.abs(w)))]
+    a = -(beta @ G) / (E - e)
+    norm2 = a @ a + 2.0 * a @ (D.T @ beta) + beta @ S_ff @ beta
+    return float(e), a, beta, float(norm2)
 
 
 def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: float | None = None):
@@ -305,17 +359,18 @@ def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: flo
     return float(e), a, beta, float(norm2)
 
 
-def lowest_without_each(E: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """The lowest eigenvalue of the basis without function i, for every i, from the eigen-solution
-    (E, C) of the whole basis: the eigenproblem restricted to c_i = 0 is, in the eigenbasis, the
-    diagonal E restricted to the plane orthogonal to r = C[i] (Golub, SIAM Rev. 15, 318 (1973)),
-    whose lowest eigenvalue is the root of Σ_k r_k² / (E_k − μ) = 0 in [E_0, E_1), increasing
-    there; found by bisection, all i at once (O(N_b^2) per step). Without a second eigenvalue,
-    the basis without i has no eigenvalue below E_0 + 1: +inf."""
-    if len(E) < 2:
+def root_without_each(E: np.ndarray, C: np.ndarray, root: int = 0) -> np.ndarray:
+    """Eigenvalue `root` (0: the lowest) of the basis without function i, for every i, from the
+    eigen-solution (E, C) of the whole basis: the eigenproblem restricted to c_i = 0 is, in the
+    eigenbasis, the diagonal E restricted to the plane orthogonal to r = C[i] (Golub, SIAM Rev.
+    15, 318 (1973)), whose eigenvalue `root` is the root of Σ_k r_k² / (E_k − μ) = 0 in
+    [E_root, E_root+1), increasing there (interlacing); found by bisection, all i at once
+    (O(N_b^2) per step). Without eigenvalue root + 1, the basis without i has no eigenvalue
+    `root`: +inf."""
+    if len(E) < root + 2:
         return np.full(len(C), np.inf)
     w = C * C
-    lo, hi = np.full(len(C), E[0]), np.full(len(C), E[1])
+    lo, hi = np.full(len(C), E[root]), np.full(len(C), E[root + 1])
     with np.errstate(divide="ignore", invalid="ignore"):  # mid reaches E_0 only within an ulp of the root
         for _ in range(64):
             mid = 0.5 * (lo + hi)
@@ -324,8 +379,8 @@ def lowest_without_each(E: np.ndarray, C: np.ndarray) -> np.ndarray:
     return hi
 
 
-def lowest_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10, root: int = 0) -> np.ndarray:
-    """`lowest_with_added` for k trials at once: rows H, S (k x nb), diagonals h_nn, s_nn (k); with
+def root_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10, root: int = 0) -> np.ndarray:
+    """`root_with_added` for k trials at once: rows H, S (k x nb), diagonals h_nn, s_nn (k); with
     `root` > 0, eigenvalue `root` instead of the lowest (module docstring: the roots interlace)."""
     c = np.ascontiguousarray
     E = c(E, dtype=float)

@@ -28,7 +28,9 @@ root k = 0..K-1 (root, energy, energy_uncertainty, virial, kinetic, potential, b
 binding_energy, and n2 and expectation where the ground state has them), each eigenvalue an upper
 bound to its exact level (Hylleraas–Undheim–MacDonald), and `transitions`, one dict per pair of
 levels i < j: lower, upper, Eh (E_j − E_i), cm-1 (× HARTREE_CM) and uncertainty (the levels'
-uncertainties added in quadrature, Eh). The top-level keys stay those of root 0.
+uncertainties added in quadrature, Eh). The top-level keys stay those of root 0. A basis optimised
+for other levels than the lowest (`[state] root`/`roots`) reports the levels up to the highest it
+targets by default, and their indices as `targets`.
 
 `bound` is False when the energy is not below the threshold: the basis describes fragments and free
 particles, not a bound state. The virial coefficient cannot tell: a basis scaled to its variational
@@ -56,7 +58,7 @@ HARTREE_CM = 219474.6313632
 
 
 def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.THRESHOLD, operators=(),
-             roots: int = 1) -> dict:
+             roots: int | None = None) -> dict:
     """The energies of `basis`'s lowest state, and of its lowest `roots` levels.
 
     Parameters: `basis`, a non-empty `Basis`; `coordinates`, "lab" (LFCC with the CM kinetic
@@ -65,7 +67,8 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     `threshold`, the relative overlap eigenvalue below which directions are dropped
     (`eigen.solve`); `operators`, names of registered operators (`expectation.OPERATORS`, e.g.
     "r2") whose expectation values to add; `roots`, how many of the lowest levels to report
-    (`levels` and `transitions` when more than one).
+    (`levels` and `transitions` when more than one; default: up to the highest root the basis's
+    state targets, `State.levels`, whose indices are then given as `targets`).
 
     Returns a dict with the keys of the module docstring — energy, energy_uncertainty,
     energy_lab, kinetic, potential, threshold and binding_energy in Eh; bound a bool; virial,
@@ -85,8 +88,10 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     operators = (operators,) if isinstance(operators, str) else tuple(operators)
     for name in operators:
         operator(name)
-    roots = checked(Integer(1, len(basis)), roots, "evaluate: roots", f"levels of a basis of {len(basis)} functions")
     basis = replace(basis)  # built again: the constructor's checks against the system it has now
+    targets = basis.system.state.levels[0]
+    roots = max(targets) + 1 if roots is None else roots
+    roots = checked(Integer(1, len(basis)), roots, "evaluate: roots", f"levels of a basis of {len(basis)} functions")
     basis.validate()  # a Basis built in Python: symmetric, positive definite, CM-separable A
     system = basis.system
     if coordinates == "lab":
@@ -113,6 +118,8 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     if energy_lab is None:
         energy_lab = ground["energy"] + 1.5 * c_A / system.m_total
     extra = {}
+    if targets != (0,):
+        extra["targets"] = list(targets)
     if roots > 1:
         extra["levels"] = levels
         extra["transitions"] = [transition(a, b) for i, a in enumerate(levels) for b in levels[i + 1:]]

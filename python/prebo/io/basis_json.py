@@ -40,7 +40,8 @@ CONVENTIONS = {
 }
 #: the keys of a basis file: the basis, then the energy, the settings and a run's state (prebo.optimise.resume)
 KEYS = ("format", "version", "conventions", "system", "symmetry", "basis_type", "functions", "coefficients",
-        "energy", "optimiser", "progress", "rng", "history", "elapsed", "schedule", "stopped", "momentum")
+        "energy", "optimiser", "progress", "rng", "history", "elapsed", "schedule", "stopped", "momentum", "levels",
+        "followed")
 #: every function's arrays beside its family's extras (name -> shape, "n": particles); and a channel
 COMMON = {"A": ("n", "n"), "c_A": ()}
 #: bytes allowed per function (twice a checkpoint's two copies of a function of 8 particles) and

@@ -1,7 +1,8 @@
 """TOML input files; each table mirrors a Python object:
 
     [system]     particles = ["p", "e", {name = "x", mass = 3.0, charge = 1, spin = 0.5}]   -> System
-    [state]      N = 0, parity = 1, spin = {e = 0}, threshold = -7.28                       -> State
+    [state]      N = 0, parity = 1, spin = {e = 0}, threshold = -7.28, root = 1 (or roots = 4
+                 or roots = [0, 2], weights = [1, 0.5])                                       -> State
     [basis]      type = "pecg", size = 100, c_A = 1.0, K_max = 20     -> Optimiser.kind (a prebo.basis.family), .size, .c_A, .K_max
     [optimiser]  trials = 20, sweeps = 1, seed = 1, channels = "pairs", length_range = [0.01, 15]
 
@@ -64,7 +65,7 @@ def from_dict(d: dict) -> Job:
         raise InputError(f"unknown top-level keys or tables {sorted(unknown)} (allowed: title, [system], [state], "
                          "[basis], [optimiser])")
     system_t = _table(d, "system", {"particles"})
-    state_t = _table(d, "state", {"N", "parity", "spin", "threshold"})
+    state_t = _table(d, "state", {"N", "parity", "spin", "threshold", "root", "roots", "weights"})
     basis_t = _table(d, "basis", set(BASIS_KEYS))
     opt_t = _table(d, "optimiser", OPTIMISER_KEYS)
     if "particles" not in system_t:

@@ -1,7 +1,7 @@
 """Stochastic basis optimisation, in the order a run uses it:
 
 settings (Optimiser, SETTINGS) → sampler (random functions) → expansion (the basis with its
-matrices and eigen-solution; objective: the root the methods lower) → methods (grow, replace,
+matrices and eigen-solution; objective: the roots the methods lower, and their following) → methods (grow, replace,
 refine, prune, polish, momentum: small configs, each one unit of work) run by the one driver
 (`optimise`) where the schedule says (schedule: the interface; fixed and adaptive: its two
 kinds; cursor: the next unit of work) → history and convergence (the report), checkpoint (the

@@ -35,9 +35,10 @@ from .expansion import Expansion
 from .history import Step
 from .lowest import Lowest
 from .methods import Run, methods
+from .objective import Levels
 from .momentum import Momentum
 from .report import Reporter
-from .resume import load_checkpoint, resumed
+from .resume import followed_roots, load_checkpoint, resumed
 from .sampler import Sampler
 from .schedule import schedule_of
 from .settings import Optimiser
@@ -85,14 +86,22 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         raise OutputError(f"optimise: out = {str(out)!r} holds a run's checkpoint ({held.name}): continue that run "
                           "with resume_from(out) (from prebo.optimise import resume_from), or give another folder")
     opts = resolved(opts, system)
+    targets, weights = system.state.levels
+    if max(targets) >= opts.size:
+        raise InputError(f"state: root {max(targets)} asked for, but a basis of size = {opts.size} holds roots "
+                         f"0..{opts.size - 1} only")
     rng = np.random.default_rng(opts.seed)
     sampler = Sampler(system, opts, rng)
     rep = laboratory(system)
+    threshold = lowest_threshold(system).energy
+    objective, followed = Levels(targets, weights, threshold=threshold), []
     if resume is None:
         basis, history, elapsed, schedule, stopped = Basis.empty(system, opts.kind), [], 0.0, schedule_of(opts), None
         cursor = schedule.first()
     else:
         basis, cursor, history, elapsed, schedule, stopped = resumed(resume, opts, rng, "checkpoint")
+        roots, followed = followed_roots(resume, targets, "checkpoint")
+        objective = objective.to(roots)
     if out is not None:
         remove_stale_temporaries(Path(out) / CHECKPOINT)
         remove_stale_temporaries(Path(out) / LOWEST)
@@ -102,13 +111,12 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         """Seconds of optimisation so far, over all segments of a resumed run."""
         return round(elapsed + time.perf_counter() - t_start, 1)
 
-    def expansion(b: Basis) -> Expansion:
+    def expansion(b: Basis, objective: Levels) -> Expansion:
         """The expansion of basis `b` with the run's representation and linear-dependence settings."""
-        return Expansion(b, rep, opts.threshold, opts.min_norm, opts.max_overlap)
+        return Expansion(b, rep, opts.threshold, opts.min_norm, opts.max_overlap, objective)
 
-    ex = expansion(basis)
+    ex = expansion(basis, objective)
     cursor, stopped = schedule.resume(cursor, stopped, len(ex.basis), ex.energy, elapsed)
-    threshold = lowest_threshold(system).energy
     lowest = Lowest(basis, opts.size, out, {"optimiser": opts.to_dict()}, resumed=resume is not None)
     lowest.see(ex)
     sampler.learn(ex.basis)
@@ -123,7 +131,8 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
             ex.basis.save(Path(out) / CHECKPOINT, {
                 "energy": energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
                 "rng": rng.bit_generator.state, "history": history, "elapsed": wall(),
-                "schedule": schedule.to_dict(), "stopped": stopped, "momentum": run.momentum.to_dict()})
+                "schedule": schedule.to_dict(), "stopped": stopped, "momentum": run.momentum.to_dict()}
+                | ({} if ex.objective.lowest else {"levels": list(ex.objective.roots), "followed": followed}))
 
     with run.report, eigen.lapack_threads(opts.size):
         while cursor.phase != "done":
@@ -138,6 +147,10 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                 if not schedule.stall(len(ex.basis)):
                     raise
                 run.stalled = 0
+            if ex.followed is not None:  # a targeted level moved to another root (objective.py, following)
+                followed.append([wall(), *map(list, ex.followed)])
+                run.report.followed(*ex.followed)
+                ex.followed = None
             if ex.energy < old:
                 history.append(Step(len(ex.basis), ex.energy, cursor.phase, wall()))
                 run.report.step(ex, old, cursor)
@@ -145,10 +158,11 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
             cursor = schedule.advance(cursor, len(ex.basis), ex.energy, wall())
             if cursor.phase == "done":
                 stopped = schedule.stopped
-            fresh = schedule.restart(phase, len(ex.basis), ex.energy, threshold - ex.sigma)
+            ground = ex.eig.energies[0] if ex.eig is not None else np.inf  # the lowest root: bound or not
+            fresh = schedule.restart(phase, len(ex.basis), ground, threshold - ex.sigma)
             if fresh is not None:  # a fresh start (adaptive.py)
                 schedule, cursor, stopped = fresh, fresh.first(), None
-                ex = run.expansion = expansion(Basis.empty(system, opts.kind))
+                ex = run.expansion = expansion(Basis.empty(system, opts.kind), Levels(targets, weights, threshold=threshold))
                 run.momentum = Momentum()
                 sampler.learn(ex.basis)
             lowest.see(ex)  # first: a run killed between the two writes keeps its lowest state
@@ -159,6 +173,8 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         best.coefficients = ex.coefficients
     best.convergence = convergence(history, opts, stopped, wall(), schedule.stalled, schedule.advantage(len(ex.basis)),
                                    ex.eig.overlap_condition, ex.sigma)
+    if not ex.objective.lowest:
+        best.convergence |= {"levels": list(ex.objective.roots), "followed": followed}
     return best
 
 

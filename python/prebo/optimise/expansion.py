@@ -14,7 +14,7 @@ import numpy as np
 from .. import eigen
 from ..basis import Basis
 from ..errors import LinearDependenceError
-from .objective import LowestRoot
+from .objective import Levels
 
 
 #: how many times what a change adds to the uncertainty it must gain (`Expansion.keep_if_lower`)
@@ -23,33 +23,60 @@ SIGMA_PRICE = 100.0
 
 class Expansion:
     """The basis `basis` with its matrices `m` (S, T, T_ti, V; hartree), eigen-solution `eig`, the
-    `energy` (hartree) of the `objective` (objective.py: the lowest root) and `sigma`, the energy's
-    numerical uncertainty (module docstring; inf beyond eigen.FIRST_ORDER, where no change is
-    kept: the optimiser does not take the basis where its first-order uncertainty fails).
+    `energy` (hartree) of the `objective` (objective.py: the lowest root, or a weighted sum of
+    targeted levels) and `sigma`, the energy's numerical uncertainty (module docstring; inf beyond
+    eigen.FIRST_ORDER, where no change is kept: the optimiser does not take the basis where its
+    first-order uncertainty fails). After a change of several functions at once (`put_group`,
+    `replace_basis`) the targeted levels are followed by overlap (Levels.follow; one function
+    added, replaced or removed never moves a level up and lowers it, objective.py); `followed`
+    holds the (before, after) root indices of the last change that moved a level to another root,
+    until the driver takes it.
 
     rep: the integrals' Representation (integrals.laboratory); threshold: eigen.solve's relative
     overlap eigenvalue below which directions are dropped; min_norm, max_overlap: the
     linear-dependence guard of `candidates` (Optimiser settings of the same names)."""
 
     def __init__(self, basis: Basis, rep, threshold: float, min_norm: float = 1e-8, max_overlap: float = 0.99,
-                 objective: LowestRoot = LowestRoot()):
+                 objective: Levels = Levels()):
         self.basis, self.rep, self.threshold = basis, rep, threshold
         self.min_norm, self.max_overlap, self.objective = min_norm, max_overlap, objective
+        self.followed = None
         if len(basis):
             self.m = rep.matrices(basis)
         else:
             self.m = {k: np.zeros((0, 0)) for k in ("S", "T", "T_ti", "V")}
         self.solve()
 
-    def solve(self) -> None:
-        """Solve the eigenproblem of the current matrices (energy inf for no functions)."""
+    def solve(self, before: tuple | None = None) -> None:
+        """Solve the eigenproblem of the current matrices (energy inf for no functions); `before`:
+        the targeted levels' eigenvectors before a change, in the changed basis's functions, and
+        their energies, to follow them (`prior`, Levels.follow)."""
         if len(self.basis) == 0:
             self.eig, self.energy, self.sigma = None, np.inf, 0.0
             return
-        self.eig = self.objective.solve(self.m["T_ti"] + self.m["V"], self.m["S"], self.threshold)
+        H = self.m["T_ti"] + self.m["V"]
+        self.eig = self.objective.solve(H, self.m["S"], self.threshold)
+        if before is not None and self.objective.holds(self.eig):
+            roots = self.objective.follow(before, self.m["S"], self.eig)
+            if roots != self.objective.roots:
+                self.followed = (self.objective.roots, roots)
+                self.objective = self.objective.to(roots)
+                self.eig = self.objective.solve(H, self.m["S"], self.threshold)
         self.energy = self.objective.value(self.eig)
-        self.sigma = (eigen.energy_uncertainty(self.coefficients, self.energy, self.m["S"], self.m["T_ti"],
-                                               self.m["V"]) if eigen.first_order(self.eig) else np.inf)
+        self.sigma = self.objective.uncertainty(self.eig, self.m["S"], self.m["T_ti"], self.m["V"])
+
+    @staticmethod
+    def prior(eig, objective: Levels, mapping: np.ndarray) -> tuple | None:
+        """The eigenvectors (nb x levels) of `objective`'s levels in the solution `eig` before a
+        change, in the functions of the changed basis, whose function j was function mapping[j]
+        (-1: new), and their energies, to follow them (`solve`); None where there is nothing to
+        follow (the lowest root alone, or a basis not holding every level)."""
+        if objective.lowest or eig is None or not objective.holds(eig):
+            return None
+        V = eig.vectors[:, list(objective.roots)]
+        out = np.zeros((len(mapping), V.shape[1]))
+        out[mapping >= 0] = V[mapping[mapping >= 0]]
+        return out, eig.energies[list(objective.roots)]
 
     @property
     def coefficients(self) -> np.ndarray:
@@ -57,12 +84,11 @@ class Expansion:
         return self.objective.vector(self.eig)
 
     def sound(self) -> bool:
-        """Whether the state's internal kinetic energy c^T T_ti c is positive beyond the
+        """Whether every targeted level's internal kinetic energy c^T T_ti c is positive beyond the
         energy's uncertainty, as that of any wave function is: rounding that dominates an
         ill-conditioned basis's elements (integrals.py, cancellation) can make it negative, and
         its energy then means nothing (two electrons "bound" at -0.13 Eh)."""
-        c = self.coefficients
-        return bool(c @ self.m["T_ti"] @ c > self.sigma)
+        return all(lv.c @ self.m["T_ti"] @ lv.c > self.sigma for lv in self.objective.levels(self.eig))
 
     def gains(self, energy: float) -> bool:
         """Whether `energy` lies below the current energy by more than its uncertainty."""
@@ -71,7 +97,11 @@ class Expansion:
     def snapshot(self) -> tuple:
         """The state to restore if a change does not pay (`keep_if_lower`)."""
         return (self.basis.subset(slice(None)), {k: v.copy() for k, v in self.m.items()}, self.eig, self.energy,
-                self.sigma)
+                self.sigma, self.objective, self.followed)
+
+    def restore(self, before: tuple) -> None:
+        """Go back to the state `before` (`snapshot`)."""
+        self.basis, self.m, self.eig, self.energy, self.sigma, self.objective, self.followed = before
 
     def keep_if_lower(self, before: tuple) -> bool:
         """After a change: keep it if the energy fell by more than the uncertainty before and after
@@ -83,17 +113,19 @@ class Expansion:
         if self.sound() and (before[3] == np.inf or (gain > max(self.sigma, before[4])
                                                     and gain > SIGMA_PRICE * (self.sigma - before[4]))):
             return True
-        self.basis, self.m, self.eig, self.energy, self.sigma = before
+        self.restore(before)
         return False
 
-    def solve_and_keep_if_lower(self, before: tuple) -> bool:
+    def solve_and_keep_if_lower(self, before: tuple, mapping: np.ndarray | None = None) -> bool:
         """Solve after a change and `keep_if_lower`; a change whose lowest root the extended-precision
         refinement cannot resolve (eigen.refine: LinearDependenceError, at an overlap condition
-        where double precision runs out) is undone like one that does not gain."""
+        where double precision runs out) is undone like one that does not gain. `mapping`: function
+        j of the changed basis was function mapping[j] before it (-1: new; `prior`), for a change of
+        several functions at once, whose levels are followed (objective.py; None: not followed)."""
         try:
-            self.solve()
+            self.solve(None if mapping is None else self.prior(before[2], before[5], mapping))
         except LinearDependenceError:
-            self.basis, self.m, self.eig, self.energy, self.sigma = before
+            self.restore(before)
             return False
         return self.keep_if_lower(before)
 
@@ -102,7 +134,7 @@ class Expansion:
         before = self.snapshot()
         self.basis = basis
         self.m = self.rep.matrices(basis)
-        return self.solve_and_keep_if_lower(before)
+        return self.solve_and_keep_if_lower(before, np.arange(len(basis)))  # each function moved a little
 
     def without(self, i):
         """The eigen-solution of the basis without function i, or without the functions of the
@@ -180,7 +212,7 @@ class Expansion:
         for i, f in zip(idx, fs):
             rows, diag = self.rep.rows(f, self.basis, i)
             self._place(i, f, {k: v[0] for k, v in rows.items()}, diag[0])
-        return self.solve_and_keep_if_lower(before)
+        return self.solve_and_keep_if_lower(before, moved(len(self.basis), idx))
 
     def _place(self, i: int, f: Basis, row: dict | None, d) -> None:
         """Append (i == len) or replace function i by `f`, the matrices patched from its row and
@@ -206,3 +238,11 @@ class Expansion:
                     r[i] = values[k]
                     self.m[k][i, :] = r
                     self.m[k][:, i] = r
+
+
+def moved(nb: int, new: list[int]) -> np.ndarray:
+    """The mapping of a changed basis of `nb` functions to the basis before it (Expansion.prior):
+    the same index, -1 for the functions `new` (replaced or appended)."""
+    mapping = np.arange(nb)
+    mapping[list(new)] = -1
+    return mapping

@@ -5,7 +5,7 @@ phase of the cursor names the method (`methods`).
 - `Grow`: competitive selection (Suzuki & Varga, Lect. Notes Phys. m54, ch. 4, the stochastic
   variational method): `trials` random functions, each one's row against the basis from the
   core (O(N_b) integrals) and the new lowest eigenvalue from the secular equation (O(N_b^2),
-  eigen.lowest_with_added_many); the best, if it lowers the energy beyond its uncertainty, is
+  eigen.root_with_added_many); the best, if it lowers the energy beyond its uncertainty, is
   appended — with a `newcomer` Minimiser, refined first.
 - `Replace` ("sweep"): one step of a replacement sweep: function i competes with `trials` replacements in the
   basis without it — its neighbours in the power K (Sampler.neighbours: K ± 1, K ± 2 with the
@@ -16,7 +16,7 @@ phase of the cursor names the method (`methods`).
 - `PruneStep` ("prune", fixed schedule): growth past the size (as `Grow`, each grown function then refined with the functions
   it overlaps most, so that it joins the basis before the removals are weighed; without that the
   cheapest to remove are the newcomers themselves), then the removal of the function whose
-  removal raises the energy least (eigen.lowest_without_each), one per step back to the size,
+  removal raises the energy least (eigen.root_without_each), one per step back to the size,
   the function that overlapped it most then refined with its partners to take over its part
   (H2 with 500 ECG-GVR functions at 1.2e-8 Eh above, 12 grown and removed: the net gain 6.3–9.5e-11
   Eh against −1.5e-11 … 7.7e-11 without; benchmarks/README, "Pruning that refines after each

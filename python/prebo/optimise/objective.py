@@ -1,50 +1,162 @@
-"""The objective: the quantity the optimisation methods lower, and the state it belongs to.
+"""The objective: the quantity the optimisation methods lower, and the levels it belongs to.
 
-It is the lowest eigenvalue E_0 of H c = E S c, an upper bound to the exact ground-state energy
-of the symmetry the basis is projected on (Hylleraas–Undheim–MacDonald), with its eigenvector
-c_0. Everything that reads the lowest root goes through `LowestRoot`: the solve that refines it
-(eigen.solve), the secular-equation updates for added or removed functions and their gradients
-(eigen module docstring), so that another root, or a weighted sum of roots, is one class here.
+It is the weighted sum Σ_k w_k E_k of the targeted roots k of H c = E S c — the lowest root E_0
+alone by default — each an upper bound to the exact level k of the symmetry the basis is
+projected on (Hylleraas–Undheim–MacDonald: J. K. L. MacDonald, Phys. Rev. 43, 830 (1933)), so
+the sum of positive weights is an upper bound to the same sum of exact levels. Everything that
+reads the roots goes through `Levels`: the solve that refines them (eigen.solve), the
+secular-equation updates for added or removed functions and their gradients (eigen module
+docstring), each evaluated per targeted root and summed with its weight.
+
+Following (`Levels.follow`): after a change of the basis, each targeted level is the root whose
+eigenvector overlaps most with the level's eigenvector before the change, so an avoided crossing
+or a new low root (a level the basis did not hold before) does not silently swap the target: the
+level keeps its identity and moves to another root index, and the run says so (driver.py). A
+level never moves below the index it targets: root r of the basis is an upper bound to the exact
+level r, so E_r' with r' ≥ r is one too, while a level followed down to r' < r could fall below
+its exact level (a fake gain the variational principle forbids; He's 2¹S followed down to the
+ground state's root did). Only a bound level is followed, one below the lowest dissociation
+threshold: above it a root is a discretised continuum state whose identity means nothing (He's
+root 1 in the first functions of a run, followed up, locked growth at two functions). By
+interlacing, adding, replacing or removing one function never moves a level up and lowers it
+(E'_{r+1} ≥ E_r), so following there could only refuse the change by which growth brings a
+missing lower level in (H's root 1 stalled at three functions): levels are followed through
+changes of several functions at once (group refinements, joint steps, momentum moves;
+optimise/expansion.py), which can gain while a new root comes in below a level. A
+basis too small to hold every targeted root has no objective (inf): growth then adds functions
+by the sum over the targeted roots the grown basis holds (`with_added_many`).
 """
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 
 from .. import eigen
 
 
-class LowestRoot:
-    """The lowest root E_0 and its eigenvector c_0 (module docstring). (E, C): the eigenvalues and
-    S-orthonormal eigenvectors of the basis a function or a block is added to."""
+#: the smallest squared overlap with a root by which a level is followed to it (`Levels.follow`)
+FOLLOW = 0.5
+
+
+class Level(NamedTuple):
+    """One targeted level of an eigen-solution: its `weight`, `root` index, energy `E` (Eh) and
+    S-normalised eigenvector `c`."""
+
+    weight: float
+    root: int
+    E: float
+    c: np.ndarray
+
+
+class Levels:
+    """The weighted sum of the `targets` (root indices, ascending; default the lowest) with
+    `weights` (positive; default 1 each), the levels standing at the root indices `roots` (default
+    the targets; each at or above its target) and followed while below `threshold` (Eh, the lowest
+    dissociation threshold; module docstring). (E, C): the eigenvalues and S-orthonormal
+    eigenvectors of the basis a function or a block is added to."""
+
+    def __init__(self, targets: tuple = (0,), weights: tuple | None = None, roots: tuple | None = None,
+                 threshold: float = -np.inf):
+        self.targets = tuple(int(r) for r in targets)
+        self.roots = self.targets if roots is None else tuple(int(r) for r in roots)
+        self.weights = tuple(float(w) for w in weights) if weights is not None else (1.0,) * len(self.roots)
+        self.threshold = threshold
+
+    @property
+    def lowest(self) -> bool:
+        """Whether the objective is the lowest root alone (nothing to follow)."""
+        return self.targets == (0,)
+
+    def to(self, roots: tuple) -> Levels:
+        """The objective with the levels at the root indices `roots`."""
+        return Levels(self.targets, self.weights, roots, self.threshold)
 
     def solve(self, H: np.ndarray, S: np.ndarray, threshold: float) -> eigen.Eigen:
-        """The eigen-solution of the pencil (H, S), its lowest root refined (eigen.solve)."""
-        return eigen.solve(H, S, threshold)
+        """The eigen-solution of the pencil (H, S), its roots up to the highest targeted one refined
+        (eigen.solve; as many as the basis has functions, if it has fewer)."""
+        return eigen.solve(H, S, threshold, min(max(self.roots) + 1, len(S)))
+
+    def holds(self, eig: eigen.Eigen) -> bool:
+        """Whether the eigen-solution holds every targeted root."""
+        return eig.kept > max(self.roots)
+
+    def levels(self, eig: eigen.Eigen) -> list[Level]:
+        """The targeted levels the eigen-solution holds."""
+        return [Level(w, r, float(eig.energies[r]), eig.vectors[:, r])
+                for r, w in zip(self.roots, self.weights) if r < eig.kept]
 
     def value(self, eig: eigen.Eigen) -> float:
-        """E_0 (hartree) of an eigen-solution."""
-        return float(eig.energies[0])
+        """Σ w_k E_k (hartree) of an eigen-solution; inf if it does not hold every targeted root."""
+        if not self.holds(eig):
+            return np.inf
+        return sum(lv.weight * lv.E for lv in self.levels(eig))
 
     def vector(self, eig: eigen.Eigen) -> np.ndarray:
-        """c_0, S-normalised, of an eigen-solution."""
-        return eig.vectors[:, 0]
+        """The eigenvector of the first targeted level the solution holds, S-normalised (the
+        coefficients a basis stores)."""
+        return eig.vectors[:, min(self.roots[0], eig.kept - 1)]
+
+    def uncertainty(self, eig: eigen.Eigen, S: np.ndarray, T_ti: np.ndarray, V: np.ndarray) -> float:
+        """Σ w_k σ_k (hartree): the levels' first-order uncertainties (eigen.energy_uncertainty),
+        added as if fully correlated (an upper bound); inf where first order fails (eigen.FIRST_ORDER)."""
+        if not eigen.first_order(eig):
+            return np.inf
+        return sum(lv.weight * eigen.energy_uncertainty(lv.c, lv.E, S, T_ti, V) for lv in self.levels(eig))
+
+    def held(self, n: int) -> list[tuple[int, float]]:
+        """The (root, weight) of the targeted levels a basis of `n` directions holds."""
+        return [(r, w) for r, w in zip(self.roots, self.weights) if r < n]
 
     def with_added(self, E, C, h, s, h_nn, s_nn, min_norm: float) -> float:
-        """E_0 with one function of rows h, s and diagonal h_nn, s_nn added (eigen.lowest_with_added)."""
-        return eigen.lowest_with_added(E, C, h, s, h_nn, s_nn, min_norm)
+        """The objective with one function of rows h, s and diagonal h_nn, s_nn added
+        (eigen.root_with_added per root; the roots the grown basis holds, module docstring)."""
+        return sum(w * eigen.root_with_added(E, C, h, s, h_nn, s_nn, min_norm, r) for r, w in self.held(len(E) + 1))
 
     def with_added_gradient(self, E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float):
-        """`with_added` and its gradient along the function's parameters (eigen.lowest_with_added_gradient)."""
-        return eigen.lowest_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm)
+        """`with_added` and its gradient along the function's parameters (eigen.root_with_added_gradient)."""
+        e, g = 0.0, 0.0
+        for r, w in self.held(len(E) + 1):
+            e_r, g_r = eigen.root_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm, r)
+            e, g = e + w * e_r, g + w * g_r
+        return e, g
 
     def with_added_many(self, E, C, H, S, h_nn, s_nn, min_norm: float) -> np.ndarray:
-        """`with_added` for each of many functions, rows H, S (eigen.lowest_with_added_many)."""
-        return eigen.lowest_with_added_many(E, C, H, S, h_nn, s_nn, min_norm)
+        """`with_added` for each of many functions, rows H, S (eigen.root_with_added_many): the sum
+        over the targeted roots the grown basis holds (module docstring)."""
+        total = np.zeros(len(H))
+        for r, w in self.held(len(E) + 1):
+            total += w * eigen.root_with_added_many(E, C, H, S, h_nn, s_nn, min_norm, r)
+        return total
 
     def with_block(self, E, C, h, s, H_ff, S_ff, min_norm: float, near: float | None = None):
-        """E_0 with a block of functions added, and its eigenvector (eigen.lowest_with_block)."""
-        return eigen.lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm, near=near)
+        """The objective with a block of functions added (eigen.root_with_block per root), and for
+        each level (weight, e, a, β, c^T S c), its eigenvector (C a, β); (inf, []) where a root is
+        not lowered or the block is linearly dependent."""
+        total, parts = 0.0, []
+        for r, w in self.held(len(E) + len(H_ff)):
+            e, a, beta, norm2 = eigen.root_with_block(E, C, h, s, H_ff, S_ff, min_norm, near if self.lowest else None, r)
+            if not np.isfinite(e):
+                return np.inf, []
+            total, parts = total + w * e, parts + [(w, e, a, beta, norm2)]
+        return total, parts
 
     def without_each(self, E: np.ndarray, C: np.ndarray) -> np.ndarray:
-        """E_0 without each function in turn (eigen.lowest_without_each)."""
-        return eigen.lowest_without_each(E, C)
+        """The objective without each function in turn (eigen.root_without_each per root)."""
+        return sum(w * eigen.root_without_each(E, C, r) for r, w in zip(self.roots, self.weights))
+
+    def follow(self, before: tuple, S: np.ndarray, eig: eigen.Eigen) -> tuple:
+        """The root indices of the targeted levels after a change (module docstring): `before`,
+        their eigenvectors before it (nb x levels), in the changed basis's functions (zero for a
+        function that is new), and their energies (Eh); a level that was bound goes to the root at
+        or above its target of largest squared overlap if that exceeds FOLLOW and no two levels go
+        to one root; otherwise the indices are kept."""
+        vectors, energies = before
+        SC = S @ eig.vectors
+        norms = np.sqrt(np.maximum(np.einsum("il,ij,jl->l", vectors, S, vectors), 1e-300))
+        overlap = ((vectors.T @ SC) / norms[:, None]) ** 2
+        roots = tuple(t + int(np.argmax(o[t:])) if e < self.threshold else r
+                      for o, t, r, e in zip(overlap, self.targets, self.roots, energies))
+        if len(set(roots)) < len(roots) or any(o[r] <= FOLLOW for o, r in zip(overlap, roots)):
+            return self.roots
+        return roots

@@ -2,8 +2,9 @@
 
 Refinement sweeps move one function at a time; near the optimum, where the functions' parameters
 are coupled, that coordinate descent crawls. Here θ = (θ_1, ..., θ_N) (Parametrisation of
-each function in its own channel; K fixed) and, with E and c the objective's root and its
-S-normalised eigenvector (objective.py; Hellmann–Feynman),
+each function in its own channel; K fixed) and, with E and c a targeted root and its
+S-normalised eigenvector (objective.py; Hellmann–Feynman; the objective's gradient is the
+weighted sum over its levels),
 
     ∂E/∂θ_i = 2 c_i Σ_{j≠i} c_j (∂H_ij − E ∂S_ij) + c_i² (∂H_ii − E ∂S_ii),
 
@@ -64,15 +65,20 @@ class Joint:
             return fail
         if eig.kept < nb or eig.overlap_condition > self.max_condition:
             return fail
-        E, c = st.objective.value(eig), st.objective.vector(eig)
-        grad = []
-        for i, (rows, d) in enumerate(parts):
-            dH, dS = rows["T_ti"][1:] + rows["V"][1:], rows["S"][1:]
-            off = (dH - E * dS) @ c - (dH[:, i] - E * dS[:, i]) * c[i]  # Σ_{j≠i}
-            grad.append(2.0 * c[i] * off + c[i] ** 2 * ((d[1:, 2] + d[1:, 3]) - E * d[1:, 0]))
-        if E < self.best_E:
-            self.best_E, self.best = E, basis
-        return E, np.concatenate(grad)
+        total = st.objective.value(eig)
+        if not np.isfinite(total):
+            return fail
+        gradient = 0.0
+        for w, _, E, c in st.objective.levels(eig):  # Σ_levels w ∂E/∂θ
+            grad = []
+            for i, (rows, d) in enumerate(parts):
+                dH, dS = rows["T_ti"][1:] + rows["V"][1:], rows["S"][1:]
+                off = (dH - E * dS) @ c - (dH[:, i] - E * dS[:, i]) * c[i]  # Σ_{j≠i}
+                grad.append(2.0 * c[i] * off + c[i] ** 2 * ((d[1:, 2] + d[1:, 3]) - E * d[1:, 0]))
+            gradient = gradient + w * np.concatenate(grad)
+        if total < self.best_E:
+            self.best_E, self.best = total, basis
+        return total, gradient
 
 
 def polish(expansion, iterations: int) -> bool:

@@ -2,16 +2,17 @@
 Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018), Sec. IV.E).
 
 The function moves in its parameters θ (parametrisation.py). The energy of a trial θ is the
-objective's root (objective.py: the lowest) of the secular equation (eigen.lowest_with_added)
+objective (objective.py: the lowest root, or a weighted sum of roots) of the secular equation
+(eigen.root_with_added)
 against the basis without the function: one row of integrals and O(N_b^2) per evaluation.
 
 Two minimisers: Powell's method on the energy (the paper's), and L-BFGS on the energy and its
 exact gradient — the row's derivatives along ∂(A, u or s)/∂θ_p by forward-mode dual numbers
-in the Rust core (Representation.row_gradient), then eigen.lowest_with_added_gradient.
+in the Rust core (Representation.row_gradient), then eigen.root_with_added_gradient.
 
 A group (`refine_group`): function i and the functions it overlaps most (`partners`) move
 together, L-BFGS on all their θ, the energy the root of the block update against the basis
-without them (eigen.lowest_with_block). Strongly overlapping functions of an optimised
+without them (eigen.root_with_block). Strongly overlapping functions of an optimised
 basis act together (a near-duplicate pair is a derivative of a Gaussian): moved one at a time,
 each is held by the other.
 """
@@ -144,22 +145,23 @@ class GroupEnergy:
                     if m < o:
                         B[m, o] = B[o, m] = X[m][0][key][0, nr + c]
             block[key] = B
-        e, a, beta, norm2 = st.objective.with_block(self.E, self.C, h, s, block["H"], block["S"], st.min_norm,
-                                                    near=st.energy)
-        if not np.isfinite(e):
+        total, levels = st.objective.with_block(self.E, self.C, h, s, block["H"], block["S"], st.min_norm,
+                                                near=st.energy)
+        if not np.isfinite(total):
             return self.worse, np.zeros_like(theta)
-        c_rest = self.C @ a
-        grad = []
-        for m, (x, dg) in enumerate(X):
-            dX = x["H"][1:] - e * x["S"][1:]
-            g = 2.0 * beta[m] * (dX[:, :nr] @ c_rest + dX[:, nr:] @ beta[others[m]])
-            grad.append((g + beta[m] ** 2 * (dg["H"][1:] - e * dg["S"][1:])) / norm2)
-        grad = np.concatenate(grad)
+        grad = 0.0
+        for w, e, a, beta, norm2 in levels:  # Σ_levels w ∂e/∂θ (eigen module docstring, block update)
+            c_rest, g_level = self.C @ a, []
+            for m, (x, dg) in enumerate(X):
+                dX = x["H"][1:] - e * x["S"][1:]
+                g = 2.0 * beta[m] * (dX[:, :nr] @ c_rest + dX[:, nr:] @ beta[others[m]])
+                g_level.append((g + beta[m] ** 2 * (dg["H"][1:] - e * dg["S"][1:])) / norm2)
+            grad = grad + w * np.concatenate(g_level)
         if not np.all(np.isfinite(grad)):
             return self.worse, np.zeros_like(theta)
-        if e < self.best_E:
-            self.best_E, self.best_f = e, fs
-        return e, grad
+        if total < self.best_E:
+            self.best_E, self.best_f = total, fs
+        return total, grad
 
 
 def partners(expansion, i: int, count: int) -> list[int]:

@@ -1,4 +1,5 @@
-"""The live progress line of a run: basis size, energy, last improvement, virial, trials per second."""
+"""The live progress line of a run: basis size, energy (each targeted level's), last improvement, virial,
+trials per second."""
 from __future__ import annotations
 
 import time
@@ -38,13 +39,22 @@ class Reporter:
         """Count `k` more trial functions (or refinements) for the rate."""
         self.n_trials += k
 
+    def followed(self, before: tuple, after: tuple) -> None:
+        """Say that the targeted levels moved from the roots `before` to `after` (objective.py, following)."""
+        if self.progress is not None:
+            self.progress.console.print(f"levels followed by overlap: roots {list(before)} → {list(after)}")
+
     def step(self, st: Expansion, old: float, cursor: Cursor) -> None:
         """Show the expansion after a step that lowered the energy from `old`."""
         if self.progress is None:
             return
         rate = self.n_trials / max(time.perf_counter() - self.t0, 1e-9)
         gain = old - st.energy if np.isfinite(old) else float("nan")
-        info = f"E = {st.energy:.12f}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.1f} trials/s"
+        if st.objective.lowest:
+            energy = f"E = {st.energy:.12f}"
+        else:  # each targeted level, then the change of the objective Σ w_k E_k
+            energy = "  ".join(f"E_{lv.root} = {lv.E:.12f}" for lv in st.objective.levels(st.eig))
+        info = f"{energy}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.1f} trials/s"
         if cursor.phase == "grow":
             self.progress.update(self.task, description="growing", completed=len(st.basis), total=self.opts.size,
                                  info=info)

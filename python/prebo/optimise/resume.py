@@ -48,6 +48,22 @@ def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> t
     return basis, cursor, history, elapsed, schedule, stopped
 
 
+def followed_roots(d: dict, targets: tuple, where: str) -> tuple[tuple, list]:
+    """The root indices at which a run with several or higher targeted levels (`targets`, the
+    state's) stood, and the record of its re-assignments (objective.py, following), from checkpoint
+    content `d` (the state's own indices where it has none); BasisFileError naming `where` for a
+    block that is not distinct root indices, one per targeted level at or above it."""
+    levels, followed = d.get("levels", list(targets)), d.get("followed", [])
+    if not (isinstance(levels, list) and len(levels) == len(targets) and len(set(levels)) == len(levels)
+            and all(type(r) is int and r >= t for r, t in zip(levels, targets))):
+        raise BasisFileError(f"{where}: levels = {reprlib.repr(levels)}: must be {len(targets)} distinct root "
+                             f"indices, one per targeted level, each at or above its target {list(targets)}")
+    if not (isinstance(followed, list) and all(isinstance(f, list) and len(f) == 3 for f in followed)):
+        raise BasisFileError(f"{where}: followed = {reprlib.repr(followed)}: must be [seconds, roots before, "
+                             "roots after] rows")
+    return tuple(levels), followed
+
+
 def check_rng(block) -> dict:
     """A checkpoint's "rng" block: the state of numpy's PCG64 generator, {bit_generator: "PCG64",
     state: {state, inc}, has_uint32, uinteger} with integers in their ranges (numpy itself takes

@@ -11,13 +11,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, SpinError
-from ..validation import MAX_PARTICLES, Integer, Real, Sign, checked, half_integer, strict_keywords
+from ..validation import MAX_PARTICLES, MAX_SIZE, Integer, Real, Sign, checked, half_integer, strict_keywords
 from .particles import Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
 
 #: N: bound few-body states have far smaller ones (H₂'s last rotational level has N = 31); the
 #: ECG-GVR quadrature holds 2 K + N ≤ 1021 (crates/prebo-core/src/families/gvr/)
 N_RANGE = Integer(0, 1000)
+#: a targeted root index: below the largest basis (validation.MAX_SIZE)
+ROOT_RANGE = Integer(0, MAX_SIZE - 1)
+#: a level's weight in the objective Σ w_k E_k (optimise/objective.py)
+WEIGHT_RANGE = Real(0.0, 1e6, hi_closed=True)
 #: a given dissociation threshold (Eh): fragments (bound: < 0) and free particles at rest (0) lie at
 #: or below 0 (prebo.thresholds)
 THRESHOLD_RANGE = Real(-math.inf, 0.0, hi_closed=True)
@@ -33,13 +37,21 @@ class State:
     {particle name: total spin S} of each group of identical particles (0, 1/2, 1, ...); a group
     not named gets its lowest total spin (singlet, doublet, para); `threshold`, a dissociation
     threshold (Eh, ≤ 0) the user knows to lie below the hydrogen-like ones `prebo.thresholds`
-    finds (e.g. Li⁺ + e for Li), or None. InputError for anything else (unknown keywords included).
+    finds (e.g. Li⁺ + e for Li), or None; the levels the optimiser targets (optimise/objective.py):
+    `root`, one eigenvalue index (0, the default: the lowest of the symmetry), or `roots`, a count
+    K (the K lowest) or a list of distinct indices, with `weights` (positive, one per root; default
+    1 each) for the objective Σ w_k E_k. They are kept as `roots`, a tuple of ascending indices
+    (None for the lowest alone), and `weights` (None for 1 each). InputError for anything else
+    (unknown keywords included).
     """
 
     N: int = 0
     parity: int = 1
     spin: dict = field(default_factory=dict)
     threshold: float | None = None
+    root: int | None = None
+    roots: int | tuple | list | None = None
+    weights: tuple | list | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "N", checked(N_RANGE, self.N, "state: N", "the total orbital angular momentum"))
@@ -51,6 +63,43 @@ class State:
         if self.threshold is not None:
             object.__setattr__(self, "threshold", checked(THRESHOLD_RANGE, self.threshold, "state: threshold",
                                                           "Eh: fragments and free particles at rest lie at or below 0"))
+        roots, weights = self._levels()
+        object.__setattr__(self, "root", None)
+        object.__setattr__(self, "roots", None if roots == (0,) else roots)
+        object.__setattr__(self, "weights", None if len(roots) == 1 or set(weights) == {1.0} else weights)
+
+    def _levels(self) -> tuple[tuple, tuple]:
+        """The targeted root indices (ascending) and their weights, from `root`, `roots`, `weights`."""
+        if self.root is not None and self.roots is not None:
+            raise InputError(f"state: root = {self.root!r} and roots = {self.roots!r}: give one of them")
+        if self.root is not None:
+            roots = [checked(ROOT_RANGE, self.root, "state: root", "an eigenvalue index, 0 for the lowest")]
+        elif self.roots is None:
+            roots = [0]
+        elif isinstance(self.roots, (list, tuple)):
+            if not self.roots:
+                raise InputError("state: roots = []: must name at least one root")
+            roots = [checked(ROOT_RANGE, r, "state: roots", "distinct eigenvalue indices, 0 for the lowest")
+                     for r in self.roots]
+            if len(set(roots)) < len(roots):
+                raise InputError(f"state: roots = {list(self.roots)!r}: must be distinct eigenvalue indices")
+        else:
+            count = checked(Integer(1, MAX_SIZE), self.roots, "state: roots",
+                            "how many of the lowest levels, or a list of eigenvalue indices")
+            roots = list(range(count))
+        if self.weights is None:
+            weights = [1.0] * len(roots)
+        elif not isinstance(self.weights, (list, tuple)) or len(self.weights) != len(roots):
+            raise InputError(f"state: weights = {self.weights!r}: must be {len(roots)} positive numbers, one per root")
+        else:
+            weights = [checked(WEIGHT_RANGE, w, "state: weights", "one per root") for w in self.weights]
+        order = sorted(range(len(roots)), key=roots.__getitem__)
+        return tuple(roots[i] for i in order), tuple(weights[i] for i in order)
+
+    @property
+    def levels(self) -> tuple[tuple, tuple]:
+        """The targeted root indices (ascending) and their weights in the objective."""
+        return self._levels()
 
 
 class System:
@@ -199,6 +248,10 @@ class System:
                  "spin": {g.name: float(g.total_spin) for g in self.groups}}
         if self.state.threshold is not None:
             state["threshold"] = self.state.threshold
+        if self.state.roots is not None:
+            state["roots"] = list(self.state.roots)
+        if self.state.weights is not None:
+            state["weights"] = list(self.state.weights)
         return {"particles": [p.to_dict() for p in self.particles], "state": state}
 
     @classmethod
@@ -213,9 +266,9 @@ class System:
         if unknown:
             raise InputError(f"system: unknown keys {sorted(unknown)} (allowed: particles, state)")
         if not isinstance(d.get("state", {}), dict):
-            raise InputError(f"state = {d['state']!r}: must be a table of N, parity, spin and threshold")
+            raise InputError(f"state = {d['state']!r}: must be a table of N, parity, spin, threshold, roots and weights")
         st = dict(d.get("state", {}))
-        unknown = set(st) - {"N", "parity", "spin", "threshold"}
+        unknown = set(st) - {"N", "parity", "spin", "threshold", "roots", "weights"}
         if unknown:
             raise InputError(f"state: unknown keys {sorted(unknown)}")
         system = cls(d["particles"], State(**st))
