@@ -521,3 +521,23 @@ def test_lowest_json_is_written_when_the_run_leaves_its_lowest_state_and_removed
     lowest.see(state(3, -0.2))
     assert path.exists()
     assert Lowest(basis, 3, tmp_path, {}, resumed=False).energy == np.inf and path.exists()  # a new run's own
+
+
+def test_a_whole_basis_with_a_function_the_symmetriser_annihilates_is_not_taken():
+    """Expansion.replace_basis (joint steps, momentum moves) refuses a basis in which a function lost
+    its digits to the symmetriser (what prebo.evaluate would refuse at the end of the run): a triplet's
+    function symmetric in the two electrons to 1e-9 is annihilated to 1e-9 of its norm."""
+    from conftest import pair_A
+    from prebo.basis import Basis
+    from prebo.integrals import laboratory
+    from prebo.optimise.expansion import Expansion
+
+    system = prebo.System(["alpha", "e", "e"], spin={"e": 1})
+    A = [pair_A(system, {(0, 1): a1, (0, 2): a2, (1, 2): 0.1}, 1.0) for a1, a2 in ((1.0, 0.3), (2.0, 0.5), (0.8, 0.2))]
+    basis = Basis(system, np.array(A), np.ones(3), ["pairs"] * 3)
+    ex = Expansion(basis, laboratory(system), 4 * 2.0**-53)
+    energy = ex.energy
+    symmetric = pair_A(system, {(0, 1): 0.7, (0, 2): 0.7 * (1 + 1e-9), (1, 2): 0.1}, 1.0)
+    moved = Basis(system, np.array(A[:2] + [symmetric]), np.ones(3), ["pairs"] * 3)
+    assert not ex.replace_basis(moved)
+    assert ex.energy == energy and np.array_equal(ex.basis.A, basis.A) and ex.resolved()

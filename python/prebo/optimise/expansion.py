@@ -130,11 +130,24 @@ class Expansion:
         return self.keep_if_lower(before)
 
     def replace_basis(self, basis: Basis) -> bool:
-        """Take a whole new basis (matrices rebuilt) if it lowers the energy beyond the uncertainty."""
+        """Take a whole new basis (matrices rebuilt) if every function kept the digits of its elements
+        (`resolved`) and it lowers the energy beyond the uncertainty."""
         before = self.snapshot()
         self.basis = basis
         self.m = self.rep.matrices(basis)
+        if not self.resolved():
+            self.restore(before)
+            return False
         return self.solve_and_keep_if_lower(before, np.arange(len(basis)))  # each function moved a little
+
+    def resolved(self) -> bool:
+        """Whether every function's elements kept their digits (Representation.resolved, what
+        prebo.evaluate requires): a momentum move, the one change not checked function by function
+        (trials, refinements and joint steps are: Representation.plausible), is what could have
+        carried a function where the symmetriser nearly annihilates it into a He 2³S run with 150
+        functions, whose result was then refused."""
+        diag = np.stack([np.diag(self.m[k]) for k in ("S", "T", "T_ti", "V")], axis=1)
+        return bool(self.rep.resolved(diag).all())
 
     def without(self, i):
         """The eigen-solution of the basis without function i, or without the functions of the

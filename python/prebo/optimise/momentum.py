@@ -73,8 +73,9 @@ class Momentum:
 
         def energy(alpha: float) -> float:
             try:
-                return Expansion(moved(alpha), expansion.rep, expansion.threshold, expansion.min_norm,
-                                 expansion.max_overlap, expansion.objective).energy
+                ex = Expansion(moved(alpha), expansion.rep, expansion.threshold, expansion.min_norm,
+                               expansion.max_overlap, expansion.objective)
+                return ex.energy if ex.resolved() else np.inf
             except PreboError:
                 return np.inf
 
