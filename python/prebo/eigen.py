@@ -253,17 +253,10 @@ def root_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: float
     dependent on the basis (as `lowest_with_block`)."""
     if root == 0:
         return lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm, near)
-    if len(E) <= root:
+    block = _Block.of(E, C, h, s, H_ff, S_ff, min_norm) if len(E) > root else None
+    if block is None:
         return np.inf, None, None, None
-    D, B = s @ C, h @ C
-    scale = 1.0 / np.sqrt(np.diag(S_ff))
-    orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
-    if not np.all(np.isfinite(orthogonal)) or np.linalg.eigvalsh(orthogonal)[0] < min_norm:
-        return np.inf, None, None, None
-
-    def schur(x):
-        G = B - x * D
-        return H_ff - x * S_ff - (G / (E - x)) @ G.T, G
+    schur = block.schur
 
     def count(x):  # the number of eigenvalues of the augmented pencil below x
         if np.any(E == x):
@@ -284,13 +277,38 @@ def root_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: float
         if mid <= lo or mid >= hi:
             break
         lo, hi = (lo, mid) if count(mid) > root else (mid, hi)
-    e = hi
-    M, G = schur(e)
-    w, V = np.linalg.eigh(M)
-    beta = V[:, int(np.argmin(np.abs(w)))]
-    a = -(beta @ G) / (E - e)
-    norm2 = a @ a + 2.0 * a @ (D.T @ beta) + beta @ S_ff @ beta
-    return float(e), a, beta, float(norm2)
+    w, V = np.linalg.eigh(schur(hi)[0])
+    return block.eigenvector(hi, V[:, int(np.argmin(np.abs(w)))])
+
+
+class _Block:
+    """k functions added to a basis of eigenvalues E and S-orthonormal eigenvectors C (module
+    docstring, block update): D = s C, B = h C and the blocks H_ff, S_ff among them."""
+
+    def __init__(self, E, D, B, H_ff, S_ff):
+        self.E, self.D, self.B, self.H_ff, self.S_ff = E, D, B, H_ff, S_ff
+
+    @classmethod
+    def of(cls, E, C, h, s, H_ff, S_ff, min_norm: float):
+        """The block of rows h, s; None when it is linearly dependent on the basis (the smallest
+        eigenvalue of its orthogonal part S_ff - D D^T below `min_norm` of its diagonal)."""
+        D, B = s @ C, h @ C
+        scale = 1.0 / np.sqrt(np.diag(S_ff))
+        orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
+        if not np.all(np.isfinite(orthogonal)) or np.linalg.eigvalsh(orthogonal)[0] < min_norm:
+            return None
+        return cls(E, D, B, H_ff, S_ff)
+
+    def schur(self, x: float):
+        """M(x), the Schur complement of the eigenbasis in H - x S, and G = B - x D."""
+        G = self.B - x * self.D
+        return self.H_ff - x * self.S_ff - (G / (self.E - x)) @ G.T, G
+
+    def eigenvector(self, e: float, beta: np.ndarray) -> tuple:
+        """(e, a, β, c^T S c) of the root e with β the null vector of M(e): c = (C a, β), a = -G^T β / (E - e)."""
+        a = -(beta @ self.schur(e)[1]) / (self.E - e)
+        norm2 = a @ a + 2.0 * a @ (self.D.T @ beta) + beta @ self.S_ff @ beta
+        return float(e), a, beta, float(norm2)
 
 
 def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: float | None = None):
@@ -302,18 +320,13 @@ def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: flo
     lowers nothing. `near`: an estimate of the root, where Newton's method starts (the energy
     before the block changed); the root found depends on it only where rounding blurs the sign of
     M's lowest eigenvalue, within a few ulp."""
-    D, B = s @ C, h @ C
-    scale = 1.0 / np.sqrt(np.diag(S_ff))
-    orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
-    if not np.all(np.isfinite(orthogonal)) or np.linalg.eigvalsh(orthogonal)[0] < min_norm:
+    block = _Block.of(E, C, h, s, H_ff, S_ff, min_norm)
+    if block is None:
         return np.inf, None, None, None
     if len(E) == 0:  # nothing else in the basis: the k x k problem itself (S_ff positive definite)
         w, V = scipy.linalg.eigh(H_ff, S_ff)
         return float(w[0]), np.zeros(0), V[:, 0], float(V[:, 0] @ S_ff @ V[:, 0])
-
-    def schur(x):
-        G = B - x * D
-        return H_ff - x * S_ff - (G / (E - x)) @ G.T, G
+    schur, D = block.schur, block.D
 
     def below(x):  # whether an eigenvalue lies below x (x < E_0)
         return np.linalg.eigvalsh(schur(x)[0])[0] < 0
@@ -351,12 +364,7 @@ def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: flo
         if mid <= lo or mid >= hi:
             break
         lo, hi = (lo, mid) if below(mid) else (mid, hi)
-    e = hi
-    M, G = schur(e)
-    beta = np.linalg.eigh(M)[1][:, 0]
-    a = -(beta @ G) / (E - e)
-    norm2 = a @ a + 2.0 * a @ (D.T @ beta) + beta @ S_ff @ beta
-    return float(e), a, beta, float(norm2)
+    return block.eigenvector(hi, np.linalg.eigh(schur(hi)[0])[1][:, 0])
 
 
 def root_without_each(E: np.ndarray, C: np.ndarray, root: int = 0) -> np.ndarray:
