@@ -43,7 +43,7 @@ def test_secular_update_equals_full_solve(problem):
     keep = slice(0, 9)
     H, S = m["T_ti"] + m["V"], m["S"]
     sub = eigen.solve(H[keep, keep], S[keep, keep])
-    e = eigen.root_with_added(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9], S[9, 9])
+    e = eigen.roots_with_added(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9], S[9, 9])[0]
     full = eigen.solve(H, S).energies[0]
     assert e == pytest.approx(full, rel=1e-12)
     assert e <= sub.energies[0]  # adding a function never raises the lowest eigenvalue
@@ -65,8 +65,8 @@ def test_block_update_equals_full_solve(problem, k):
     assert c @ S @ c == pytest.approx(norm2, rel=1e-12)
     assert np.allclose(H @ c, e * S @ c, atol=1e-9 * np.sqrt(norm2))
     if k == 1:
-        assert e == pytest.approx(eigen.root_with_added(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9],
-                                                          S[9, 9]), rel=1e-14)
+        assert e == pytest.approx(eigen.roots_with_added(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9],
+                                                           S[9, 9])[0], rel=1e-14)
     if n:
         dup = [0] + list(range(n + 1, 10))  # function 0 again, with the others of the block
         assert eigen.lowest_with_block(sub.energies, sub.vectors, H[dup, :n], S[dup, :n], H[np.ix_(dup, dup)],
@@ -103,17 +103,20 @@ def test_block_root_is_a_flip_of_the_inertia_wherever_newton_starts(problem, k):
 @pytest.mark.parametrize("root", [1, 2, 5])
 @pytest.mark.parametrize("k", [1, 2, 3])
 def test_higher_roots_of_the_updates_equal_the_full_solve(problem, root, k):
-    """Eigenvalue `root` with k functions added at once (the inertia count, eigen.root_with_block),
-    its eigenvector, and for k = 1 the secular root and its gradient (eigen.root_with_added_gradient,
-    against central differences of a dense solve along a random direction of the new row), and
+    """Eigenvalue `root` with k functions added at once (the inertia count, eigen.roots_with_block),
+    its eigenvector, and for k = 1 the secular root and its gradient (eigen.roots_with_added_gradient,
+    against central differences of a dense solve along a random direction of the new row; asked
+    together with root 0, the same bits as asked alone), and
     root `root` without each function (eigen.root_without_each), all against dense solves."""
     _, _, _, m = problem
     H, S = m["T_ti"] + m["V"], m["S"]
     n = 10 - k
     sub = eigen.solve(H[:n, :n], S[:n, :n])
     full = scipy.linalg.eigh(H, S, eigvals_only=True)
-    e, a, beta, norm2 = eigen.root_with_block(sub.energies, sub.vectors, H[n:, :n], S[n:, :n], H[n:, n:],
-                                              S[n:, n:], root=root)
+    args = (sub.energies, sub.vectors, H[n:, :n], S[n:, :n], H[n:, n:], S[n:, n:])
+    (e, a, beta, norm2), = eigen.roots_with_block(*args, roots=(root,))
+    both = eigen.roots_with_block(*args, roots=(0, root))  # one block, several roots: each as asked alone
+    assert both[0][0] == eigen.lowest_with_block(*args)[0] and both[1][0] == e
     assert e == pytest.approx(full[root], rel=1e-12)
     c = np.concatenate([sub.vectors @ a, beta])
     assert c @ S @ c == pytest.approx(norm2, rel=1e-10)
@@ -122,9 +125,12 @@ def test_higher_roots_of_the_updates_equal_the_full_solve(problem, root, k):
         rng = np.random.default_rng(root)
         dh, ds = rng.normal(size=(1, n)) * 1e-2, rng.normal(size=(1, n)) * 1e-3
         dh_nn, ds_nn = np.array([2e-2]), np.array([1e-3])
-        e1, g = eigen.root_with_added_gradient(sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9], S[9, 9],
-                                               dh, ds, dh_nn, ds_nn, root=root)
+        args = (sub.energies, sub.vectors, H[9, :9], S[9, :9], H[9, 9], S[9, 9], dh, ds, dh_nn, ds_nn)
+        (e1,), (g,) = eigen.roots_with_added_gradient(*args, roots=(root,))
         assert e1 == pytest.approx(full[root], rel=1e-12)
+        both = eigen.roots_with_added_gradient(*args, roots=(0, root))
+        alone = eigen.roots_with_added_gradient(*args, roots=(0,))
+        assert list(both[0]) == [alone[0][0], e1] and np.array_equal(both[1], np.stack([alone[1][0], g]))
 
         def moved(t):
             Ht, St = H.copy(), S.copy()
@@ -140,9 +146,28 @@ def test_higher_roots_of_the_updates_equal_the_full_solve(problem, root, k):
         keep = np.arange(10) != i
         assert without[i] == pytest.approx(scipy.linalg.eigh(H[np.ix_(keep, keep)], S[np.ix_(keep, keep)],
                                                              eigvals_only=True)[root], rel=1e-12)
-    assert eigen.root_with_block(sub.energies[:root], sub.vectors[:, :root], H[n:, :n], S[n:, :n], H[n:, n:],
-                                 S[n:, n:], root=root)[0] == np.inf  # the basis does not hold the root
+    assert eigen.roots_with_block(sub.energies[:root], sub.vectors[:, :root], H[n:, :n], S[n:, :n], H[n:, n:],
+                                  S[n:, n:], roots=(root,))[0][0] == np.inf  # the basis does not hold the root
 
+
+def test_block_roots_below_the_basis_lowest_equal_the_full_solve():
+    """A block of three low functions added to four high ones puts three roots below the basis's
+    E_0: roots 1 and 2 lie in the interval below the first pole (eigen._Block.root with j < root),
+    root 3 above it; each, asked together, equals the dense solve and the eigenvector solves the pencil."""
+    rng = np.random.default_rng(5)
+    B = np.eye(7) + 0.1 * rng.normal(size=(7, 7))
+    S = B.T @ B
+    H = 0.3 * rng.normal(size=(7, 7))
+    H = 0.5 * (H + H.T) + np.diag([5.0, 6.0, 7.0, 8.0, -5.0, -4.0, -3.0])
+    base = eigen.solve(H[:4, :4], S[:4, :4])
+    full = scipy.linalg.eigh(H, S, eigvals_only=True)
+    assert full[2] < base.energies[0] < full[3]
+    found = eigen.roots_with_block(base.energies, base.vectors, H[4:, :4], S[4:, :4], H[4:, 4:], S[4:, 4:],
+                                   roots=(0, 1, 2, 3))
+    for r, (e, a, beta, norm2) in enumerate(found):
+        assert e == pytest.approx(full[r], rel=1e-12)
+        c = np.concatenate([base.vectors @ a, beta])
+        assert np.allclose(H @ c, e * S @ c, atol=1e-8 * np.sqrt(norm2))
 
 def test_rows_from_core_agree_with_matrices(problem):
     _, basis, rep, m = problem
@@ -168,7 +193,7 @@ def test_duplicate_function_is_handled_without_inverse(problem):
     # and the update refuses the duplicate as linearly dependent
     base = eigen.solve(m["T_ti"] + m["V"], m["S"])
     H, S = md["T_ti"] + md["V"], md["S"]
-    assert eigen.root_with_added(base.energies, base.vectors, H[-1, :-1], S[-1, :-1], H[-1, -1], S[-1, -1]) == np.inf
+    assert eigen.roots_with_added(base.energies, base.vectors, H[-1, :-1], S[-1, :-1], H[-1, -1], S[-1, -1])[0] == np.inf
 
 
 def test_indefinite_overlap_is_refused():

@@ -333,6 +333,22 @@ def test_the_progress_line_starts_at_the_size_of_the_basis_a_run_resumes_from():
         assert (report.progress.tasks[0].completed, report.progress.tasks[0].total) == (0, 40)
 
 
+
+def test_the_progress_line_is_what_the_schedule_says():
+    """The progress line's description and counts come from the schedule (Schedule.progress): a
+    fixed schedule counts the functions of a sweep and the steps of a joint pass, the adaptive one
+    the functions of a pass of at most CHUNK; growth counts functions to the size in both."""
+    from prebo.optimise.adaptive import CHUNK, Adaptive
+    from prebo.optimise.fixed import Fixed
+    opts = Optimiser(size=80, polish=4)
+    fixed, adaptive = Fixed(opts), Adaptive(opts)
+    assert fixed.progress(Cursor("grow"), 30) == adaptive.progress(Cursor("grow"), 30) == ("growing", 30, 80)
+    assert fixed.progress(Cursor("refine", sweep=1, index=9, cycle=2), 80) == ("refine 2 (cycle 3)", 10, 80)
+    assert fixed.progress(Cursor("polish", sweep=2, cycle=0), 80) == ("polish (cycle 1)", 3, 4)
+    assert fixed.progress(Cursor("prune", index=1, cycle=0), 83) == ("prune (cycle 1)", 3, opts.prune)
+    assert adaptive.progress(Cursor("sweep", sweep=4, cycle=6), 80) == ("sweep (pass 7)", 5, min(CHUNK, 80))
+    assert adaptive.progress(Cursor("momentum", cycle=1), 80) == ("momentum (pass 2)", 1, 1)
+
 def test_a_growth_step_refines_the_newcomer_before_it_joins_and_solves_once(monkeypatch):
     """A grown function is refined against the basis it joins, then appended: one eigen-solution
     per step (not one for the raw winner, one for the basis without it and one after refinement),

@@ -88,12 +88,13 @@ class Engine:
         basis in the laboratory frame; mu (n,): mass fractions m_i/m_tot. Error for other families."""
 
 
-def root_with_added(e: ArrayLike, c: ArrayLike, h: ArrayLike, s: ArrayLike, h_nn: ArrayLike,
-                    s_nn: ArrayLike, min_norm: float, root: int = 0) -> NDArray[np.float64]:
-    """Eigenvalue `root` (E_h; 0: the lowest) after adding each of k trials to a basis (secular
-    equation): e (kept,) eigenvalues, c (nb, kept) S-orthonormal eigenvectors, rows h, s (k, nb)
-    of H and S, diagonals h_nn, s_nn (k,); a trial whose part orthogonal to the basis has norm²
-    below `min_norm` · s_nn gets +inf, a root above `kept` NaN. Returns (k,)."""
+def roots_with_added(e: ArrayLike, c: ArrayLike, h: ArrayLike, s: ArrayLike, h_nn: ArrayLike,
+                     s_nn: ArrayLike, min_norm: float, roots: list[int]) -> NDArray[np.float64]:
+    """Eigenvalues `roots` (E_h; 0: the lowest) after adding each of k trials to a basis (secular
+    equation, C^T s and C^T h formed once per trial): e (kept,) eigenvalues, c (nb, kept)
+    S-orthonormal eigenvectors, rows h, s (k, nb) of H and S, diagonals h_nn, s_nn (k,); a trial
+    whose part orthogonal to the basis has norm² below `min_norm` · s_nn gets +inf, a root above
+    `kept` NaN. Returns (k, len(roots))."""
 
 
 def refine_eigenpairs(h: ArrayLike, s: ArrayLike, e: ArrayLike, c: ArrayLike, roots: int

@@ -17,7 +17,7 @@ Gradient (Hellmann–Feynman for the augmented problem): at the root e the eigen
 c = (C a, 1) with a_k = -(b_k - e d_k)/(E_k - e); when only the new function's parameters move,
 de = [2 (C a)·(dh - e ds) + dh_nn - e ds_nn] / (|a|^2 + 2 a·d + s_nn).
 
-Block update (a few functions at once, `lowest_with_block`; higher roots `root_with_block`): with rows h, s (k x N) of k new
+Block update (a few functions at once, `roots_with_block`): with rows h, s (k x N) of k new
 functions and their k x k blocks H_ff, S_ff, the Schur complement of the eigenbasis in H - x S is
 M(x) = H_ff - x S_ff - G diag(1/(E - x)) G^T, G = (h - x s) C. Below E_0 the block E - x is
 positive, so by Sylvester's law of inertia the number of eigenvalues below x is the number of
@@ -220,65 +220,56 @@ def uncertainty(eig: Eigen, S: np.ndarray, *terms: np.ndarray, threshold: float 
     return float(np.max(np.abs(np.array(energies) - eig.energies[root])))
 
 
-def root_with_added(E, C, h, s, h_nn, s_nn, min_norm: float = 1e-10, root: int = 0) -> float:
-    """Eigenvalue `root` (0: the lowest) after adding one function (secular equation, in the Rust
+def roots_with_added(E, C, h, s, h_nn, s_nn, min_norm: float = 1e-10, roots: tuple = (0,)) -> np.ndarray:
+    """Eigenvalues `roots` (0: the lowest) after adding one function (secular equation, in the Rust
     core); +inf if it is linearly dependent on the basis (orthogonal remainder below `min_norm` of
     its norm)."""
-    return float(root_with_added_many(E, C, np.atleast_2d(h), np.atleast_2d(s), [h_nn], [s_nn], min_norm, root)[0])
+    return roots_with_added_many(E, C, np.atleast_2d(h), np.atleast_2d(s), [h_nn], [s_nn], min_norm, roots)[0]
 
 
-def root_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float = 1e-10, root: int = 0):
-    """`root_with_added` and its gradient with respect to parameters of the new function, given the
-    derivatives dh, ds (P x nb) and dh_nn, ds_nn (P) of its rows and diagonal (module docstring;
-    the eigenvector (C a, 1) holds at any root e of the augmented problem that is not an E_k)."""
-    e = root_with_added(E, C, h, s, h_nn, s_nn, min_norm, root)
-    if not np.isfinite(e):
-        return e, np.zeros(len(dh_nn))
-    if len(E) == 0:
-        return e, (dh_nn - e * ds_nn) / s_nn
-    d, b = C.T @ s, C.T @ h
-    a = -(b - e * d) / (E - e)
-    c_old = C @ a
-    norm2 = a @ a + 2.0 * a @ d + s_nn
-    return e, (2.0 * (dh - e * ds) @ c_old + dh_nn - e * ds_nn) / norm2
+def roots_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float = 1e-10,
+                              roots: tuple = (0,)):
+    """`roots_with_added` and their gradients (len(roots) x P) with respect to parameters of the
+    new function, given the derivatives dh, ds (P x nb) and dh_nn, ds_nn (P) of its rows and
+    diagonal (module docstring; the eigenvector (C a, 1) holds at any root e of the augmented
+    problem that is not an E_k; d = C^T s and b = C^T h formed once for every root)."""
+    e = roots_with_added(E, C, h, s, h_nn, s_nn, min_norm, roots)
+    g = np.zeros((len(e), len(dh_nn)))
+    d, b = (C.T @ s, C.T @ h) if len(E) else (None, None)
+    for i, e_r in enumerate(e):
+        if not np.isfinite(e_r):
+            continue
+        if len(E) == 0:
+            g[i] = (dh_nn - e_r * ds_nn) / s_nn
+            continue
+        a = -(b - e_r * d) / (E - e_r)
+        c_old = C @ a
+        norm2 = a @ a + 2.0 * a @ d + s_nn
+        g[i] = (2.0 * (dh - e_r * ds) @ c_old + dh_nn - e_r * ds_nn) / norm2
+    return e, g
 
 
-def root_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: float | None = None, root: int = 0):
-    """Eigenvalue `root` after adding k functions at once, with its eigenvector (module docstring,
-    block update): the lowest by `lowest_with_block`; a higher one by bisection on the inertia
-    count, the number of eigenvalues below x being #{E_j < x} + the number of negative eigenvalues
-    of M(x) (Sylvester's law of inertia for x not an E_j), to adjacent doubles, its eigenvector
-    from the eigenvalue of M nearest zero. By interlacing it lies at or below E_root: (inf, None,
-    None, None) where it does not lie below (the block lowers nothing) or the block is linearly
-    dependent on the basis (as `lowest_with_block`)."""
-    if root == 0:
-        return lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm, near)
-    block = _Block.of(E, C, h, s, H_ff, S_ff, min_norm) if len(E) > root else None
-    if block is None:
-        return np.inf, None, None, None
-    schur = block.schur
+def roots_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near=None, roots: tuple = (0,)) -> list[tuple]:
+    """Eigenvalues `roots` after adding k functions at once, each with its eigenvector as (e, a, β,
+    c^T S c), a over the eigenvectors C, β over the new functions (module docstring, block update;
+    the products s C, h C formed once for every root; `_Block.root`). h, s: (k x nb) rows against
+    the basis; H_ff, S_ff: (k x k) among the new functions. By interlacing root r lies at or below
+    E_r: (inf, None, None, None) where it does not (the block lowers nothing), where the basis does
+    not hold E_r, or where the block is linearly dependent on the basis (the smallest eigenvalue of
+    its orthogonal part S_ff - D D^T, D = s C, below `min_norm` of its diagonal). `near`: per root,
+    an estimate where Newton's method starts (the energies before the block changed; None: no
+    estimate); the root found depends on it only where rounding blurs the sign of M's eigenvalue
+    at the root, within a few ulp."""
+    block = _Block.of(E, C, h, s, H_ff, S_ff, min_norm)
+    near = [None] * len(roots) if near is None else near
+    none = (np.inf, None, None, None)
+    return [none if block is None or len(E) <= r and not (r == 0 and len(E) == 0) else block.root(r, x)
+            for r, x in zip(roots, near)]
 
-    def count(x):  # the number of eigenvalues of the augmented pencil below x
-        if np.any(E == x):
-            x = np.nextafter(x, -np.inf)
-        return int(np.searchsorted(E, x)) + int((np.linalg.eigvalsh(schur(x)[0]) < 0).sum())
 
-    hi, lo = np.nextafter(E[root], -np.inf), E[0] - 1.0
-    for _ in range(64):  # a lower bound: below every eigenvalue (M(lo) positive definite, lo < E_0)
-        if count(lo) == 0:
-            break
-        lo -= 2.0 * abs(lo) + 1.0
-    else:
-        return np.inf, None, None, None
-    if count(hi) <= root:
-        return np.inf, None, None, None
-    for _ in range(2100):  # bisection to adjacent doubles: count(lo) <= root < count(hi)
-        mid = 0.5 * (lo + hi)
-        if mid <= lo or mid >= hi:
-            break
-        lo, hi = (lo, mid) if count(mid) > root else (mid, hi)
-    w, V = np.linalg.eigh(schur(hi)[0])
-    return block.eigenvector(hi, V[:, int(np.argmin(np.abs(w)))])
+def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: float | None = None):
+    """The lowest eigenvalue after adding k functions at once, with its eigenvector (`roots_with_block`)."""
+    return roots_with_block(E, C, h, s, H_ff, S_ff, min_norm, [near])[0]
 
 
 class _Block:
@@ -310,61 +301,74 @@ class _Block:
         norm2 = a @ a + 2.0 * a @ (self.D.T @ beta) + beta @ self.S_ff @ beta
         return float(e), a, beta, float(norm2)
 
+    def count(self, x: float) -> int:
+        """The number of eigenvalues of the augmented pencil below x: #{E_j < x} + the number of
+        negative eigenvalues of M(x) (Sylvester's law of inertia; x moved off a pole E_j)."""
+        if np.any(self.E == x):
+            x = np.nextafter(x, -np.inf)
+        return int(np.searchsorted(self.E, x)) + int((np.linalg.eigvalsh(self.schur(x)[0]) < 0).sum())
 
-def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: float | None = None):
-    """Lowest eigenvalue after adding k functions at once (module docstring, block update), with its
-    eigenvector: (e, a, β, norm2), a over the eigenvectors C, β over the new functions, norm2 =
-    c^T S c. h, s: (k x nb) rows against the basis; H_ff, S_ff: (k x k) among the new functions.
-    (inf, None, None, None) when the block is linearly dependent on the basis (the smallest
-    eigenvalue of its orthogonal part S_ff - D D^T, D = s C, below `min_norm` of its diagonal) or
-    lowers nothing. `near`: an estimate of the root, where Newton's method starts (the energy
-    before the block changed); the root found depends on it only where rounding blurs the sign of
-    M's lowest eigenvalue, within a few ulp."""
-    block = _Block.of(E, C, h, s, H_ff, S_ff, min_norm)
-    if block is None:
-        return np.inf, None, None, None
-    if len(E) == 0:  # nothing else in the basis: the k x k problem itself (S_ff positive definite)
-        w, V = scipy.linalg.eigh(H_ff, S_ff)
-        return float(w[0]), np.zeros(0), V[:, 0], float(V[:, 0] @ S_ff @ V[:, 0])
-    schur, D = block.schur, block.D
+    def root(self, root: int, near: float | None):
+        """Root `root` and its eigenvector (`roots_with_block`). Between two poles E_{j-1} < x < E_j
+        M(x) falls strictly (v^T M' v = -c^T S c), so each of its ordered eigenvalues does and the
+        count is j + #{λ_m(x) < 0}: the root lies in the first such interval whose count just below
+        E_j exceeds `root` (the count is continuous across a pole), where λ_m, m = root - j, crosses
+        zero. Newton's method on λ_m (from `near`, else the bracket's left end below E_0 or its
+        middle), kept inside the bracket, finished by bisection to adjacent doubles; its eigenvector
+        is M's m-th at the root."""
+        E, S_ff = self.E, self.S_ff
+        if len(E) == 0:  # nothing else in the basis: the k x k problem itself (S_ff positive definite)
+            w, V = scipy.linalg.eigh(self.H_ff, S_ff)
+            return float(w[0]), np.zeros(0), V[:, 0], float(V[:, 0] @ S_ff @ V[:, 0])
+        schur, D = self.schur, self.D
+        j = root
+        if self.count(np.nextafter(E[j], -np.inf)) <= root:
+            return np.inf, None, None, None
+        while j > 0 and self.count(np.nextafter(E[j - 1], -np.inf)) > root:
+            j -= 1
+        m = root - j
 
-    def below(x):  # whether an eigenvalue lies below x (x < E_0)
-        return np.linalg.eigvalsh(schur(x)[0])[0] < 0
+        def below(x):  # whether root `root` lies below x (x in the interval)
+            return np.linalg.eigvalsh(schur(x)[0])[m] < 0
 
-    def newton(x):  # the lowest eigenvalue λ of M(x) and the Newton step -λ/λ', λ' = v^T M' v = -c^T S c
-        M, G = schur(x)
-        w, V = np.linalg.eigh(M)
-        v, r = V[:, 0], 1.0 / (E - x)
-        Gv, Dv = v @ G, v @ D
-        return w[0], w[0] / (v @ S_ff @ v - 2.0 * (Dv * r) @ Gv + (Gv * r) @ (Gv * r))
+        def newton(x):  # λ_m of M(x) and the Newton step -λ/λ', λ' = v^T M' v = -c^T S c
+            M, G = schur(x)
+            w, V = np.linalg.eigh(M)
+            v, r = V[:, m], 1.0 / (E - x)
+            Gv, Dv = v @ G, v @ D
+            return w[m], w[m] / (v @ S_ff @ v - 2.0 * (Dv * r) @ Gv + (Gv * r) @ (Gv * r))
 
-    hi, lo = np.nextafter(E[0], -np.inf), E[0] - 1.0
-    for _ in range(64):  # a lower bound: M(lo) positive definite (the orthogonal part is)
-        if not below(lo):
-            break
-        lo -= 2.0 * abs(lo) + 1.0
-    else:
-        return np.inf, None, None, None
-    if not below(hi):
-        return np.inf, None, None, None
-    x = near if near is not None and lo < near < hi else lo
-    for _ in range(100):  # Newton within the bracket [lo, hi] (λ decreasing in x), bisection where it leaves it
-        lam, step = newton(x)
-        lo, hi = (lo, x) if lam < 0 else (x, hi)
-        if abs(step) <= 1e-12 * abs(x):
-            break
-        x = x + step if lo < x + step < hi else 0.5 * (lo + hi)
-    width = 4e-13 * abs(x)  # a narrow bracket about the converged x, if it holds
-    if lo < x - width and not below(x - width):
-        lo = x - width
-    if x + width < hi and below(x + width):
-        hi = x + width
-    for _ in range(2100):  # bisection to adjacent doubles
-        mid = 0.5 * (lo + hi)
-        if mid <= lo or mid >= hi:
-            break
-        lo, hi = (lo, mid) if below(mid) else (mid, hi)
-    return block.eigenvector(hi, np.linalg.eigh(schur(hi)[0])[1][:, 0])
+        hi = np.nextafter(E[j], -np.inf)
+        if j > 0:  # the pole itself bounds the bracket; it is never evaluated
+            lo = E[j - 1]
+            start = 0.5 * (lo + hi)
+        else:
+            lo = E[0] - 1.0
+            for _ in range(64):  # a lower bound: λ_m(lo) ≥ 0
+                if not below(lo):
+                    break
+                lo -= 2.0 * abs(lo) + 1.0
+            else:
+                return np.inf, None, None, None
+            start = lo
+        x = near if near is not None and lo < near < hi else start
+        for _ in range(100):  # Newton within the bracket [lo, hi] (λ_m decreasing in x), bisection where it leaves it
+            lam, step = newton(x)
+            lo, hi = (lo, x) if lam < 0 else (x, hi)
+            if abs(step) <= 1e-12 * abs(x):
+                break
+            x = x + step if lo < x + step < hi else 0.5 * (lo + hi)
+        width = 4e-13 * abs(x)  # a narrow bracket about the converged x, if it holds
+        if lo < x - width and not below(x - width):
+            lo = x - width
+        if x + width < hi and below(x + width):
+            hi = x + width
+        for _ in range(2100):  # bisection to adjacent doubles
+            mid = 0.5 * (lo + hi)
+            if mid <= lo or mid >= hi:
+                break
+            lo, hi = (lo, mid) if below(mid) else (mid, hi)
+        return self.eigenvector(hi, np.linalg.eigh(schur(hi)[0])[1][:, m])
 
 
 def root_without_each(E: np.ndarray, C: np.ndarray, root: int = 0) -> np.ndarray:
@@ -387,13 +391,13 @@ def root_without_each(E: np.ndarray, C: np.ndarray, root: int = 0) -> np.ndarray
     return hi
 
 
-def root_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10, root: int = 0) -> np.ndarray:
-    """`root_with_added` for k trials at once: rows H, S (k x nb), diagonals h_nn, s_nn (k); with
-    `root` > 0, eigenvalue `root` instead of the lowest (module docstring: the roots interlace)."""
+def roots_with_added_many(E, C, H, S, h_nn, s_nn, min_norm: float = 1e-10, roots: tuple = (0,)) -> np.ndarray:
+    """`roots_with_added` for k trials at once: rows H, S (k x nb), diagonals h_nn, s_nn (k);
+    k x len(roots) (module docstring: the roots interlace)."""
     c = np.ascontiguousarray
     E = c(E, dtype=float)
     C = c(np.asarray(C, dtype=float).reshape(-1, len(E)) if len(E) else np.zeros((0, 0)))
-    out = _core.root_with_added(E, C, c(H, dtype=float), c(S, dtype=float), c(h_nn, dtype=float),
-                                c(s_nn, dtype=float), float(min_norm), root)
+    out = _core.roots_with_added(E, C, c(H, dtype=float), c(S, dtype=float), c(h_nn, dtype=float),
+                                 c(s_nn, dtype=float), float(min_norm), [int(r) for r in roots])
     out[~np.isfinite(out)] = np.inf  # NaN elements (a near-singular trial) never win
     return out

@@ -130,10 +130,15 @@ class Representation:
             ok &= diag[:, 2] >= internal * diag[:, 1]
         return ok
 
+    @staticmethod
+    def diagonal(m: dict) -> np.ndarray:
+        """The diagonal [S, T, T_ti, V] of matrices `m`, one row per function (what `resolved` reads)."""
+        return np.stack([np.diag(m[k]) for k in ("S", "T", "T_ti", "V")], axis=1)
+
     def require_resolved(self, m: dict) -> None:
         """Refuse (CancellationError, naming the first such function) matrices `m` of a basis with a
         function whose elements lost their digits to cancellation (`resolved`)."""
-        diag = np.stack([np.diag(m[k]) for k in ("S", "T", "T_ti", "V")], axis=1)
+        diag = self.diagonal(m)
         bad = np.flatnonzero(~self.resolved(diag) & np.isfinite(diag).all(axis=1))  # NaN: eigen.solve's error
         if len(bad):
             i, total = int(bad[0]), np.abs(self.sym_c).sum()

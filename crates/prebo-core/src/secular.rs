@@ -10,13 +10,92 @@
 //! `(E_{r−1}, E_r]` (`E_{−1} = −∞`, `E_kept = +∞`). The lowest is found by Newton's method from
 //! the left (f is concave below `E_0`), any other from the middle of its bracket; bisection
 //! whenever a step leaves the bracket. Cost per trial: O(N_b · N_kept) for the two products,
-//! O(N_kept) per root iteration.
+//! formed once for every root asked of it, and O(N_kept) per root iteration.
 use rayon::prelude::*;
 
-/// Root `root` (0: the lowest) of the basis with one trial added; `f64::INFINITY` if the trial's
-/// orthogonal remainder is below `min_norm · s_nn`, NaN if `root` > `kept` (one trial adds one root).
+/// The secular function of one trial against the basis (module docstring): its couplings γ_k²
+/// and energy h' in the orthogonal complement, shared by every root asked of the trial.
+struct Secular<'a> {
+    e: &'a [f64],
+    gamma2: Vec<f64>,
+    hp: f64,
+}
+
+impl<'a> Secular<'a> {
+    /// The secular function of a trial; `None` if its orthogonal remainder is below
+    /// `min_norm · s_nn` or its elements are not finite (a near-singular trial).
+    #[allow(clippy::too_many_arguments)]
+    fn of(e: &'a [f64], c: &[f64], kept: usize, h: &[f64], s: &[f64], h_nn: f64, s_nn: f64, min_norm: f64) -> Option<Self> {
+        // d = C^T s, b = C^T h with C row-major nb x kept
+        let (mut d, mut b) = (vec![0.0; kept], vec![0.0; kept]);
+        for i in 0..h.len() {
+            let row = &c[i * kept..(i + 1) * kept];
+            let (si, hi) = (s[i], h[i]);
+            for k in 0..kept {
+                d[k] += row[k] * si;
+                b[k] += row[k] * hi;
+            }
+        }
+        let nu = s_nn - d.iter().map(|x| x * x).sum::<f64>();
+        if !(nu > min_norm * s_nn) {
+            return None;
+        }
+        let gamma2: Vec<f64> = (0..kept).map(|k| (b[k] - e[k] * d[k]).powi(2) / nu).collect();
+        let bd: f64 = (0..kept).map(|k| b[k] * d[k]).sum();
+        let edd: f64 = (0..kept).map(|k| e[k] * d[k] * d[k]).sum();
+        let hp = (h_nn - 2.0 * bd + edd) / nu;
+        if !hp.is_finite() || gamma2.iter().any(|g| !g.is_finite()) {
+            return None;
+        }
+        Some(Secular { e, gamma2, hp })
+    }
+
+    /// Root `root` of the secular equation, in its interlacing bracket.
+    fn root(&self, root: usize) -> f64 {
+        let (e, gamma2, hp, kept) = (self.e, &self.gamma2, self.hp, self.e.len());
+        let f = |x: f64| hp - x - (0..kept).map(|k| gamma2[k] / (e[k] - x)).sum::<f64>();
+        let reach = gamma2.iter().sum::<f64>().sqrt();
+        let (mut lo, mut hi) = if root == 0 { (f64::NEG_INFINITY, e[0]) } else if root < kept { (e[root - 1], e[root]) } else { (e[kept - 1], f64::INFINITY) };
+        if root == 0 {
+            lo = e[0].min(hp) - reach - 1e-3 * e[0].abs().max(1.0);
+            while f(lo) < 0.0 {
+                lo -= 2.0 * (e[0] - lo);
+            }
+        }
+        if root == kept {
+            let top = e[kept - 1];
+            hi = top.max(hp) + reach + 1e-3 * top.abs().max(1.0);
+            while f(hi) > 0.0 {
+                hi += 2.0 * (hi - top);
+            }
+        }
+        let mut x = if root == 0 { lo } else { 0.5 * (lo + hi) };
+        for _ in 0..200 {
+            let fx = f(x);
+            if fx == 0.0 || hi - lo < 1e-15 * x.abs().max(1.0) {
+                break;
+            }
+            if fx > 0.0 {
+                lo = x;
+            } else {
+                hi = x;
+            }
+            let df = -1.0 - (0..kept).map(|k| gamma2[k] / (e[k] - x).powi(2)).sum::<f64>();
+            let step = x - fx / df;
+            x = if lo < step && step < hi { step } else { 0.5 * (lo + hi) };
+            if step == x && fx.abs() < 1e-15 * x.abs().max(1.0) {
+                break;
+            }
+        }
+        x
+    }
+}
+
+/// The roots `roots` (0: the lowest) of the basis with one trial added, the products C^T s,
+/// C^T h formed once for all of them; each `f64::INFINITY` if the trial's orthogonal remainder is
+/// below `min_norm · s_nn`, NaN for a root above `kept` (one trial adds one root).
 #[allow(clippy::too_many_arguments)]
-pub fn root_with_added(
+pub fn roots_with_added(
     e: &[f64],
     c: &[f64],
     kept: usize,
@@ -25,76 +104,24 @@ pub fn root_with_added(
     h_nn: f64,
     s_nn: f64,
     min_norm: f64,
-    root: usize,
-) -> f64 {
-    let nb = h.len();
-    if root > kept {
-        return f64::NAN;
-    }
-    if kept == 0 {
-        return h_nn / s_nn;
-    }
-    // d = C^T s, b = C^T h with C row-major nb x kept
-    let (mut d, mut b) = (vec![0.0; kept], vec![0.0; kept]);
-    for i in 0..nb {
-        let row = &c[i * kept..(i + 1) * kept];
-        let (si, hi) = (s[i], h[i]);
-        for k in 0..kept {
-            d[k] += row[k] * si;
-            b[k] += row[k] * hi;
-        }
-    }
-    let nu = s_nn - d.iter().map(|x| x * x).sum::<f64>();
-    if !(nu > min_norm * s_nn) {
-        return f64::INFINITY;
-    }
-    let gamma2: Vec<f64> = (0..kept).map(|k| (b[k] - e[k] * d[k]).powi(2) / nu).collect();
-    let bd: f64 = (0..kept).map(|k| b[k] * d[k]).sum();
-    let edd: f64 = (0..kept).map(|k| e[k] * d[k] * d[k]).sum();
-    let hp = (h_nn - 2.0 * bd + edd) / nu;
-    if !hp.is_finite() || gamma2.iter().any(|g| !g.is_finite()) {
-        return f64::INFINITY; // NaN elements of a near-singular trial
-    }
-    let f = |x: f64| hp - x - (0..kept).map(|k| gamma2[k] / (e[k] - x)).sum::<f64>();
-    let reach = gamma2.iter().sum::<f64>().sqrt();
-    let (mut lo, mut hi) = if root == 0 { (f64::NEG_INFINITY, e[0]) } else if root < kept { (e[root - 1], e[root]) } else { (e[kept - 1], f64::INFINITY) };
-    if root == 0 {
-        lo = e[0].min(hp) - reach - 1e-3 * e[0].abs().max(1.0);
-        while f(lo) < 0.0 {
-            lo -= 2.0 * (e[0] - lo);
-        }
-    }
-    if root == kept {
-        let top = e[kept - 1];
-        hi = top.max(hp) + reach + 1e-3 * top.abs().max(1.0);
-        while f(hi) > 0.0 {
-            hi += 2.0 * (hi - top);
-        }
-    }
-    let mut x = if root == 0 { lo } else { 0.5 * (lo + hi) };
-    for _ in 0..200 {
-        let fx = f(x);
-        if fx == 0.0 || hi - lo < 1e-15 * x.abs().max(1.0) {
-            break;
-        }
-        if fx > 0.0 {
-            lo = x;
-        } else {
-            hi = x;
-        }
-        let df = -1.0 - (0..kept).map(|k| gamma2[k] / (e[k] - x).powi(2)).sum::<f64>();
-        let step = x - fx / df;
-        x = if lo < step && step < hi { step } else { 0.5 * (lo + hi) };
-        if step == x && fx.abs() < 1e-15 * x.abs().max(1.0) {
-            break;
-        }
-    }
-    x
+    roots: &[usize],
+) -> Vec<f64> {
+    let secular = if kept > 0 && roots.iter().any(|&r| r <= kept) { Secular::of(e, c, kept, h, s, h_nn, s_nn, min_norm) } else { None };
+    roots
+        .iter()
+        .map(|&r| match (&secular, r) {
+            (_, r) if r > kept => f64::NAN,
+            (_, _) if kept == 0 => h_nn / s_nn,
+            (Some(sec), r) => sec.root(r),
+            (None, _) => f64::INFINITY,
+        })
+        .collect()
 }
 
-/// `root_with_added` for `k` trials (rows `h`, `s` row-major k x nb), in parallel.
+/// `roots_with_added` for `k` trials (rows `h`, `s` row-major k x nb), in parallel: row-major
+/// k x roots.
 #[allow(clippy::too_many_arguments)]
-pub fn root_with_added_many(
+pub fn roots_with_added_many(
     e: &[f64],
     c: &[f64],
     kept: usize,
@@ -103,14 +130,14 @@ pub fn root_with_added_many(
     h_nn: &[f64],
     s_nn: &[f64],
     min_norm: f64,
-    root: usize,
+    roots: &[usize],
 ) -> Vec<f64> {
     let k = h_nn.len();
     let nb = if k == 0 { 0 } else { h.len() / k };
     (0..k)
         .into_par_iter()
-        .map(|t| {
-            root_with_added(e, c, kept, &h[t * nb..(t + 1) * nb], &s[t * nb..(t + 1) * nb], h_nn[t], s_nn[t], min_norm, root)
+        .flat_map_iter(|t| {
+            roots_with_added(e, c, kept, &h[t * nb..(t + 1) * nb], &s[t * nb..(t + 1) * nb], h_nn[t], s_nn[t], min_norm, roots)
         })
         .collect()
 }
@@ -121,7 +148,7 @@ mod tests {
 
     /// A 4-function pencil (H, S) and its generalised eigenpairs by a dense solve of the 3 leading
     /// functions, the 4th as the trial: every root of the secular equation equals the dense
-    /// solve's eigenvalue of the whole pencil.
+    /// solve's eigenvalue of the whole pencil, and every root asked in one call is the root asked alone.
     #[test]
     fn every_root_matches_the_dense_solve() {
         // S = B^T B (positive definite), H symmetric; functions: 3 in the basis, 1 trial
@@ -137,8 +164,10 @@ mod tests {
         let (e4, _) = dense(&h, &s, 4);
         let row_h: Vec<f64> = (0..3).map(|i| h[3][i]).collect();
         let row_s: Vec<f64> = (0..3).map(|i| s[3][i]).collect();
+        let all = roots_with_added(&e3, &c3, 3, &row_h, &row_s, h[3][3], s[3][3], 1e-12, &[0, 1, 2, 3, 4]);
         for (r, want) in e4.iter().enumerate() {
-            let got = root_with_added(&e3, &c3, 3, &row_h, &row_s, h[3][3], s[3][3], 1e-12, r);
+            let got = all[r];
+            assert_eq!(got, roots_with_added(&e3, &c3, 3, &row_h, &row_s, h[3][3], s[3][3], 1e-12, &[r])[0]);
             assert!((got - want).abs() < 1e-12 * want.abs().max(1.0), "root {r}: {got} vs {want}");
             if r > 0 {
                 assert!(e3[r - 1] <= got, "root {r} below E_{}", r - 1);
@@ -147,7 +176,7 @@ mod tests {
                 assert!(got <= e3[r], "root {r} above E_{r}");
             }
         }
-        assert!(root_with_added(&e3, &c3, 3, &row_h, &row_s, h[3][3], s[3][3], 1e-12, 4).is_nan());
+        assert!(all[4].is_nan());
     }
 
     /// Eigenvalues (ascending) and S-orthonormal eigenvectors (row-major n x n) of the leading

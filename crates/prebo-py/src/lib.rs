@@ -147,13 +147,13 @@ impl Engine {
     }
 }
 
-/// Eigenvalue `root` (0: the lowest) after adding each of k trials (secular equation,
+/// Eigenvalues `roots` (0: the lowest) after adding each of k trials (secular equation,
 /// prebo_core::secular): `e` (kept), `c` (nb x kept, S-orthonormal columns), rows `h`, `s`
-/// (k x nb), diagonals (k).
+/// (k x nb), diagonals (k); k x len(roots).
 #[pyfunction]
-#[pyo3(signature = (e, c, h, s, h_nn, s_nn, min_norm, root=0))]
+#[pyo3(signature = (e, c, h, s, h_nn, s_nn, min_norm, roots))]
 #[allow(clippy::too_many_arguments)]
-fn root_with_added<'py>(
+fn roots_with_added<'py>(
     py: Python<'py>,
     e: &Bound<'py, PyAny>,
     c: &Bound<'py, PyAny>,
@@ -162,8 +162,8 @@ fn root_with_added<'py>(
     h_nn: &Bound<'py, PyAny>,
     s_nn: &Bound<'py, PyAny>,
     min_norm: f64,
-    root: usize,
-) -> Result<Bound<'py, PyArray1<f64>>> {
+    roots: Vec<usize>,
+) -> Result<Bound<'py, PyArray2<f64>>> {
     let (e, c) = (floats(e, "e")?, floats(c, "c")?);
     let kept = e.len();
     let (h, s) = (floats(h, "h")?, floats(s, "s")?);
@@ -175,9 +175,9 @@ fn root_with_added<'py>(
         return Err(ShapeError::new_err("eigenvectors do not fit the rows").into());
     }
     let out = py.allow_threads(|| {
-        prebo_core::secular::root_with_added_many(&e, &c, kept, &h, &s, &hn, &sn, min_norm, root)
+        prebo_core::secular::roots_with_added_many(&e, &c, kept, &h, &s, &hn, &sn, min_norm, &roots)
     });
-    Ok(numpy::ndarray::Array1::from_vec(out).into_pyarray(py))
+    Ok(numpy::ndarray::Array2::from_shape_vec((hn.len(), roots.len()), out).expect("k x roots").into_pyarray(py))
 }
 
 /// H, S (nb x nb) and the eigenvalues e (kept) and eigenvectors c (nb x kept) of a
@@ -259,7 +259,7 @@ fn num_threads() -> usize {
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Engine>()?;
-    m.add_function(wrap_pyfunction!(root_with_added, m)?)?;
+    m.add_function(wrap_pyfunction!(roots_with_added, m)?)?;
     m.add_function(wrap_pyfunction!(refine_eigenpairs, m)?)?;
     m.add_function(wrap_pyfunction!(inverse_iteration, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;

@@ -292,6 +292,14 @@ class Adaptive:
         rates = self.rates()
         return max((("grow",) if growing else ()) + self.kinds(nb), key=rates.get)
 
+    def progress(self, cursor: Cursor, nb: int) -> tuple[str, int, int]:
+        """(description, done, total) of the progress line: functions grown, or functions visited
+        in the pass (one step for a whole-basis pass)."""
+        if cursor.phase == "grow":
+            return "growing", nb, self.opts.size
+        done, total = (cursor.sweep + 1, min(CHUNK, nb)) if cursor.phase not in ("polish", "prune", "momentum") else (1, 1)
+        return f"{cursor.phase} (pass {cursor.cycle + 1})", done, total
+
     def to_dict(self) -> dict:
         """The checkpoint's "schedule" block (a pass as the list of its fields)."""
         return {"passes": self.passes, "start": self.start, "next": self.next, "stalled": self.stalled,

@@ -94,14 +94,15 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     sampler = Sampler(system, opts, rng)
     rep = laboratory(system)
     threshold = lowest_threshold(system).energy
-    objective, followed = Levels(targets, weights, threshold=threshold), []
+    start, followed = Levels(targets, weights, threshold=threshold), []  # the levels at their targets
+    objective = start
     if resume is None:
         basis, history, elapsed, schedule, stopped = Basis.empty(system, opts.kind), [], 0.0, schedule_of(opts), None
         cursor = schedule.first()
     else:
         basis, cursor, history, elapsed, schedule, stopped = resumed(resume, opts, rng, "checkpoint")
         roots, followed = followed_roots(resume, targets, "checkpoint")
-        objective = objective.to(roots)
+        objective = start.to(roots)
     if out is not None:
         remove_stale_temporaries(Path(out) / CHECKPOINT)
         remove_stale_temporaries(Path(out) / LOWEST)
@@ -153,7 +154,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                 ex.followed = None
             if ex.energy < old:
                 history.append(Step(len(ex.basis), ex.energy, cursor.phase, wall()))
-                run.report.step(ex, old, cursor)
+                run.report.step(ex, old, cursor, schedule)
                 sampler.learn(ex.basis)  # a function of the basis alone, so a resumed run learns the same
             cursor = schedule.advance(cursor, len(ex.basis), ex.energy, wall())
             if cursor.phase == "done":
@@ -162,7 +163,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
             fresh = schedule.restart(phase, len(ex.basis), ground, threshold - ex.sigma)
             if fresh is not None:  # a fresh start (adaptive.py)
                 schedule, cursor, stopped = fresh, fresh.first(), None
-                ex = run.expansion = expansion(Basis.empty(system, opts.kind), Levels(targets, weights, threshold=threshold))
+                ex = run.expansion = expansion(Basis.empty(system, opts.kind), start)
                 run.momentum = Momentum()
                 sampler.learn(ex.basis)
             lowest.see(ex)  # first: a run killed between the two writes keeps its lowest state

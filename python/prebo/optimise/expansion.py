@@ -146,8 +146,7 @@ class Expansion:
         (trials, refinements and joint steps are: Representation.plausible), is what could have
         carried a function where the symmetriser nearly annihilates it into a He 2³S run with 150
         functions, whose result was then refused."""
-        diag = np.stack([np.diag(self.m[k]) for k in ("S", "T", "T_ti", "V")], axis=1)
-        return bool(self.rep.resolved(diag).all())
+        return bool(self.rep.resolved(self.rep.diagonal(self.m)).all())
 
     def without(self, i):
         """The eigen-solution of the basis without function i, or without the functions of the

@@ -85,6 +85,18 @@ class Fixed:
         """No rates are measured."""
         return None
 
+    def progress(self, cursor: Cursor, nb: int) -> tuple[str, int, int]:
+        """(description, done, total) of the progress line: functions grown, pruned again past the
+        size, joint steps, or functions visited in a sweep."""
+        opts, cycle = self.opts, cursor.cycle + 1
+        if cursor.phase == "grow":
+            return "growing", nb, opts.size
+        if cursor.phase == "prune":  # growth past the size: the functions to be pruned again
+            return f"prune (cycle {cycle})", nb - opts.size, opts.prune
+        if cursor.phase == "polish":
+            return f"polish (cycle {cycle})", cursor.sweep + 1, opts.polish
+        return f"{cursor.phase} {cursor.sweep + 1} (cycle {cycle})", cursor.index + 1, nb
+
     def to_dict(self) -> dict:
         """The checkpoint's "schedule" block (IDLE)."""
         return IDLE

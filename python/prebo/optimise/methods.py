@@ -5,7 +5,7 @@ phase of the cursor names the method (`methods`).
 - `Grow`: competitive selection (Suzuki & Varga, Lect. Notes Phys. m54, ch. 4, the stochastic
   variational method): `trials` random functions, each one's row against the basis from the
   core (O(N_b) integrals) and the new lowest eigenvalue from the secular equation (O(N_b^2),
-  eigen.root_with_added_many); the best, if it lowers the energy beyond its uncertainty, is
+  eigen.roots_with_added_many); the best, if it lowers the energy beyond its uncertainty, is
   appended — with a `newcomer` Minimiser, refined first.
 - `Replace` ("sweep"): one step of a replacement sweep: function i competes with `trials` replacements in the
   basis without it — its neighbours in the power K (Sampler.neighbours: K ± 1, K ± 2 with the

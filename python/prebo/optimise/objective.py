@@ -110,32 +110,41 @@ class Levels:
 
     def with_added(self, E, C, h, s, h_nn, s_nn, min_norm: float) -> float:
         """The objective with one function of rows h, s and diagonal h_nn, s_nn added
-        (eigen.root_with_added per root; the roots the grown basis holds, module docstring)."""
-        return sum(w * eigen.root_with_added(E, C, h, s, h_nn, s_nn, min_norm, r) for r, w in self.held(len(E) + 1))
+        (eigen.roots_with_added; the roots the grown basis holds, module docstring)."""
+        held = self.held(len(E) + 1)
+        e = eigen.roots_with_added(E, C, h, s, h_nn, s_nn, min_norm, [r for r, _ in held])
+        return float(sum(w * e_r for (_, w), e_r in zip(held, e)))
 
     def with_added_gradient(self, E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float):
-        """`with_added` and its gradient along the function's parameters (eigen.root_with_added_gradient)."""
-        e, g = 0.0, 0.0
-        for r, w in self.held(len(E) + 1):
-            e_r, g_r = eigen.root_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm, r)
-            e, g = e + w * e_r, g + w * g_r
-        return e, g
+        """`with_added` and its gradient along the function's parameters (eigen.roots_with_added_gradient)."""
+        held = self.held(len(E) + 1)
+        e, g = eigen.roots_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm,
+                                               [r for r, _ in held])
+        e_sum, g_sum = 0.0, 0.0
+        for (_, w), e_r, g_r in zip(held, e, g):
+            e_sum, g_sum = e_sum + w * e_r, g_sum + w * g_r
+        return float(e_sum), g_sum
 
     def with_added_many(self, E, C, H, S, h_nn, s_nn, min_norm: float) -> np.ndarray:
-        """`with_added` for each of many functions, rows H, S (eigen.root_with_added_many): the sum
+        """`with_added` for each of many functions, rows H, S (eigen.roots_with_added_many): the sum
         over the targeted roots the grown basis holds (module docstring)."""
+        held = self.held(len(E) + 1)
+        e = eigen.roots_with_added_many(E, C, H, S, h_nn, s_nn, min_norm, [r for r, _ in held])
         total = np.zeros(len(H))
-        for r, w in self.held(len(E) + 1):
-            total += w * eigen.root_with_added_many(E, C, H, S, h_nn, s_nn, min_norm, r)
+        for (_, w), e_r in zip(held, e.T):
+            total += w * e_r
         return total
 
-    def with_block(self, E, C, h, s, H_ff, S_ff, min_norm: float, near: float | None = None):
-        """The objective with a block of functions added (eigen.root_with_block per root), and for
-        each level (weight, e, a, β, c^T S c), its eigenvector (C a, β); (inf, []) where a root is
-        not lowered or the block is linearly dependent."""
+    def with_block(self, E, C, h, s, H_ff, S_ff, min_norm: float, near: np.ndarray | None = None):
+        """The objective with a block of functions added (eigen.roots_with_block), and for each
+        level (weight, e, a, β, c^T S c), its eigenvector (C a, β); (inf, []) where a root is not
+        lowered or the block is linearly dependent. `near`: the eigenvalues before the block
+        changed, where each root's search starts."""
+        held = self.held(len(E) + len(H_ff))
+        starts = [near[r] if near is not None and r < len(near) else None for r, _ in held]
+        found = eigen.roots_with_block(E, C, h, s, H_ff, S_ff, min_norm, starts, [r for r, _ in held])
         total, parts = 0.0, []
-        for r, w in self.held(len(E) + len(H_ff)):
-            e, a, beta, norm2 = eigen.root_with_block(E, C, h, s, H_ff, S_ff, min_norm, near if self.lowest else None, r)
+        for (_, w), (e, a, beta, norm2) in zip(held, found):
             if not np.isfinite(e):
                 return np.inf, []
             total, parts = total + w * e, parts + [(w, e, a, beta, norm2)]

@@ -3,16 +3,16 @@ Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018), Sec. IV.E).
 
 The function moves in its parameters θ (parametrisation.py). The energy of a trial θ is the
 objective (objective.py: the lowest root, or a weighted sum of roots) of the secular equation
-(eigen.root_with_added)
+(eigen.roots_with_added)
 against the basis without the function: one row of integrals and O(N_b^2) per evaluation.
 
 Two minimisers: Powell's method on the energy (the paper's), and L-BFGS on the energy and its
 exact gradient — the row's derivatives along ∂(A, u or s)/∂θ_p by forward-mode dual numbers
-in the Rust core (Representation.row_gradient), then eigen.root_with_added_gradient.
+in the Rust core (Representation.row_gradient), then eigen.roots_with_added_gradient.
 
 A group (`refine_group`): function i and the functions it overlaps most (`partners`) move
 together, L-BFGS on all their θ, the energy the root of the block update against the basis
-without them (eigen.root_with_block). Strongly overlapping functions of an optimised
+without them (eigen.roots_with_block). Strongly overlapping functions of an optimised
 basis act together (a near-duplicate pair is a derivative of a Gaussian): moved one at a time,
 each is held by the other.
 """
@@ -146,7 +146,7 @@ class GroupEnergy:
                         B[m, o] = B[o, m] = X[m][0][key][0, nr + c]
             block[key] = B
         total, levels = st.objective.with_block(self.E, self.C, h, s, block["H"], block["S"], st.min_norm,
-                                                near=st.energy)
+                                                near=st.eig.energies)
         if not np.isfinite(total):
             return self.worse, np.zeros_like(theta)
         grad = 0.0

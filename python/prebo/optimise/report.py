@@ -6,7 +6,6 @@ import time
 
 import numpy as np
 
-from .adaptive import CHUNK
 from .cursor import Cursor
 from .expansion import Expansion
 from .settings import Optimiser
@@ -44,8 +43,9 @@ class Reporter:
         if self.progress is not None:
             self.progress.console.print(f"levels followed by overlap: roots {list(before)} → {list(after)}")
 
-    def step(self, st: Expansion, old: float, cursor: Cursor) -> None:
-        """Show the expansion after a step that lowered the energy from `old`."""
+    def step(self, st: Expansion, old: float, cursor: Cursor, schedule) -> None:
+        """Show the expansion after a step at `cursor` of `schedule` (schedule.Schedule) that lowered
+        the energy from `old`."""
         if self.progress is None:
             return
         rate = self.n_trials / max(time.perf_counter() - self.t0, 1e-9)
@@ -55,20 +55,5 @@ class Reporter:
         else:  # each targeted level, then the change of the objective Σ w_k E_k
             energy = "  ".join(f"E_{lv.root} = {lv.E:.12f}" for lv in st.objective.levels(st.eig))
         info = f"{energy}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.1f} trials/s"
-        if cursor.phase == "grow":
-            self.progress.update(self.task, description="growing", completed=len(st.basis), total=self.opts.size,
-                                 info=info)
-        elif self.opts.adaptive:
-            done, total = (cursor.sweep + 1, min(CHUNK, len(st.basis))) if cursor.phase not in ("polish", "prune", "momentum") \
-                else (1, 1)
-            self.progress.update(self.task, description=f"{cursor.phase} (pass {cursor.cycle + 1})", completed=done,
-                                 total=total, info=info)
-        elif cursor.phase == "prune":  # growth past the size: the functions to be pruned again
-            self.progress.update(self.task, description=f"prune (cycle {cursor.cycle + 1})",
-                                 completed=len(st.basis) - self.opts.size, total=self.opts.prune, info=info)
-        elif cursor.phase == "polish":
-            self.progress.update(self.task, description=f"polish (cycle {cursor.cycle + 1})", completed=cursor.sweep + 1, total=self.opts.polish,
-                                 info=info)
-        else:
-            self.progress.update(self.task, description=f"{cursor.phase} {cursor.sweep + 1} (cycle {cursor.cycle + 1})",
-                                 completed=cursor.index + 1, total=len(st.basis), info=info)
+        description, done, total = schedule.progress(cursor, len(st.basis))
+        self.progress.update(self.task, description=description, completed=done, total=total, info=info)

@@ -43,6 +43,10 @@ class Schedule(Protocol):
     def advantage(self, nb: int) -> float | None:
         """The convergence report's "advantage" (convergence.py) at `nb` functions."""
 
+    def progress(self, cursor: Cursor, nb: int) -> tuple[str, int, int]:
+        """The progress line's (description, done, total) of the unit of work at `cursor` on a basis
+        of `nb` functions (report.Reporter)."""
+
     def to_dict(self) -> dict:
         """The checkpoint's "schedule" block."""
 
