@@ -169,6 +169,36 @@ def test_block_roots_below_the_basis_lowest_equal_the_full_solve():
         c = np.concatenate([base.vectors @ a, beta])
         assert np.allclose(H @ c, e * S @ c, atol=1e-8 * np.sqrt(norm2))
 
+
+def test_a_block_root_at_a_decoupled_pole_is_found_without_evaluating_the_pole():
+    """Root 1 of a block that does not couple to the basis's eigenvector 0 (|D|, |B| ~ 1e-16: the
+    H2⁺ N = 1 growth of session 30, where roots 0 and 1 of the basis were degenerate) lies at the
+    pole E_0 itself: Newton's method from the bracket (E_0, E_1) walks down to it and, the bracket
+    down to adjacent doubles, stops there instead of evaluating M at the pole (which failed with
+    "Eigenvalues did not converge") and returns that eigenvalue and eigenvector; root 0 lies
+    below, from the block."""
+    E = np.array([-0.4241688756700338, 0.3563764008238357, 18.43415780833227, 32.65939824163085, 52.481723732873654])
+    D = np.array([[-3.0305248997330683e-16, 0.10108217704915519, -0.17859746406168334, 0.0017532754031652832, -0.00716857196533346],
+                  [-9.014130001409275e-17, 0.029657513811786624, -0.42710148038802553, 0.016274989555748083, -0.08959547016346289],
+                  [6.485480895999697e-16, -0.21634284560202577, 0.03405444107153875, 0.0003868069493189397, -0.006459683966661972]])
+    B = np.array([[2.1071921865903758e-16, -0.06841149047819475, 0.5316019105621892, -0.05933168212840087, 0.4093550238492213],
+                  [1.5301868945738982e-16, -0.051237766010891216, -0.7213751993538176, 0.02065993825869566, 0.5095917371911268],
+                  [8.209883574377946e-17, -0.027658539053337938, -0.13820272424265562, 0.00970672104411533, -0.03449808954005403]])
+    H_ff = np.array([[-0.8234839572102332, -0.7924297811549881, 0.31606955389914426],
+                     [-0.7924297811549881, 1.037256339535113, 0.20435397469741587],
+                     [0.31606955389914426, 0.20435397469741587, 0.09325231093193757]])
+    S_ff = np.array([[1.5528358577184154, 0.7628248637047491, -0.4649324996184854],
+                     [0.7628248637047491, 1.0168886228185388, -0.1194779537409077],
+                     [-0.4649324996184854, -0.1194779537409077, 1.9517993077002989]])
+    H = np.block([[np.diag(E), B.T], [B, H_ff]])  # the basis in its S-orthonormal eigenvectors (C = 1)
+    S = np.block([[np.eye(5), D.T], [D, S_ff]])
+    full = scipy.linalg.eigh(H, S, eigvals_only=True)
+    found = eigen.roots_with_block(E, np.eye(5), B, D, H_ff, S_ff, near=[E[0], E[0]], roots=(0, 1))
+    assert found[0][0] == pytest.approx(full[0], rel=1e-12)
+    e, a, beta, norm2 = found[1]
+    assert e == pytest.approx(full[1], rel=1e-12) and e == E[0]  # eigenvector 0 of the basis, untouched
+    assert np.array_equal(a, np.eye(5)[0]) and not beta.any() and norm2 == 1.0
+
 def test_rows_from_core_agree_with_matrices(problem):
     _, basis, rep, m = problem
     rows, diag = rep.rows(basis.subset([3, 4]), basis)

@@ -315,7 +315,8 @@ class _Block:
         E_j exceeds `root` (the count is continuous across a pole), where λ_m, m = root - j, crosses
         zero. Newton's method on λ_m (from `near`, else the bracket's left end below E_0 or its
         middle), kept inside the bracket, finished by bisection to adjacent doubles; its eigenvector
-        is M's m-th at the root."""
+        is M's m-th at the root. A root the search pins to the pole E_{j-1} (a basis eigenvector the
+        block does not couple to) is that eigenvalue, with that eigenvector."""
         E, S_ff = self.E, self.S_ff
         if len(E) == 0:  # nothing else in the basis: the k x k problem itself (S_ff positive definite)
             w, V = scipy.linalg.eigh(self.H_ff, S_ff)
@@ -341,7 +342,7 @@ class _Block:
         hi = np.nextafter(E[j], -np.inf)
         if j > 0:  # the pole itself bounds the bracket; it is never evaluated
             lo = E[j - 1]
-            start = 0.5 * (lo + hi)
+            start = 0.5 * (lo + hi) if lo < 0.5 * (lo + hi) else hi
         else:
             lo = E[0] - 1.0
             for _ in range(64):  # a lower bound: λ_m(lo) ≥ 0
@@ -358,6 +359,8 @@ class _Block:
             if abs(step) <= 1e-12 * abs(x):
                 break
             x = x + step if lo < x + step < hi else 0.5 * (lo + hi)
+            if not lo < x < hi:  # the bracket is down to adjacent doubles (lo may be a pole)
+                break
         width = 4e-13 * abs(x)  # a narrow bracket about the converged x, if it holds
         if lo < x - width and not below(x - width):
             lo = x - width
@@ -368,6 +371,8 @@ class _Block:
             if mid <= lo or mid >= hi:
                 break
             lo, hi = (lo, mid) if below(mid) else (mid, hi)
+        if j > 0 and lo == E[j - 1]:  # the root is the pole: eigenvector j - 1, which the block does not couple to
+            return float(lo), np.eye(len(E))[j - 1], np.zeros(len(S_ff)), 1.0
         return self.eigenvector(hi, np.linalg.eigh(schur(hi)[0])[1][:, m])
 
 
