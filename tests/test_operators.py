@@ -19,6 +19,7 @@ import pytest
 from numpy.polynomial.hermite import hermgauss
 
 import prebo
+from prebo.expectation import OPERATORS
 from prebo.integrals import laboratory, translationally_invariant
 
 from conftest import ROOT, random_centres, random_pair_A
@@ -120,17 +121,19 @@ def test_r2_elements_against_quadrature(kind, n, N):
             assert abs(got[k, I, J] - ref) <= 1e-12 * scale, (kind, pairs[k], I, J, got[k, I, J], ref)
 
 
+@pytest.mark.parametrize("name", sorted(OPERATORS))
 @pytest.mark.parametrize("kind", ["pecg", "ecg-gvr", "fecg"])
-def test_r2_is_the_same_in_lfcc_and_ticc(kind):
+def test_every_operator_is_the_same_in_lfcc_and_ticc(kind, name):
     """One shared c_A (and c_U = 0, μᵀs = 0): the CM Gaussian cancels, so the laboratory-frame
-    matrices equal those in Jacobi coordinates, for three particles with two identical ones."""
+    matrices of every registered operator equal those in Jacobi coordinates, for three particles
+    with two identical ones."""
     e, p = _p("e", 1.0, -1.0), _p("p", 1836.15267343, 1.0)
     system = prebo.System([p, p, e], state=prebo.State(N=0, parity=1))
     basis = family_basis(kind, system, np.random.default_rng(3), nb=4, shared_c_A=0.9, cm_free=True)
     w = np.array([[1.0, -1.0, 0.0], [1.0, 0.0, -1.0], [0.0, 1.0, -1.0]])
-    lab = laboratory(system).operator("r2", basis, w)
-    ti = translationally_invariant(system).operator("r2", basis, w)
-    assert np.max(np.abs(lab - ti)) <= 1e-12 * np.max(np.abs(lab))
+    lab = laboratory(system).operator(name, basis, w)
+    ti = translationally_invariant(system).operator(name, basis, w)
+    assert np.max(np.abs(lab - ti)) <= 1e-12 * np.max(np.abs(lab)), np.max(np.abs(lab - ti)) / np.max(np.abs(lab))
     assert np.max(np.abs(lab[0] - lab[0].T)) <= 1e-13 * np.max(np.abs(lab[0]))
 
 

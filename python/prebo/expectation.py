@@ -44,7 +44,12 @@ class PairOperator:
 
 
 OPERATORS: dict[str, PairOperator] = {
+    "r": PairOperator("r", "bohr", "⟨r_ij⟩, the mean distance of particles i and j"),
     "r2": PairOperator("r2", "bohr²", "⟨r_ij²⟩, the mean square distance of particles i and j"),
+    "inv_r": PairOperator("inv_r", "bohr⁻¹", "⟨1/r_ij⟩, the mean inverse distance of particles i and j"),
+    "inv_r2": PairOperator("inv_r2", "bohr⁻²", "⟨1/r_ij²⟩, the mean inverse square distance of particles i and j"),
+    "delta": PairOperator("delta", "bohr⁻³", "⟨δ³(r_ij)⟩, the density of particles i and j at one point "
+                                             "(direct: converges slowly in Gaussians, which lack the cusp)"),
 }
 
 

@@ -165,6 +165,16 @@ pub fn check(len: usize, want: usize, what: &str) -> Result<()> {
     }
 }
 
+/// How the profile `F(u)` of a damped overlap depends on `u` (`operators::profile`): what the
+/// expectation values of `δ(r_w)` and of the powers of `|r_w|` need to know of a family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// A polynomial of this degree (plain ECGs 0, ECG-GVR `K_I + K_J + N`).
+    Polynomial(usize),
+    /// `exp(−λ u)` (floating ECGs, `λ = |w^T r̄|²/q`).
+    Exponential,
+}
+
 /// Symmetry operations `(T, c_P)`: `phi -> phi(T r)` with Young-operator coefficient `c_P`.
 pub type Symmetry<const D: usize> = [(Mat<D>, f64)];
 
@@ -218,6 +228,12 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// of an overlap that generates Gaussian-weighted operators (e.g. `r_w²` as `-∂/∂α` of the
     /// overlap at `M = α w w^T`). Only its overlaps (`overlap`) are meaningful.
     fn damped<T: Real>(f: &Self::Function<f64>, m: &SMatrix<T, D, D>) -> Self::Function<T>;
+
+    /// The Gaussian exponent `A` of `f`, `exp(−r^T (A ⊗ I_3) r)` (the representation's coordinates).
+    fn exponent(f: &Self::Function<f64>) -> &Mat<D>;
+
+    /// How the damped overlap of `bra` and `ket` depends on the damping (`Shape`).
+    fn shape(bra: &Self::Function<f64>, ket: &Self::Function<f64>, ctx: &Self::Context) -> Shape;
 
     /// The symmetrised matrices of a basis (`path::matrices`, or the family's kernel).
     fn matrices(ctx: &Self::Context, sym: &Symmetry<D>, basis: &Self::Params<'_>) -> Result<Matrices>;

@@ -2,14 +2,20 @@
 //! the CM part (`T`, `T_TI`) and the Coulomb potential — are evaluated together by each family's
 //! element (one pass over the shared `A_I + A_J` factorisation). Every further operator is one
 //! module here with an element function generic over the family, built from the family's
-//! primitives (`Family::overlap`, `Family::damped`, `Family::element`), and one line in
-//! `registry`; `path::operator` symmetrises it and the binding exposes it by name
+//! primitives (`Family::overlap`, `Family::damped`, `Family::element`; for the operators of one
+//! pair vector beyond r², the damped overlap's profile in `profile`, which needs of a family only
+//! its exponent and the `Shape` of that profile), and one line in `registry`; `path::operator` symmetrises it and the binding exposes it by name
 //! (`Engine.operator(name, params, w)`).
 use crate::ecg::Vector;
 use crate::error::{CoreError, Result};
 use crate::families::plain::PlainEcg;
 use crate::families::Family;
 
+pub mod delta;
+pub mod distance;
+pub mod inverse;
+pub mod inverse_square;
+pub mod profile;
 pub mod r2;
 
 /// `<phi_I| O(w) |phi_J>` for normalised functions of family `F` and one operator vector `w`
@@ -23,7 +29,13 @@ pub type ElementFn<const D: usize, F> = fn(
 
 /// The registered operators: name and element function.
 fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, ElementFn<D, F>)> {
-    vec![(r2::NAME, r2::element::<D, F>)]
+    vec![
+        (r2::NAME, r2::element::<D, F>),
+        (distance::NAME, distance::element::<D, F>),
+        (inverse::NAME, inverse::element::<D, F>),
+        (inverse_square::NAME, inverse_square::element::<D, F>),
+        (delta::NAME, delta::element::<D, F>),
+    ]
 }
 
 /// The names of the registered operators.
@@ -38,4 +50,32 @@ pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<ElementFn<D, F
         .find(|(n, _)| *n == name)
         .map(|(_, f)| f)
         .ok_or_else(|| CoreError::Unsupported(format!("operator {name:?} (registered: {:?})", names())))
+}
+
+/// What the operators' tests share: three coordinates, random exponents, the pair vector `e_1 − e_2`.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use crate::ecg::{Mat, Operators, Vector};
+
+    pub const D: usize = 3;
+
+    /// A positive-definite exponent `L Lᵀ + 0.3` with `L` lower-triangular, varied by `seed`.
+    pub fn exponent(seed: f64) -> Mat<D> {
+        let l = Mat::<D>::from_fn(|i, j| if j <= i { ((i * 3 + j) as f64 * 0.7 + seed).sin() } else { 0.0 });
+        l * l.transpose() + Mat::<D>::identity() * 0.3
+    }
+
+    /// Kinetic `Λ = ½` and the Coulomb `pairs`.
+    pub fn operators(pairs: Vec<(Vector<D>, f64)>) -> Operators<D> {
+        Operators { lambda: Mat::<D>::identity() * 0.5, pairs, cm_mass: None }
+    }
+
+    pub fn w() -> Vector<D> {
+        Vector::<D>::new(1.0, -1.0, 0.0)
+    }
+
+    /// `got` within `tol` of `want`, relative.
+    pub fn close(got: f64, want: f64, tol: f64) -> bool {
+        (got - want).abs() <= tol * want.abs()
+    }
 }

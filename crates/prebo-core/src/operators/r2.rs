@@ -31,30 +31,16 @@ mod tests {
     //! the Gaussian second moment `(3/2 wᵀB⁻¹w + |wᵀr̄|²) S_IJ`; ECG-GVR at K = N = 0 equal to
     //! plain ECGs, and for K, N > 0 against central differences of the damped overlap in α.
     use super::*;
-    use crate::ecg::{Gaussian, Mat, Operators};
+    use crate::ecg::Gaussian;
     use crate::families::floating::fecg::{self, Centres, Fecg};
     use crate::families::floating::FloatingEcg;
     use crate::families::gvr::gvr_element::{Gvr, GvrOps};
     use crate::families::gvr::EcgGvr;
     use crate::families::plain::{pecg, PlainEcg};
+    use crate::operators::fixtures::{close, exponent, w, D};
 
-    const D: usize = 3;
-
-    fn exponent(seed: f64) -> Mat<D> {
-        let l = Mat::<D>::from_fn(|i, j| if j <= i { ((i * 3 + j) as f64 * 0.7 + seed).sin() } else { 0.0 });
-        l * l.transpose() + Mat::<D>::identity() * 0.3
-    }
-
-    fn operators() -> Operators<D> {
-        Operators { lambda: Mat::<D>::identity() * 0.5, pairs: vec![], cm_mass: None }
-    }
-
-    fn w() -> Vector<D> {
-        Vector::<D>::new(1.0, -1.0, 0.0)
-    }
-
-    fn close(a: f64, b: f64, tol: f64) -> bool {
-        (a - b).abs() <= tol * b.abs()
+    fn operators() -> crate::ecg::Operators<D> {
+        crate::operators::fixtures::operators(vec![])
     }
 
     #[test]

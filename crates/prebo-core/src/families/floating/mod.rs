@@ -11,7 +11,7 @@ use nalgebra::SMatrix;
 use crate::cache::Cache;
 use crate::ecg::{re, Element, Mat, Operators, Real};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Symmetry};
+use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::matrices::Matrices;
 use crate::path;
@@ -59,6 +59,14 @@ impl<const D: usize> Family<D> for FloatingEcg {
     fn seeded<const W: usize>(f: &Fecg<D>, da: &[Mat<D>], ds: &[f64], _: &Operators<D>) -> Result<Fecg<D, Dual<W>>> {
         let ds: Vec<Centres<D>> = matrices_of::<D, 3>(ds, da.len(), "centre directions")?;
         Fecg::new(seed_matrix(&f.a, da), seed_matrix(&f.s, &ds), f.c_a, 0)
+    }
+
+    fn exponent(f: &Fecg<D>) -> &Mat<D> {
+        &f.a
+    }
+
+    fn shape(_bra: &Fecg<D>, _ket: &Fecg<D>, _ctx: &Operators<D>) -> Shape {
+        Shape::Exponential
     }
 
     fn damped<T: Real>(f: &Fecg<D>, m: &SMatrix<T, D, D>) -> Fecg<D, T> {

@@ -85,7 +85,7 @@ pub struct GvrOps<const D: usize> {
 static RULES: [std::sync::OnceLock<Vec<(f64, f64)>>; 512] = [const { std::sync::OnceLock::new() }; 512];
 
 /// `even_rule(m)`, computed on first use (m < 512, i.e. K up to ~500).
-fn legendre_rule(m: usize) -> &'static [(f64, f64)] {
+pub(crate) fn legendre_rule(m: usize) -> &'static [(f64, f64)] {
     RULES[m].get_or_init(|| even_rule(m))
 }
 

@@ -14,7 +14,7 @@ use nalgebra::SMatrix;
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Symmetry};
+use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
@@ -68,6 +68,14 @@ impl<const D: usize> Family<D> for EcgGvr {
     fn seeded<const W: usize>(f: &Gvr<D>, da: &[Mat<D>], du: &[f64], go: &GvrOps<D>) -> Result<Gvr<D, Dual<W>>> {
         let du: Vec<Vector<D>> = matrices_of::<D, 1>(du, da.len(), "global-vector directions")?;
         Gvr::new(seed_matrix(&f.a, da), seed_matrix(&f.u, &du), f.k, f.c_a, go, 0)
+    }
+
+    fn exponent(f: &Gvr<D>) -> &Mat<D> {
+        &f.a
+    }
+
+    fn shape(bra: &Gvr<D>, ket: &Gvr<D>, ctx: &GvrOps<D>) -> Shape {
+        Shape::Polynomial((bra.k + ket.k + ctx.n_ang) as usize)
     }
 
     fn damped<T: Real>(f: &Gvr<D>, m: &SMatrix<T, D, D>) -> Gvr<D, T> {

@@ -11,7 +11,7 @@ use super::gvr::gvr_element::{self, Gvr, GvrOps};
 use crate::cache::Cache;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Parameters, Symmetry};
+use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Parameters, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::images::Images;
 use crate::isa::best_isa;
@@ -76,6 +76,14 @@ impl<const D: usize> Family<D> for PlainEcg {
     /// Directions of `A` only (`dv` is ignored: u drops out).
     fn seeded<const W: usize>(f: &Gvr<D>, da: &[Mat<D>], _: &[f64], go: &GvrOps<D>) -> Result<Gvr<D, Dual<W>>> {
         Gvr::new(seed_matrix(&f.a, da), seed_matrix(&f.u, &[]), 0, f.c_a, go, 0)
+    }
+
+    fn exponent(f: &Gvr<D>) -> &Mat<D> {
+        &f.a
+    }
+
+    fn shape(_bra: &Gvr<D>, _ket: &Gvr<D>, _ctx: &GvrOps<D>) -> Shape {
+        Shape::Polynomial(0)
     }
 
     fn damped<T: Real>(f: &Gvr<D>, m: &SMatrix<T, D, D>) -> Gvr<D, T> {
