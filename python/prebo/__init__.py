@@ -8,6 +8,7 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.integrals`, `prebo.eigen`: matrices and the generalised eigenproblem;
 - `prebo.optimise`: `Optimiser` settings and `optimise`, the stochastic variational driver;
 - `prebo.results`: `evaluate`, the energies of a basis;
+- `prebo.properties`: `properties`, a level's energy and expectation values;
 - `prebo.thresholds`: the lowest dissociation threshold, below which a state is bound;
 - `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
 - `prebo.cli`, `prebo.plot`: the command line and convergence plots.
@@ -19,6 +20,7 @@ from .basis import Basis
 from .coordinates import CoordinateSet, all_sets, cm_centred, heavy_particle_centred, jacobi
 from .errors import PreboError
 from .optimise import Optimiser, optimise
+from .properties import properties
 from .results import evaluate
 from .system import Particle, State, System, particle
 
@@ -28,6 +30,6 @@ __all__ = [
     # coordinates
     "CoordinateSet", "jacobi", "heavy_particle_centred", "cm_centred", "all_sets",
     # basis, solving, results
-    "Basis", "Optimiser", "optimise", "evaluate", "PreboError",
+    "Basis", "Optimiser", "optimise", "evaluate", "properties", "PreboError",
 ]
 __version__ = "0.1.0"

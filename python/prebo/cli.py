@@ -319,6 +319,42 @@ def cmd_energy(args) -> int:
     return 0
 
 
+def cmd_properties(args) -> int:
+    """`prebo properties BASIS [--root K] [--coordinates lab|ti] [--threshold T] [--json]`: the
+    energy of level K of a stored basis and the expectation value of every registered operator per
+    class of equivalent pairs (properties.py)."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from .properties import properties
+
+    basis, stored = load_basis(args.basis)
+    try:
+        p = properties(basis, args.root, args.coordinates, args.threshold or stored)
+    except PreboError as exc:
+        raise type(exc)(f"{args.basis}: {exc}") from exc
+    values = [v for per in p["expectation"].values() for v in per.values()]
+    if not all(math.isfinite(v) for v in values + [p["energy"]]):
+        raise NonFiniteError(f"{args.basis}: the properties are not finite: the basis's integrals overflow or lost "
+                             "their digits")
+    if args.json:
+        print(json.dumps(p, allow_nan=False))
+        return 0
+    head = Table(show_header=False, box=None)
+    head.add_row("level", f"root {p['root']} ({'bound' if p['bound'] else 'not bound'})")
+    head.add_row("energy (translation-free)", f"{p['energy']:.12f} Eh ± {p['energy_uncertainty']:.1e}")
+    head.add_row("virial η_TI", f"{p['virial']:.2e}")
+    if "n2" in p:
+        head.add_row("⟨N²⟩_TI", f"{p['n2']:.3e} ħ²")
+    Console().print(head)
+    classes = list(next(iter(p["expectation"].values())))
+    table = Table("operator", *classes, "unit", title="expectation values per class of equivalent pairs")
+    for name, per in p["expectation"].items():
+        table.add_row(name, *(f"{per[c]:.10g}" for c in classes), p["units"][name])
+    Console().print(table)
+    return 0
+
+
 class Parser(argparse.ArgumentParser):
     """argparse with the one-line errors of every other failure (exit 2)."""
 
@@ -359,6 +395,13 @@ def fraction(text: str) -> float:
     return within(text, 0.0, 1.0, "a number between 0 and 1")
 
 
+def natural(text: str) -> int:
+    """A command line's index: an integer ≥ 0."""
+    if not (text.isascii() and text.isdigit()):
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer ≥ 0")
+    return int(text)
+
+
 def positive_integer(text: str) -> int:
     """A command line's count: an integer ≥ 1."""
     if not (text.isascii() and text.isdigit() and int(text) >= 1):
@@ -383,6 +426,15 @@ def parser() -> argparse.ArgumentParser:
                           "budget, or the checkpoint's with --resume (a run stopped by its budget goes on)")
     run.add_argument("--quiet", action="store_true", help="no progress display")
     run.set_defaults(func=cmd_run)
+    pr = sub.add_parser("properties", help="a level's energy and the expectation values of every registered operator")
+    pr.add_argument("basis", help="basis.json, or an ecgpack FILE.inout.txt")
+    pr.add_argument("--root", type=natural, default=0, metavar="K", help="the level: root K of the basis's symmetry (default 0)")
+    pr.add_argument("--coordinates", choices=["lab", "ti"], default="lab",
+                    help="lab: LFCC with CM elimination (default); ti: translationally invariant (shared c_A only)")
+    pr.add_argument("--threshold", type=fraction, metavar="T",
+                    help="relative overlap eigenvalue below which directions are dropped (default: as for prebo energy)")
+    pr.add_argument("--json", action="store_true", help="print the properties as JSON")
+    pr.set_defaults(func=cmd_properties)
     en = sub.add_parser("energy", help="re-evaluate a stored basis")
     en.add_argument("basis", help="basis.json, or an ecgpack FILE.inout.txt")
     en.add_argument("--coordinates", choices=["lab", "ti"], default="lab",

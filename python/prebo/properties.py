@@ -1,0 +1,30 @@
+"""The properties of one level of a basis (issue 40): its energy, uncertainty, virial coefficient
+and whether it is bound, with the expectation value of every registered pair operator
+(`expectation.OPERATORS`: ⟨r_ij⟩, ⟨r_ij²⟩, ⟨1/r_ij⟩, ⟨1/r_ij²⟩, ⟨δ³(r_ij)⟩) per class of equivalent
+pairs — what `prebo properties BASIS --root k` prints and `prebo.properties(basis, root=k)`
+returns. ⟨δ³(r_ij)⟩ is the direct expectation value, which Gaussians, lacking the cusp, reach
+slowly (hydrogen 1s in 80 even-tempered Gaussians: 1.8e-4 low, against 2e-11 for ⟨r⟩).
+"""
+from __future__ import annotations
+
+from . import eigen
+from .errors import InputError
+from .expectation import OPERATORS
+from .results import evaluate
+
+
+def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float = eigen.THRESHOLD) -> dict:
+    """The properties of level `root` (0: the lowest of the basis's symmetry) of `basis`.
+
+    Returns {"root", "energy", "energy_uncertainty" (Eh), "virial", "bound", "expectation":
+    {operator: {pair class "a-b": value}}, "units": {operator: unit}} (and "n2", ⟨N²⟩_TI in ħ²,
+    for floating ECGs). InputError for a root that is not a non-negative integer below the basis
+    size; the errors of `results.evaluate` otherwise."""
+    if isinstance(root, bool) or not isinstance(root, int) or root < 0:
+        raise InputError(f"properties: root = {root!r}: must be a non-negative integer")
+    if root >= len(basis):
+        raise InputError(f"properties: root = {root}: a basis of {len(basis)} functions holds roots 0..{len(basis) - 1}")
+    r = evaluate(basis, coordinates=coordinates, threshold=threshold, operators=tuple(OPERATORS), roots=root + 1)
+    level = r["levels"][root] if "levels" in r else r
+    keys = ("root", "energy", "energy_uncertainty", "virial", "bound", "n2", "expectation")
+    return {k: level[k] for k in keys if k in level} | {"root": root, "units": {k: op.unit for k, op in OPERATORS.items()}}
