@@ -11,7 +11,8 @@ of n orthogonal to the basis has norm^2 ν = s_nn - d·d, couplings γ_k = (b_k 
 and energy h' = (h_nn - 2 b·d + Σ E_k d_k^2)/ν. The new lowest eigenvalue is the root
 below E_0 of f(x) = h' - x - Σ γ_k^2 / (E_k - x), strictly decreasing there; root r of the grown
 basis is its root in (E_{r-1}, E_r), the roots interlacing (Hylleraas–Undheim–MacDonald), which is
-how the objective of several levels (optimise/objective.py) evaluates each (`root_*` functions).
+how the objective of several levels (optimise/objective.py) evaluates each (`roots_with_added`,
+`roots_with_block`, `root_without_each`).
 
 Gradient (Hellmann–Feynman for the augmented problem): at the root e the eigenvector is
 c = (C a, 1) with a_k = -(b_k - e d_k)/(E_k - e); when only the new function's parameters move,
