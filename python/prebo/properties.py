@@ -8,9 +8,11 @@ slowly (hydrogen 1s in 80 even-tempered Gaussians: 1.8e-4 low, against 2e-11 for
 from __future__ import annotations
 
 from . import eigen
+from .basis import Basis
 from .errors import InputError
 from .expectation import OPERATORS
 from .results import evaluate
+from .validation import Integer, checked
 
 
 def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float = eigen.THRESHOLD) -> dict:
@@ -20,10 +22,9 @@ def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float 
     {operator: {pair class "a-b": value}}, "units": {operator: unit}} (and "n2", ⟨N²⟩_TI in ħ²,
     for floating ECGs). InputError for a root that is not a non-negative integer below the basis
     size; the errors of `results.evaluate` otherwise."""
-    if isinstance(root, bool) or not isinstance(root, int) or root < 0:
-        raise InputError(f"properties: root = {root!r}: must be a non-negative integer")
-    if root >= len(basis):
-        raise InputError(f"properties: root = {root}: a basis of {len(basis)} functions holds roots 0..{len(basis) - 1}")
+    if not isinstance(basis, Basis) or len(basis) == 0:
+        raise InputError(f"properties: basis = {basis!r}: must be a prebo.Basis with at least one function")
+    root = checked(Integer(0, len(basis) - 1), root, "properties: root", f"roots of a basis of {len(basis)} functions")
     r = evaluate(basis, coordinates=coordinates, threshold=threshold, operators=tuple(OPERATORS), roots=root + 1)
     level = r["levels"][root] if "levels" in r else r
     keys = ("root", "energy", "energy_uncertainty", "virial", "bound", "n2", "expectation")
