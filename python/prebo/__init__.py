@@ -8,7 +8,8 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.integrals`, `prebo.eigen`: matrices and the generalised eigenproblem;
 - `prebo.optimise`: `Optimiser` settings and `optimise`, the stochastic variational driver;
 - `prebo.results`: `evaluate`, the energies of a basis;
-- `prebo.properties`: `properties`, a level's energy and expectation values;
+- `prebo.properties`: `properties`, a level's energy and expectation values; `densities`, the
+  distance distributions of levels;
 - `prebo.thresholds`: the lowest dissociation threshold, below which a state is bound;
 - `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
 - `prebo.cli`, `prebo.plot`: the command line and convergence plots.
@@ -20,7 +21,7 @@ from .basis import Basis
 from .coordinates import CoordinateSet, all_sets, cm_centred, heavy_particle_centred, jacobi
 from .errors import PreboError
 from .optimise import Optimiser, optimise
-from .properties import properties
+from .properties import densities, properties
 from .results import evaluate
 from .system import Particle, State, System, particle
 
@@ -30,6 +31,6 @@ __all__ = [
     # coordinates
     "CoordinateSet", "jacobi", "heavy_particle_centred", "cm_centred", "all_sets",
     # basis, solving, results
-    "Basis", "Optimiser", "optimise", "evaluate", "properties", "PreboError",
+    "Basis", "Optimiser", "optimise", "evaluate", "properties", "densities", "PreboError",
 ]
 __version__ = "0.1.0"

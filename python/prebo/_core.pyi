@@ -25,8 +25,9 @@ Matrices = dict[str, NDArray[np.float64]]
 MAX_DIM: int
 """Largest number of coordinates compiled (laboratory frame: particles)."""
 
-OPERATORS: list[str]
-"""Names of the registered extra operators of `Engine.operator`."""
+OPERATORS: dict[str, list[str]]
+"""Per basis family ("pecg", "ecg-gvr", "fecg"), the names of the registered extra operators of
+`Engine.operator` it evaluates (the others are refused: not derived for that family)."""
 
 
 class Engine:
@@ -82,6 +83,13 @@ class Engine:
         the Coulomb vectors ("r2": r_w² = |Σ_k w_k r_k|² in a_0², with w = e_i − e_j in the
         laboratory frame the squared distance r_ij²). Symmetrised like S, which is exact for
         operators that commute with the symmetry operations."""
+
+    def density(self, params: Params, w: ArrayLike, C: ArrayLike, r: ArrayLike) -> NDArray[np.float64]:
+        """Spherically averaged densities <Ψ|ρ̄_w(r)|Ψ> (bohr⁻³) of the states Ψ = Σ_I c_I Yφ_I
+        (C: (nb, ns), the columns) at the radii r (bohr), one per vector w (p, n) given in this
+        representation like the Coulomb vectors: (p, ns, len(r)). For w = e_i − e_j the pair
+        correlation function of r_ij; for w = e_i − μ (mass fractions) the density of particle i
+        about the centre of mass."""
 
     def angular(self, params: Params, mu: ArrayLike) -> NDArray[np.float64]:
         """Symmetrised (nb, nb) matrix of the translation-free <N²> (ħ² = 1) of a floating-ECG

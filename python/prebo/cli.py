@@ -268,7 +268,15 @@ def cmd_export(args) -> int:
 
 def cmd_plot(args) -> int:
     """`prebo plot RUN... [--reference E] [--since S] [--log-time] [--out PNG|DIR] [--force]`:
-    convergence plot of run checkpoints (into DIR/convergence.png for an existing folder DIR)."""
+    convergence plot of run checkpoints (into DIR/convergence.png for an existing folder DIR);
+    `prebo plot --densities BASIS [--roots K...] [--rmax R] [--points N] [--out PNG] [--force]`: the
+    distance distributions of levels, the picture and its CSV table beside it."""
+    if args.densities:
+        return plot_densities(args)
+    given_options = [o for o, v in (("--roots", args.roots), ("--rmax", args.rmax), ("--points", args.points)) if v]
+    if given_options:
+        from .errors import InputError
+        raise InputError(f"{', '.join(given_options)}: only with --densities")
     from .optimise.checkpoint import CHECKPOINT
     from .plot import convergence
 
@@ -283,6 +291,42 @@ def cmd_plot(args) -> int:
     except OSError as exc:
         raise OutputError(f"{png}: cannot write ({exc.strerror})") from exc
     print(f"wrote {png}")
+    return 0
+
+
+def plot_densities(args) -> int:
+    """`prebo plot --densities`: properties.densities of one stored basis, drawn (plot.densities)
+    into BASIS.densities.png (or --out) and tabulated into the same name with .csv."""
+    import numpy as np
+
+    from .errors import InputError
+    from .io.files import write_atomic
+    from .plot import densities as draw
+    from .properties import POINTS, csv_text, densities
+
+    if len(args.runs) != 1:
+        raise InputError(f"--densities draws one basis, not {len(args.runs)} ({' '.join(map(str, args.runs))})")
+    source = args.runs[0]
+    default = Path(str(source).removesuffix(".json").removesuffix(".inout.txt") + ".densities.png")
+    png = given(args.out, default, "an image file")
+    png = output_file(png if png.suffix else png.with_suffix(".png"), args.force, [source])
+    table_file = output_file(png.with_suffix(".csv"), args.force, [source])
+    basis, stored = load_basis(source)
+    points = args.points or POINTS
+    r = None if args.rmax is None else np.linspace(0.0, args.rmax, points)
+    try:
+        table = densities(basis, args.roots or [0], r, points, threshold=stored)
+    except PreboError as exc:
+        raise type(exc)(f"{source}: {exc}") from exc
+    if not all(np.all(np.isfinite(p)) for level in table["levels"] for g in ("pairs", "particles")
+               for p in level[g].values()):
+        raise NonFiniteError(f"{source}: the densities are not finite: the basis's integrals overflow or lost their digits")
+    try:
+        draw(table, png)
+        write_atomic(table_file, csv_text(table))
+    except OSError as exc:
+        raise OutputError(f"{png}: cannot write ({exc.strerror})") from exc
+    print(f"wrote {png} and {table_file}")
     return 0
 
 
@@ -347,11 +391,16 @@ def cmd_properties(args) -> int:
     if "n2" in p:
         head.add_row("⟨N²⟩_TI", f"{p['n2']:.3e} ħ²")
     Console().print(head)
-    classes = list(next(iter(p["expectation"].values())))
-    table = Table("operator", *classes, "unit", title="expectation values per class of equivalent pairs")
-    for name, per in p["expectation"].items():
-        table.add_row(name, *(f"{per[c]:.10g}" for c in classes), p["units"][name])
-    Console().print(table)
+    for acts_on in ("pairs", "particles"):
+        names = [name for name in p["expectation"] if OPERATORS[name].acts_on == acts_on]
+        if names:
+            classes = list(p["expectation"][names[0]])
+            table = Table("operator", *classes, "unit", title=f"expectation values per class of equivalent {acts_on}")
+            for name in names:
+                table.add_row(name, *(f"{p['expectation'][name][c]:.10g}" for c in classes), p["units"][name])
+            Console().print(table)
+    if p["not_derived"]:
+        Console().print(f"not derived for {basis.family.name} functions: {', '.join(p['not_derived'])}")
     return 0
 
 
@@ -393,6 +442,14 @@ def seconds(text: str) -> float:
 def fraction(text: str) -> float:
     """A command line's threshold: a number strictly between 0 and 1."""
     return within(text, 0.0, 1.0, "a number between 0 and 1")
+
+
+def distance(text: str) -> float:
+    """A command line's distance: a finite number > 0."""
+    value = finite(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a distance > 0")
+    return value
 
 
 def natural(text: str) -> int:
@@ -465,8 +522,17 @@ def parser() -> argparse.ArgumentParser:
     ex.add_argument("--out", help="file to write (default BASIS.inout.txt)")
     ex.add_argument("--force", action="store_true", help="replace an existing --out file")
     ex.set_defaults(func=cmd_export)
-    pl = sub.add_parser("plot", help="energy against basis size of one or more runs (PNG)")
-    pl.add_argument("runs", nargs="+", type=Path, help="run folders (with basis.json checkpoints)")
+    pl = sub.add_parser("plot", help="energy against basis size of one or more runs, or the distance "
+                                     "distributions of a basis's levels (PNG)")
+    pl.add_argument("runs", nargs="+", type=Path, help="run folders (with basis.json checkpoints); with --densities "
+                                                       "one basis.json or ecgpack FILE.inout.txt")
+    pl.add_argument("--densities", action="store_true",
+                    help="draw P(r) of every inter-particle distance and every particle's distance from the centre "
+                         "of mass (and write the table as CSV beside the picture)")
+    pl.add_argument("--roots", type=natural, nargs="+", metavar="K", help="with --densities: the levels (default 0)")
+    pl.add_argument("--rmax", type=distance, metavar="R",
+                    help="with --densities: the grid's end in bohr (default: 5 root-mean-square distances)")
+    pl.add_argument("--points", type=positive_integer, metavar="N", help="with --densities: grid points (default 400)")
     pl.add_argument("--reference", type=finite, help="exact energy: plot E - E_ref on a log axis")
     pl.add_argument("--since", type=finite, metavar="SECONDS",
                     help="only the wall time from then on, against time (runs branched from one checkpoint)")

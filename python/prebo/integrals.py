@@ -98,15 +98,28 @@ class Representation:
             raise ValueError("row gradients are computed in the laboratory frame")
         return self.engine(f).row_gradient(self.arrays(f), dA, dv, self.arrays(basis))
 
-    def operator(self, name: str, f, w: np.ndarray) -> np.ndarray:
+    def operator(self, name: str, f, w: np.ndarray, momentum: bool = False) -> np.ndarray:
         """Symmetrised (p, nb, nb) matrices of the core's registered operator `name` between the
         normalised functions of the basis `f` ("r2": r_w² = |Σ_k w_k r_k|², bohr²), one per
-        laboratory-frame vector w (p, n), transformed into this representation like the Coulomb
-        vectors (w' = (U^-T w)_{1..n-1} in TICC)."""
+        laboratory-frame vector w (p, n), position-like or, with `momentum`, momentum-like
+        (p_w = Σ_k w_k p_k)."""
+        return self.engine(f).operator(name, self.arrays(f), self.vectors(w, momentum))
+
+    def density(self, f, w: np.ndarray, C: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """The spherically averaged densities (p, states, len(r)) of r_w (bohr⁻³) at the radii `r`
+        (bohr) in the states Σ_k C_ks Yφ_k of the basis `f`, one per laboratory-frame vector w (p, n)."""
+        C = np.ascontiguousarray(C, dtype=float)
+        return self.engine(f).density(self.arrays(f), self.vectors(w), C, np.ascontiguousarray(r, dtype=float))
+
+    def vectors(self, w: np.ndarray, momentum: bool = False) -> np.ndarray:
+        """Laboratory-frame operator vectors w (p, n) in this representation: in TICC a position-like
+        w as the Coulomb vectors, w' = (U^-T w)_{1..n-1} (Σ w_k r_k = Σ w'_k x_k), a momentum-like
+        one as ∇, w' = (U w)_{1..n-1} (Σ w_k ∇_{r_k} = Σ w'_k ∇_{x_k}); both without the CM component,
+        which vanishes for 1ᵀw = 0 and μᵀw = 0 respectively."""
         w = np.atleast_2d(np.asarray(w, dtype=float))
         if self.coords is not None:
-            w = self.coords.transform_vectors_to_x(w)[:, :-1]
-        return self.engine(f).operator(name, self.arrays(f), np.ascontiguousarray(w))
+            w = (w @ self.coords.U.T if momentum else self.coords.transform_vectors_to_x(w))[:, :-1]
+        return np.ascontiguousarray(w)
 
     def plausible(self, rows: dict, diag: np.ndarray, S_basis: np.ndarray) -> np.ndarray:
         """Per trial, whether its elements pass the bounds exact integrals obey: 0 < S_nn ≤ Σ_P |c_P|,

@@ -1,5 +1,7 @@
-"""Convergence plots from run checkpoints: energy against basis size and against wall time
-(one line per run).
+"""The pictures: convergence plots from run checkpoints (`convergence`) and the distance
+distributions of levels (`densities`).
+
+Convergence: energy against basis size and against wall time (one line per run).
 
 The growth phase gives one point per basis size; refinement sweeps at the final size are
 drawn as a vertical run of points there, and spread out in the wall-time panel (histories
@@ -57,15 +59,7 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None, 
     the wall time from then on (`since`: runs branched from one checkpoint); with `log_time` the
     wall time on a log axis (its rows at time zero left out). Returns `png`.
     InputError for a suffix not in FORMATS or a reference not below every energy plotted."""
-    if Path(png).suffix.lower() not in FORMATS:
-        raise InputError(f"{png}: an image file ends in {', '.join(FORMATS)}")
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .io.files import write_atomic
-
+    plt = pyplot(png)
     runs = [(Path(folder).name, history(folder)) for folder in folders]
     if start is not None:
         runs = [(name, since(h, start, str(folder))) for (name, h), folder in zip(runs, folders)]
@@ -96,9 +90,58 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None, 
             ax.set_ylabel("E / Eh (translation-free)")
         ax.grid(alpha=0.3)
         ax.legend()
+    return save(fig, png)
+
+
+def densities(table: dict, png: Path) -> Path:
+    """Draw `properties.densities`' table into `png`: one panel per inter-particle distance r_ij and
+    per distance r_i − R from the centre of mass, P(r) of each level side by side in it."""
+    import numpy as np
+
+    plt = pyplot(png)
+    first = table["levels"][0]
+    panels = [("pairs", c, f"r({c.replace('-', ', ')})") for c in first["pairs"]] + \
+             [("particles", c, f"|r({c}) − R_CM|") for c in first["particles"]]
+    columns = min(3, len(panels))
+    rows = -(-len(panels) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 3.6 * rows), squeeze=False)
+    for ax, (group, c, label) in zip(axes.flat, panels):
+        r = table["r"][group][c]
+        for level in table["levels"]:
+            ax.plot(r, level[group][c], lw=1.2, label=f"root {level['root']} ({level['energy']:.8f} Eh)")
+        # the axis ends where every level's P has fallen below 1e-4 of its peak (the table goes on)
+        seen = [r[np.abs(level[group][c]) > 1e-4 * np.abs(level[group][c]).max()] for level in table["levels"]]
+        ax.set_xlim(0.0, 1.05 * max((x.max() for x in seen if len(x)), default=r.max()) or None)
+        ax.set_xlabel(f"{label} / bohr")
+        ax.set_ylabel("P(r) / bohr⁻¹")
+        ax.grid(alpha=0.3)
+    for ax in axes.flat[len(panels):]:
+        ax.set_visible(False)
+    axes.flat[0].legend(fontsize="small")
+    return save(fig, png)
+
+
+def pyplot(png: Path):
+    """matplotlib.pyplot without a display; InputError for a suffix not in FORMATS."""
+    if Path(png).suffix.lower() not in FORMATS:
+        raise InputError(f"{png}: an image file ends in {', '.join(FORMATS)}")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save(fig, png: Path) -> Path:
+    """Write `fig` into `png` at once (never half an image) and close it."""
+    import matplotlib.pyplot as plt
+
+    from .io.files import write_atomic
+
     fig.tight_layout()
     image = io.BytesIO()
     fig.savefig(image, format=Path(png).suffix[1:].lower(), dpi=130)
     plt.close(fig)
-    write_atomic(png, image.getvalue())  # replaced at once: never half an image
+    write_atomic(png, image.getvalue())
     return Path(png)

@@ -1,17 +1,29 @@
-"""The properties of one level of a basis (issue 40): its energy, uncertainty, virial coefficient
-and whether it is bound, with the expectation value of every registered pair operator
-(`expectation.OPERATORS`: ⟨r_ij⟩, ⟨r_ij²⟩, ⟨1/r_ij⟩, ⟨1/r_ij²⟩, ⟨δ³(r_ij)⟩) per class of equivalent
-pairs — what `prebo properties BASIS --root k` prints and `prebo.properties(basis, root=k)`
-returns. ⟨δ³(r_ij)⟩ is the direct expectation value, which Gaussians, lacking the cusp, reach
-slowly (hydrogen 1s in 80 even-tempered Gaussians: 1.8e-4 low, against 2e-11 for ⟨r⟩).
+"""The properties of the levels of a basis (issue 40).
+
+- `properties`: one level's energy, uncertainty, virial coefficient and whether it is bound, with
+  the expectation value of every registered pair operator (`expectation.OPERATORS`: ⟨r_ij⟩,
+  ⟨r_ij²⟩, ⟨1/r_ij⟩, ⟨1/r_ij²⟩, ⟨δ³(r_ij)⟩) per class of equivalent pairs — what `prebo properties
+  BASIS --root k` prints and `prebo.properties(basis, root=k)` returns. ⟨δ³(r_ij)⟩ is the direct
+  expectation value, which Gaussians, lacking the cusp, reach slowly (hydrogen 1s in 80
+  even-tempered Gaussians: 1.8e-4 low, against 2e-11 for ⟨r⟩).
+- `densities`: the pictures of several levels — the distribution P(r) = 4πr²ρ̄(r) of every
+  inter-particle distance and of every particle's distance from the centre of mass, ρ̄ the
+  spherically averaged density (`expectation.densities`), on a grid; `csv` its text, which
+  `prebo plot --densities` writes beside the picture (plot.densities).
 """
 from __future__ import annotations
+
+import csv
+import io
+import math
+
+import numpy as np
 
 from . import eigen
 from .basis import Basis
 from .errors import InputError
 from .expectation import OPERATORS
-from .results import evaluate
+from .results import evaluate, grids
 from .validation import Integer, checked
 
 
@@ -19,13 +31,82 @@ def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float 
     """The properties of level `root` (0: the lowest of the basis's symmetry) of `basis`.
 
     Returns {"root", "energy", "energy_uncertainty" (Eh), "virial", "bound", "expectation":
-    {operator: {pair class "a-b": value}}, "units": {operator: unit}} (and "n2", ⟨N²⟩_TI in ħ²,
-    for floating ECGs). InputError for a root that is not a non-negative integer below the basis
-    size; the errors of `results.evaluate` otherwise."""
+    {operator: {class: value}}, "units": {operator: unit}, "not_derived": [operators]} (and "n2",
+    ⟨N²⟩_TI in ħ², for floating ECGs): every registered operator the basis family evaluates, per
+    class of equivalent pairs "a-b" or particles "a", and those it has no element for. InputError
+    for a root that is not a non-negative integer below the basis size; the errors of
+    `results.evaluate` otherwise."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"properties: basis = {basis!r}: must be a prebo.Basis with at least one function")
     root = checked(Integer(0, len(basis) - 1), root, "properties: root", f"roots of a basis of {len(basis)} functions")
-    r = evaluate(basis, coordinates=coordinates, threshold=threshold, operators=tuple(OPERATORS), roots=root + 1)
+    names = [name for name, op in OPERATORS.items() if op.evaluates(basis.family)]
+    r = evaluate(basis, coordinates=coordinates, threshold=threshold, operators=names, roots=root + 1)
     level = r["levels"][root] if "levels" in r else r
     keys = ("root", "energy", "energy_uncertainty", "virial", "bound", "n2", "expectation")
-    return {k: level[k] for k in keys if k in level} | {"root": root, "units": {k: op.unit for k, op in OPERATORS.items()}}
+    return {k: level[k] for k in keys if k in level} | {
+        "root": root, "units": {k: OPERATORS[k].unit for k in names},
+        "not_derived": [k for k in OPERATORS if k not in names]}
+
+
+#: the points of the default grid of `densities`, and its reach in root-mean-square distances
+POINTS, REACH = 400, 5.0
+
+
+def densities(basis, roots=(0,), r=None, points: int = POINTS, coordinates: str = "lab",
+              threshold: float = eigen.THRESHOLD) -> dict:
+    """The distance distributions of the levels `roots` of `basis` at the radii `r` (bohr), or by
+    default on a grid per class of `points` from 0 to REACH root-mean-square distances of that
+    class (the largest over the levels; `rms`).
+
+    Returns {"r": {"pairs": {"a-b": radii}, "particles": {"a": radii}}, "levels": [{"root",
+    "energy", "pairs": {"a-b": P}, "particles": {"a": P}}]} with P(r) = 4πr²ρ̄(r) (bohr⁻¹; ∫P dr = 1
+    over a grid that reaches far enough). InputError for roots that are not distinct non-negative
+    integers below the basis size, or radii that are empty or not finite distances ≥ 0; the errors
+    of `results.evaluate` otherwise."""
+    if not isinstance(basis, Basis) or len(basis) == 0:
+        raise InputError(f"densities: basis = {basis!r}: must be a prebo.Basis with at least one function")
+    roots = [roots] if not isinstance(roots, (list, tuple)) else list(roots)
+    if not roots or len(set(roots)) != len(roots):
+        raise InputError(f"densities: roots = {roots!r}: must be distinct levels of the basis")
+    for k in roots:
+        checked(Integer(0, len(basis) - 1), k, "densities: roots", f"roots of a basis of {len(basis)} functions")
+    if r is None:
+        points = checked(Integer(2, 10**6), points, "densities: points", "grid points")
+        e = evaluate(basis, coordinates=coordinates, threshold=threshold, operators=("r2",), roots=max(roots) + 1)
+        levels = e.get("levels", [e])
+        reach = [rms(basis.system, levels[k]["expectation"]["r2"]) for k in roots]
+        r = {group: {c: np.linspace(0.0, REACH * max(x[group][c] for x in reach), points) for c in classes}
+             for group, classes in reach[0].items()}
+    radii = grids(basis.system, r)
+    e = evaluate(basis, coordinates=coordinates, threshold=threshold, roots=max(roots) + 1, radii=radii)
+    levels = e.get("levels", [e])
+    return {"r": radii, "levels": [{"root": k, "energy": levels[k]["energy"]} | {
+        group: {c: 4.0 * math.pi * radii[group][c] ** 2 * rho for c, rho in levels[k]["densities"][group].items()}
+        for group in radii} for k in roots]}
+
+
+def rms(system, r2: dict) -> dict:
+    """Root-mean-square distances per class from the pair classes' ⟨r_ij²⟩ `r2`: {"pairs": {"a-b"},
+    "particles": {"a": ⟨|r_i − R|²⟩^½}}, from r_i − R = Σ_j μ_j r_ij (μ the mass fractions):
+    ⟨|r_i − R|²⟩ = Σ_j μ_j d_ij − ½ Σ_jk μ_j μ_k d_jk, d_ij = ⟨r_ij²⟩ (equal within a class)."""
+    names = [p.name for p in system.particles]
+    d = np.zeros((system.n, system.n))
+    for i, j, _ in system.pairs():
+        d[i, j] = d[j, i] = r2["-".join(sorted((names[i], names[j])))]
+    mu = system.cm_vector
+    about_cm = d @ mu - 0.5 * mu @ d @ mu
+    return {"pairs": {c: math.sqrt(v) for c, v in r2.items()},
+            "particles": {names[i]: math.sqrt(max(x, 0.0)) for i, x in enumerate(about_cm)}}
+
+
+def csv_text(table: dict) -> str:
+    """`densities`' table as CSV, one row per level, class and radius: root, group ("pair" or
+    "particle"), class ("a-b" or "a"), r (bohr), P (bohr⁻¹)."""
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(["root", "group", "class", "r_bohr", "P_per_bohr"])
+    for level in table["levels"]:
+        for group, word in (("pairs", "pair"), ("particles", "particle")):
+            for c, p in level[group].items():
+                writer.writerows([level["root"], word, c, x, y] for x, y in zip(table["r"][group][c].tolist(), p.tolist()))
+    return out.getvalue()

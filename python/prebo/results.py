@@ -39,6 +39,7 @@ optimum satisfies the virial theorem, 2<T> + <V> = 0, whatever it describes (tes
 from __future__ import annotations
 
 import math
+import reprlib
 from dataclasses import replace
 
 import numpy as np
@@ -46,7 +47,7 @@ import numpy as np
 from . import eigen
 from .basis import Basis
 from .errors import CancellationError, InputError
-from .expectation import expectation, operator
+from .expectation import densities, density_classes, expectation, operator
 from .integrals import laboratory, require_shared_c_A, translationally_invariant
 from .optimise.settings import check
 from .thresholds import candidates, lowest
@@ -58,7 +59,7 @@ HARTREE_CM = 219474.6313632
 
 
 def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.THRESHOLD, operators=(),
-             roots: int | None = None) -> dict:
+             roots: int | None = None, radii=None) -> dict:
     """The energies of `basis`'s lowest state, and of its lowest `roots` levels.
 
     Parameters: `basis`, a non-empty `Basis`; `coordinates`, "lab" (LFCC with the CM kinetic
@@ -68,14 +69,18 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     (`eigen.solve`); `operators`, names of registered operators (`expectation.OPERATORS`, e.g.
     "r2") whose expectation values to add; `roots`, how many of the lowest levels to report
     (`levels` and `transitions` when more than one; default: up to the highest root the basis's
-    state targets, `State.levels`, whose indices are then given as `targets`).
+    state targets, `State.levels`, whose indices are then given as `targets`); `radii` (bohr),
+    where to add each level's `densities` (`expectation.densities`): one grid for every class, or
+    {"pairs": {"a-b": grid}, "particles": {"a": grid}} with a grid per class.
 
     Returns a dict with the keys of the module docstring — energy, energy_uncertainty,
     energy_lab, kinetic, potential, threshold and binding_energy in Eh; bound a bool; virial,
     overlap_condition dimensionless; n2 in ħ²; expectation in each operator's unit — and
     `coefficients`, the S-normalised ground-state vector. InputError for a basis that is not a
     non-empty `Basis` or does not fit its system (its arrays or system replaced since it was built),
-    an unknown `coordinates` or operator, `roots` not a positive integer or above the basis size;
+    an unknown `coordinates` or operator, UnsupportedError for an operator the basis family has
+    not (`_core.OPERATORS`), `roots` not a positive integer or above the basis size,
+    `radii` empty or not finite non-negative numbers;
     LinearDependenceError for more roots than the basis resolves; CancellationError for a function whose elements lost
     their digits (Representation.require_resolved); NonFiniteError and the eigen errors as
     `eigen.solve` raises them."""
@@ -87,7 +92,9 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         raise InputError(f"evaluate: operators = {operators!r}: must be a name or a list of names")
     operators = (operators,) if isinstance(operators, str) else tuple(operators)
     for name in operators:
-        operator(name)
+        operator(name, basis.family)
+    if radii is not None:
+        radii = grids(basis.system, radii)
     basis = replace(basis)  # built again: the constructor's checks against the system it has now
     targets = basis.system.state.levels[0]
     roots = max(targets) + 1 if roots is None else roots
@@ -112,8 +119,9 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     low = lowest(system)
     n2 = None if basis.family.conserves_L else laboratory(system).angular(basis, system.cm_vector)
     values = {name: expectation(rep, basis, ti.vectors[:, :roots], name) for name in operators}
+    rho = None if radii is None else densities(rep, basis, ti.vectors[:, :roots], radii)
     levels = [level(ti, k, m, low.energy, threshold, n2, {name: v[k] for name, v in values.items()})
-              for k in range(roots)]
+              | ({} if rho is None else {"densities": rho[k]}) for k in range(roots)]
     ground = levels[0]
     if energy_lab is None:
         energy_lab = ground["energy"] + 1.5 * c_A / system.m_total
@@ -138,6 +146,31 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         "kept": ti.kept,
         "coefficients": ti.vectors[:, 0],
     }
+
+
+def grids(system, radii) -> dict:
+    """`radii`, one grid or one per class of `expectation.density_classes`, as {group: {class:
+    float array}}; InputError unless every grid is a non-empty list of finite distances ≥ 0 (bohr)
+    and a dict names exactly those classes."""
+    classes = density_classes(system)
+    if isinstance(radii, dict):
+        want = {group: set(c) for group, c in classes.items()}
+        if {group: set(radii[group]) for group in radii if isinstance(radii[group], dict)} != want:
+            raise InputError(f"radii: a grid per class must name exactly the classes {want}")
+        return {group: {label: distances(radii[group][label]) for label in c} for group, c in classes.items()}
+    r = distances(radii)
+    return {group: {label: r for label in c} for group, c in classes.items()}
+
+
+def distances(radii) -> np.ndarray:
+    """`radii` as a float array; InputError unless a non-empty list of finite distances ≥ 0 (bohr)."""
+    try:
+        r = np.asarray(radii, dtype=float)
+    except (TypeError, ValueError):
+        r = np.array([np.nan])
+    if r.ndim != 1 or len(r) == 0 or not np.all(np.isfinite(r) & (r >= 0)):
+        raise InputError(f"radii = {reprlib.repr(radii)}: must be a non-empty list of finite distances ≥ 0 (bohr)")
+    return r
 
 
 def level(eig: eigen.Eigen, k: int, m: dict, threshold_energy: float, threshold: float, n2=None,

@@ -10,7 +10,7 @@ use crate::families::gvr::EcgGvr;
 use crate::families::plain::PlainEcg;
 use crate::families::{check, Column, Directions, Family, Field, Parameters};
 use crate::matrices::Matrices;
-use crate::operators;
+use crate::operators::{self, density};
 use crate::path;
 
 /// The basis families.
@@ -34,6 +34,15 @@ impl Kind {
             Kind::Pecg => <PlainEcg as Family<1>>::NAME,
             Kind::EcgGvr => <EcgGvr as Family<1>>::NAME,
             Kind::Fecg => <FloatingEcg as Family<1>>::NAME,
+        }
+    }
+
+    /// The registered operators the family evaluates (`operators::derived`).
+    pub fn operators(self) -> Vec<&'static str> {
+        match self {
+            Kind::Pecg => operators::derived::<PlainEcg>(),
+            Kind::EcgGvr => operators::derived::<EcgGvr>(),
+            Kind::Fecg => operators::derived::<FloatingEcg>(),
         }
     }
 
@@ -192,6 +201,20 @@ fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &[Col
     path::operator::<D, F>(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis, element, w)
 }
 
+fn density_d<const D: usize, F: Family<D>>(e: &Engine, basis: &[Column], w: &[f64], c: &[f64], radii: &[f64]) -> Result<Vec<f64>> {
+    check(w.len(), w.len() / D * D, "density vectors")?;
+    let basis = F::params(basis)?;
+    let (ops, sym) = e.rep.operators::<D>();
+    let ctx = F::context(ops, e.n_ang, &[&basis])?;
+    let b = path::images::<D, F>(&ctx, &sym, &basis)?;
+    let mut out = Vec::new();
+    for wk in w.chunks_exact(D) {
+        let wk = Vector::<D>::from_row_slice(wk);
+        out.extend(path::contracted(&b, c, radii.len(), |x, y| density::element::<D, F>(x, y, &ctx, &wk, radii))?);
+    }
+    Ok(out)
+}
+
 fn angular_d<const D: usize, F>(e: &Engine, basis: &[Column], mu: &[f64]) -> Result<Vec<f64>>
 where
     F: Family<D, Function<f64> = fecg::Fecg<D>, Context = Operators<D>>,
@@ -252,6 +275,13 @@ impl Engine {
     /// The symmetrised matrices of the registered operator `name`, one per vector `w` (`p x n`).
     pub fn operator(&self, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
         dispatch!(self, operator_d(self, name, basis, w))
+    }
+
+    /// The spherically averaged densities `<Ψ| ρ̄_w(r) |Ψ>` (operators/density.rs) of the states
+    /// `Ψ = Σ_I c_I Yφ_I` (`c`: `nb x ns`, row-major) at `radii`, one block per vector `w`
+    /// (`p x ns x radii`).
+    pub fn density(&self, basis: &[Column], w: &[f64], c: &[f64], radii: &[f64]) -> Result<Vec<f64>> {
+        dispatch!(self, density_d(self, basis, w, c, radii))
     }
 
     /// The symmetrised `<phi_I|N_TI²|phi_J>` matrix of a floating-ECG basis (LFCC; `mu` = m/m_tot).

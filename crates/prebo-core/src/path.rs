@@ -13,6 +13,7 @@ use crate::families::{check, Directions, Family, Parameters, Symmetry};
 use crate::gradient::{self, Dual};
 use crate::images::Images;
 use crate::matrices::Matrices;
+use rayon::prelude::*;
 
 /// The functions of `p` with their images under `sym`.
 pub fn images<const D: usize, F: Family<D>>(
@@ -145,6 +146,50 @@ pub fn operator<const D: usize, F: Family<D>>(
     for wk in w.chunks_exact(D) {
         let wk = Vector::<D>::from_row_slice(wk);
         out.extend(symmetric_scalar(&b, |x, y| element(x, y, ctx, &wk)));
+    }
+    Ok(out)
+}
+
+/// `Σ_IJ c_I c_J Σ_P c_P <phi_I| O_k |P phi_J>` of an operator with `len` components `O_k`
+/// (`element` returns them all), for each state `c` (the columns of `c`, `nb x ns` row-major):
+/// `ns x len`, row-major. Rows `I` in parallel, `J >= I` mirrored as in `symmetric_scalar`,
+/// summed in row order (the same bits for any number of threads).
+pub fn contracted<G: Sync>(
+    b: &Images<G>,
+    c: &[f64],
+    len: usize,
+    element: impl Fn(&G, &G) -> Vec<f64> + Sync,
+) -> Result<Vec<f64>> {
+    let nb = b.len();
+    check(c.len(), c.len() / nb.max(1) * nb, "coefficients (basis size x states)")?;
+    let ns = c.len() / nb.max(1);
+    let rows: Vec<Vec<f64>> = (0..nb)
+        .into_par_iter()
+        .map(|i| {
+            let mut row = vec![0.0; ns * len];
+            for j in i..nb {
+                let mirror = if j == i { 1.0 } else { 2.0 };
+                let mut o = vec![0.0; len];
+                for (ket, cp) in b.images[j].iter().zip(&b.coef) {
+                    for (acc, x) in o.iter_mut().zip(element(&b.functions[i], ket)) {
+                        *acc += cp * x;
+                    }
+                }
+                for s in 0..ns {
+                    let weight = mirror * c[i * ns + s] * c[j * ns + s];
+                    for (acc, x) in row[s * len..(s + 1) * len].iter_mut().zip(&o) {
+                        *acc += weight * x;
+                    }
+                }
+            }
+            row
+        })
+        .collect();
+    let mut out = vec![0.0; ns * len];
+    for row in &rows {
+        for (acc, x) in out.iter_mut().zip(row) {
+            *acc += x;
+        }
     }
     Ok(out)
 }

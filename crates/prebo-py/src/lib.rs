@@ -5,6 +5,7 @@
 mod convert;
 
 use convert::{blocks, columns, dict, floats, floats_shaped, matrix, Result, Rows, ShapeError};
+use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use prebo_core::engine::{self, Kind, Representation};
 use prebo_core::families::Directions;
@@ -127,6 +128,24 @@ impl Engine {
         let nb = self.core.count(&basis)?;
         let m = py.allow_threads(|| self.core.operator(name, &basis, &w))?;
         Ok(blocks(py, nb, m))
+    }
+
+    #[allow(non_snake_case)]
+    fn density<'py>(
+        &self,
+        py: Python<'py>,
+        params: &Bound<'py, PyAny>,
+        w: &Bound<'py, PyAny>,
+        C: &Bound<'py, PyAny>,
+        r: &Bound<'py, PyAny>,
+    ) -> Result<Bound<'py, PyArray3<f64>>> {
+        let basis = columns(self.core.kind, params)?;
+        let (w, c, r) = (floats(w, "w")?, floats(C, "C")?, floats(r, "r")?);
+        let nb = self.core.count(&basis)?;
+        let ns = if nb == 0 { 0 } else { c.len() / nb };
+        let d = py.allow_threads(|| self.core.density(&basis, &w, &c, &r))?;
+        let p = if ns * r.len() == 0 { 0 } else { d.len() / (ns * r.len()) };
+        Ok(Array3::from_shape_vec((p, ns, r.len()), d).expect("p x ns x radii values").into_pyarray(py))
     }
 
     fn angular<'py>(
@@ -264,6 +283,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(inverse_iteration, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add("MAX_DIM", prebo_core::ecg::MAX_DIM)?;
-    m.add("OPERATORS", prebo_core::operators::names())?;
+    let operators = PyDict::new(m.py());
+    for kind in [Kind::Pecg, Kind::EcgGvr, Kind::Fecg] {
+        operators.set_item(kind.name(), kind.operators())?;
+    }
+    m.add("OPERATORS", operators)?;
     Ok(())
 }

@@ -19,7 +19,7 @@
 use nalgebra::SMatrix;
 
 use crate::cache::{Cache, Keyed};
-use crate::ecg::{Element, Mat, Operators, Real};
+use crate::ecg::{Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
 use crate::gradient::Dual;
 use crate::images::Transform;
@@ -165,15 +165,36 @@ pub fn check(len: usize, want: usize, what: &str) -> Result<()> {
     }
 }
 
-/// How the profile `F(u)` of a damped overlap depends on `u` (`operators::profile`): what the
-/// expectation values of `δ(r_w)` and of the powers of `|r_w|` need to know of a family.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How the profile `G(u)` of a damped overlap depends on `u` (`operators::profile`): what the
+/// expectation values of `δ(r_w)`, of the powers of `|r_w|` and the density of `r_w` need to know
+/// of a family.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
-    /// A polynomial of this degree (plain ECGs 0, ECG-GVR `K_I + K_J + N`).
-    Polynomial(usize),
-    /// `exp(−λ u)` (floating ECGs, `λ = |w^T r̄|²/q`).
+    /// `G = Σ_k g_k (1 − u)^k`, the coefficients `g_k` (plain ECGs `[S_IJ]`, ECG-GVR of degree
+    /// `K_I + K_J + N`).
+    Polynomial(Vec<f64>),
+    /// `S_IJ exp(−λ u)` (floating ECGs, `λ = |w^T r̄|²/q`).
     Exponential,
 }
+
+impl Shape {
+    /// The degree of a polynomial profile.
+    pub fn degree(&self) -> Option<usize> {
+        match self {
+            Shape::Polynomial(g) => Some(g.len() - 1),
+            Shape::Exponential => None,
+        }
+    }
+}
+
+/// `(<phi_I| p_g² |phi_J>, <phi_I| p_g⁴ |phi_J>)` of normalised functions of family `F`, for
+/// `p_g = −i Σ_k g_k ∇_k` with a D-vector `g` (`operators::momentum`; docs/properties-derivations.md §5).
+pub type Momentum<const D: usize, F> = fn(
+    &<F as Family<D>>::Function<f64>,
+    &<F as Family<D>>::Function<f64>,
+    &<F as Family<D>>::Context,
+    &Vector<D>,
+) -> (f64, f64);
 
 /// Symmetry operations `(T, c_P)`: `phi -> phi(T r)` with Young-operator coefficient `c_P`.
 pub type Symmetry<const D: usize> = [(Mat<D>, f64)];
@@ -187,6 +208,9 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// Whether `rows(.., position)` evaluates every element in the orientation of a full build
     /// (lower index as bra), so that rows patched into the matrices give the bits of `matrices`.
     const ORIENTED: bool = true;
+    /// The element of the momentum operators `p_g²` and `p_g⁴` (`Momentum`), or `None` where the
+    /// family's is not derived (`operators::lookup` then refuses them).
+    const MOMENTUM: Option<Momentum<D, Self>>;
     /// One function over the scalar `T`.
     type Function<T: Real>: Clone + Send + Sync + Transform<D, Self::Context>;
     /// What the elements need beside the functions (operators, quadrature rules, N).
@@ -233,7 +257,7 @@ pub trait Family<const D: usize>: Sized + 'static {
     fn exponent(f: &Self::Function<f64>) -> &Mat<D>;
 
     /// How the damped overlap of `bra` and `ket` depends on the damping (`Shape`).
-    fn shape(bra: &Self::Function<f64>, ket: &Self::Function<f64>, ctx: &Self::Context) -> Shape;
+    fn shape(bra: &Self::Function<f64>, ket: &Self::Function<f64>, ctx: &Self::Context, w: &Vector<D>) -> Shape;
 
     /// The symmetrised matrices of a basis (`path::matrices`, or the family's kernel).
     fn matrices(ctx: &Self::Context, sym: &Symmetry<D>, basis: &Self::Params<'_>) -> Result<Matrices>;

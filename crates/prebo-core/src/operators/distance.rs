@@ -8,16 +8,16 @@ use std::f64::consts::PI;
 use super::profile::Profile;
 use crate::ecg::Vector;
 use crate::families::floating::fecg::coulomb_factor;
-use crate::families::{Family, Shape};
+use crate::families::Family;
 
 pub const NAME: &str = "r";
 
 /// `<φ_I| |r_w| |φ_J>` for normalised functions (bohr).
 pub fn element<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, w: &Vector<D>) -> f64 {
     let p = Profile::<D, F>::of(bra, ket, ctx, w);
-    match p.shape {
-        Shape::Polynomial(m) => 2.0 / (PI * p.q).sqrt() * Profile::<D, F>::even_integral(m + 1, |t| p.slope(t * t)),
-        Shape::Exponential => {
+    match p.shape.degree() {
+        Some(m) => 2.0 / (PI * p.q).sqrt() * Profile::<D, F>::even_integral(m + 1, |t| p.slope(t * t)),
+        None => {
             let (lambda, q) = (p.lambda(), p.q);
             p.s * ((q / PI).sqrt() * (-lambda).exp() + (lambda * q + 0.5 * q) * coulomb_factor(lambda * q, q))
         }

@@ -7,15 +7,15 @@ use std::f64::consts::PI;
 use super::profile::Profile;
 use crate::ecg::Vector;
 use crate::families::floating::fecg::coulomb_factor;
-use crate::families::{Family, Shape};
+use crate::families::Family;
 
 pub const NAME: &str = "inv_r";
 
 /// `<φ_I| 1/|r_w| |φ_J>` for normalised functions (bohr⁻¹).
 pub fn element<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, w: &Vector<D>) -> f64 {
     let p = Profile::<D, F>::of(bra, ket, ctx, w);
-    match p.shape {
-        Shape::Polynomial(m) => 2.0 / (PI * p.q).sqrt() * Profile::<D, F>::even_integral(m, |t| p.at(t * t)),
-        Shape::Exponential => p.s * coulomb_factor(p.lambda() * p.q, p.q),
+    match p.shape.degree() {
+        Some(m) => 2.0 / (PI * p.q).sqrt() * Profile::<D, F>::even_integral(m, |t| p.at(t * t)),
+        None => p.s * coulomb_factor(p.lambda() * p.q, p.q),
     }
 }

@@ -4,15 +4,15 @@
 //! integral) for `G = S exp(−λu)`.
 use super::profile::{rising_gaussian, Profile};
 use crate::ecg::Vector;
-use crate::families::{Family, Shape};
+use crate::families::Family;
 
 pub const NAME: &str = "inv_r2";
 
 /// `<φ_I| 1/r_w² |φ_J>` for normalised functions (bohr⁻²).
 pub fn element<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, w: &Vector<D>) -> f64 {
     let p = Profile::<D, F>::of(bra, ket, ctx, w);
-    match p.shape {
-        Shape::Polynomial(m) => 2.0 / p.q * Profile::<D, F>::even_integral(m, |s| p.at(1.0 - s * s)),
-        Shape::Exponential => 2.0 * p.s / p.q * rising_gaussian(p.lambda()),
+    match p.shape.degree() {
+        Some(m) => 2.0 / p.q * Profile::<D, F>::even_integral(m, |s| p.at(1.0 - s * s)),
+        None => 2.0 * p.s / p.q * rising_gaussian(p.lambda()),
     }
 }

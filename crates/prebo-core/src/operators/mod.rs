@@ -12,9 +12,11 @@ use crate::families::plain::PlainEcg;
 use crate::families::Family;
 
 pub mod delta;
+pub mod density;
 pub mod distance;
 pub mod inverse;
 pub mod inverse_square;
+pub mod momentum;
 pub mod profile;
 pub mod r2;
 
@@ -27,14 +29,17 @@ pub type ElementFn<const D: usize, F> = fn(
     &Vector<D>,
 ) -> f64;
 
-/// The registered operators: name and element function.
-fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, ElementFn<D, F>)> {
+/// The registered operators: name and element function (`None`: not derived for the family `F`).
+fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, Option<ElementFn<D, F>>)> {
+    let derived = |element: ElementFn<D, F>| F::MOMENTUM.map(|_| element);
     vec![
-        (r2::NAME, r2::element::<D, F>),
-        (distance::NAME, distance::element::<D, F>),
-        (inverse::NAME, inverse::element::<D, F>),
-        (inverse_square::NAME, inverse_square::element::<D, F>),
-        (delta::NAME, delta::element::<D, F>),
+        (r2::NAME, Some(r2::element::<D, F>)),
+        (distance::NAME, Some(distance::element::<D, F>)),
+        (inverse::NAME, Some(inverse::element::<D, F>)),
+        (inverse_square::NAME, Some(inverse_square::element::<D, F>)),
+        (delta::NAME, Some(delta::element::<D, F>)),
+        (momentum::P2, derived(momentum::p2::<D, F>)),
+        (momentum::P4, derived(momentum::p4::<D, F>)),
     ]
 }
 
@@ -43,13 +48,18 @@ pub fn names() -> Vec<&'static str> {
     registry::<1, PlainEcg>().into_iter().map(|(name, _)| name).collect()
 }
 
-/// The element function of the operator `name`.
+/// The names of the registered operators the family `F` evaluates.
+pub fn derived<F: Family<1>>() -> Vec<&'static str> {
+    registry::<1, F>().into_iter().filter(|(_, element)| element.is_some()).map(|(name, _)| name).collect()
+}
+
+/// The element function of the operator `name` for the family `F`.
 pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<ElementFn<D, F>> {
-    registry::<D, F>()
+    let (_, element) = registry::<D, F>()
         .into_iter()
         .find(|(n, _)| *n == name)
-        .map(|(_, f)| f)
-        .ok_or_else(|| CoreError::Unsupported(format!("operator {name:?} (registered: {:?})", names())))
+        .ok_or_else(|| CoreError::Unsupported(format!("operator {name:?} (registered: {:?})", names())))?;
+    element.ok_or_else(|| CoreError::Unsupported(format!("operator {name:?} is not derived for {} functions", F::NAME)))
 }
 
 /// What the operators' tests share: three coordinates, random exponents, the pair vector `e_1 − e_2`.

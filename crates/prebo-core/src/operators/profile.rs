@@ -4,13 +4,12 @@
 //! `<φ_I| exp(−α r_w²) |φ_J> = (1 − u)^{3/2} G(u)`,  `u = αq/(1 + αq)`,  `q = w^T (A_I + A_J)^{-1} w`,
 //!
 //! (the matrix determinant lemma gives the Gaussian factor), `G(0) = S_IJ`, and `G` is a
-//! polynomial of degree `K_I + K_J + N` for ECG-GVR (a constant for plain ECGs) and
-//! `S_IJ exp(−λu)` for floating ECGs (`Family::shape`). `G` is read off the family's own damped
-//! overlap (`Family::damped`), so every element built on it holds for every family, exact up to
-//! rounding: a polynomial `G` is integrated exactly by Gauss–Legendre rules and extrapolated
-//! exactly to `u = 1` from Chebyshev nodes, an exponential one is integrated in closed form or by
-//! a rule panelled in the exponent.
-use std::f64::consts::PI;
+//! polynomial of degree `K_I + K_J + N` for ECG-GVR (a constant for plain ECGs), whose
+//! coefficients in `1 − u` the family gives, and `S_IJ exp(−λu)` for floating ECGs
+//! (`Family::shape`). Between those ends `G` is read off the family's own damped overlap
+//! (`Family::damped`), so every element built on it holds for every family, exact up to
+//! rounding: a polynomial `G` is integrated exactly by Gauss–Legendre rules, an exponential one in
+//! closed form or by a rule panelled in the exponent.
 use std::sync::OnceLock;
 
 use crate::ecg::{Mat, Vector};
@@ -37,7 +36,7 @@ impl<'a, const D: usize, F: Family<D>> Profile<'a, D, F> {
         let b = F::exponent(bra) + F::exponent(ket);
         let q = b.cholesky().map_or(f64::NAN, |c| w.dot(&c.solve(w)));
         let s = F::overlap(bra, ket, ctx);
-        Self { bra, ket, ctx, ww: w * w.transpose(), s, q, shape: F::shape(bra, ket, ctx) }
+        Self { bra, ket, ctx, ww: w * w.transpose(), s, q, shape: F::shape(bra, ket, ctx, w) }
     }
 
     /// The damping `α` of `u`.
@@ -58,23 +57,10 @@ impl<'a, const D: usize, F: Family<D>> Profile<'a, D, F> {
         -d.eps.unwrap_generic(Const::<1>, U1)[0] / (1.0 - u).powf(1.5)
     }
 
-    /// `G(1)`, the limit `α → ∞`: the polynomial through Chebyshev nodes in (0, 1) evaluated at 1,
-    /// or `G(½)² / S` for `S exp(−λu)`.
+    /// `G(1)`, the limit `α → ∞`: `g_0` of a polynomial profile, `G(½)² / S` for `S exp(−λu)`.
     pub fn at_one(&self) -> f64 {
-        match self.shape {
-            Shape::Polynomial(m) => {
-                let nodes: Vec<f64> =
-                    (0..=m).map(|k| 0.5 * (1.0 - ((2 * k + 1) as f64 * PI / (2 * (m + 1)) as f64).cos())).collect();
-                nodes
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &uk)| {
-                        let lagrange: f64 =
-                            nodes.iter().enumerate().filter(|&(j, _)| j != k).map(|(_, &uj)| (1.0 - uj) / (uk - uj)).product();
-                        self.at(uk) * lagrange
-                    })
-                    .sum()
-            }
+        match &self.shape {
+            Shape::Polynomial(g) => g[0],
             Shape::Exponential => {
                 let half = self.at(0.5);
                 half * half / self.s
@@ -124,6 +110,7 @@ mod tests {
     //! α → ∞ ends, where the damped overlap loses digits) and δ against `(α/π)^{3/2}` times the damped
     //! overlap extrapolated to `α → ∞` (Richardson).
     use super::*;
+    use std::f64::consts::PI;
     use crate::families::floating::fecg::{erf, Centres, Fecg};
     use crate::families::floating::FloatingEcg;
     use crate::families::gvr::gvr_element::{Gvr, GvrOps};

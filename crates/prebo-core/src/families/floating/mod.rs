@@ -9,9 +9,9 @@
 use nalgebra::SMatrix;
 
 use crate::cache::Cache;
-use crate::ecg::{re, Element, Mat, Operators, Real};
+use crate::ecg::{re, Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Shape, Symmetry};
+use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Momentum, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::matrices::Matrices;
 use crate::path;
@@ -27,6 +27,8 @@ pub struct FloatingEcg;
 impl<const D: usize> Family<D> for FloatingEcg {
     const NAME: &'static str = "fecg";
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("s"), Field::floats("c_A")];
+    /// Eq. (25) of docs/properties-derivations.md (`fecg::momentum`).
+    const MOMENTUM: Option<Momentum<D, Self>> = Some(fecg::momentum::<D>);
     type Function<T: Real> = Fecg<D, T>;
     type Context = Operators<D>;
     type Params<'a> = FecgParams<'a>;
@@ -65,7 +67,7 @@ impl<const D: usize> Family<D> for FloatingEcg {
         &f.a
     }
 
-    fn shape(_bra: &Fecg<D>, _ket: &Fecg<D>, _ctx: &Operators<D>) -> Shape {
+    fn shape(_bra: &Fecg<D>, _ket: &Fecg<D>, _ctx: &Operators<D>, _w: &Vector<D>) -> Shape {
         Shape::Exponential
     }
 

@@ -52,7 +52,7 @@ use std::f64::consts::PI;
 use nalgebra::{Cholesky, SMatrix, SVector};
 
 use super::gvr_series::{cm_kinetic, horner, omega, series_at_one, Coefficients};
-use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real};
+use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
 use crate::cache::Keyed;
 use crate::families::{check, matrices_of, Exponents, Parameters};
@@ -310,6 +310,62 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
         v += re::<T>(*q * 2.0) / (c * PI).sqrt() * integral;
     }
     Element { s, t, t_ti, v: scale * v }
+}
+
+/// The profile of the damped overlap `<φ_I| exp(−α r_w²) |φ_J> = (1 − u)^{3/2} G(u)`,
+/// `u = αq/(1 + αq)` (`operators::profile`), as the coefficients `g_k` of `G = Σ_k g_k v^k`,
+/// `v = 1 − u`. Damping by `α w wᵀ` turns `B^{-1}` into `B^{-1} − (u/q) b bᵀ`, `b = B^{-1} w`
+/// (Sherman–Morrison), and `S_0` into `(1 − u)^{3/2} S_0`, so x, y, z fall linearly in u as in the
+/// Coulomb element: `G = S_0 Ω(x' + vγ_I², y' + vγ_J², z' + vγ_Iγ_J)`, `x' = x − γ_I²`,
+/// `y' = y − γ_J²`, `z' = z − γ_Iγ_J` (the covariances conditioned on `r_w = 0`), expanded in v
+/// term by term of Ω scaled by `x`, `y`, `√(xy)` as `omega` scales it.
+pub fn profile<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &Vector<D>) -> Vec<f64> {
+    let n = go.n_ang;
+    let Some((binv, log_det)) = inverse_log_det(&(bra.a + ket.a)) else {
+        return vec![f64::NAN; (bra.k + ket.k + n) as usize + 1];
+    };
+    let (gi, gj) = (binv * bra.u, binv * ket.u);
+    let (x, y, z) = (bra.u.dot(&gi) * 0.5, ket.u.dot(&gj) * 0.5, bra.u.dot(&gj) * 0.5);
+    let sq = (w.dot(&(binv * w)) * 2.0).sqrt();
+    let (gam_i, gam_j) = (gi.dot(w) / sq, gj.dot(w) / sq);
+    let rt = (x * y).sqrt();
+    // X/x, Y/y, Z/√(xy) as polynomials a_0 + a_1 v
+    let xs = [(x - gam_i * gam_i) / x, gam_i * gam_i / x];
+    let ys = [(y - gam_j * gam_j) / y, gam_j * gam_j / y];
+    let zs = [(z - gam_i * gam_j) / rt, gam_i * gam_j / rt];
+    // Σ_k ĉ_k (XY)^{m−k} (Z²)^k, m = min(K_I, K_J), by Horner in XY: acc ← acc XY + ĉ_k Z^{2k}
+    let c = Coefficients::new(bra.k, ket.k, n).c;
+    let (xy, zz) = (times(&xs, &ys), times(&zs, &zs));
+    let (mut acc, mut zz_k) = (vec![c[0]], vec![1.0]);
+    for ck in &c[1..] {
+        zz_k = times(&zz_k, &zz);
+        acc = times(&acc, &xy);
+        for (a, b) in acc.iter_mut().zip(&zz_k) {
+            *a += ck * b;
+        }
+    }
+    let m = c.len() as u32 - 1;
+    for (factor, power) in [(&xs, bra.k - m), (&ys, ket.k - m), (&zs, n)] {
+        for _ in 0..power {
+            acc = times(&acc, factor);
+        }
+    }
+    let nf = n as f64;
+    let l = x.ln() * (bra.k as f64 + 0.5 * nf) + y.ln() * (ket.k as f64 + 0.5 * nf);
+    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
+    let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
+    acc.iter().map(|g| scale * g).collect()
+}
+
+/// The product of two polynomials (coefficients from the constant term up).
+fn times(a: &[f64], b: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; a.len() + b.len() - 1];
+    for (i, ai) in a.iter().enumerate() {
+        for (j, bj) in b.iter().enumerate() {
+            out[i + j] += ai * bj;
+        }
+    }
+    out
 }
 
 impl<const D: usize, T: Real> Transform<D, GvrOps<D>> for Gvr<D, T> {

@@ -14,7 +14,7 @@ use nalgebra::SMatrix;
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Shape, Symmetry};
+use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Momentum, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
@@ -38,6 +38,8 @@ impl<const D: usize> Family<D> for EcgGvr {
     const NAME: &'static str = "ecg-gvr";
     const FIELDS: &'static [Field] =
         &[Field::floats("A"), Field::floats("u"), Field::naturals("K"), Field::floats("c_A")];
+    /// Not derived (docs/properties-derivations.md eq. 26).
+    const MOMENTUM: Option<Momentum<D, Self>> = None;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = GvrParams<'a>;
@@ -74,8 +76,8 @@ impl<const D: usize> Family<D> for EcgGvr {
         &f.a
     }
 
-    fn shape(bra: &Gvr<D>, ket: &Gvr<D>, ctx: &GvrOps<D>) -> Shape {
-        Shape::Polynomial((bra.k + ket.k + ctx.n_ang) as usize)
+    fn shape(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &Vector<D>) -> Shape {
+        Shape::Polynomial(gvr_element::profile(bra, ket, go, w))
     }
 
     fn damped<T: Real>(f: &Gvr<D>, m: &SMatrix<T, D, D>) -> Gvr<D, T> {

@@ -1,0 +1,265 @@
+//! `p_g² = −Δ_g` and `p_g⁴`, the powers of the momentum `p_g = −i Σ_k g_k ∇_k` of a D-vector `g`,
+//! with `<φ_I| p_g⁴ |φ_J> = <Δ_g φ_I|Δ_g φ_J>` (docs/properties-derivations.md, eq. 20). In the
+//! laboratory frame `g = e_i − μ_i 1` (`μ_i = m_i/m_tot`) gives particle i's momentum in the
+//! centre-of-mass frame, the `p_i` of the mass–velocity term (§5). `g` transforms like `∇`, not
+//! like `r`: in coordinates `x = U_x r` it is `U_x g`. The elements are the family's
+//! (`Family::MOMENTUM`): plain ECGs `6τ S_IJ` and `60τ² S_IJ`, `τ = g^T A_I (A_I + A_J)^{-1} A_J g`
+//! (eqs. 22–23); floating ECGs eq. (25). ECG-GVR has none (eq. 26 is not derived) and
+//! `operators::lookup` refuses both operators for it.
+use crate::ecg::Vector;
+use crate::families::Family;
+
+pub const P2: &str = "p2";
+pub const P4: &str = "p4";
+
+/// `(<φ_I| p_g² |φ_J>, <φ_I| p_g⁴ |φ_J>)` of a family that has them (`operators::lookup` checks).
+fn moments<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> (f64, f64) {
+    let element = F::MOMENTUM.unwrap_or_else(|| panic!("p_g², p_g⁴: no element for {} functions", F::NAME));
+    element(bra, ket, ctx, g)
+}
+
+/// `<φ_I| p_g² |φ_J>` for normalised functions ((ħ/bohr)²).
+pub fn p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
+    moments::<D, F>(bra, ket, ctx, g).0
+}
+
+/// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴).
+pub fn p4<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
+    moments::<D, F>(bra, ket, ctx, g).1
+}
+
+#[cfg(test)]
+mod tests {
+    //! `p_g²` against each family's own kinetic element with `Λ = g g^T`; `p_g⁴` (and `p_g²`)
+    //! against `∫ Δ_gφ_I Δ_gφ_J` by quadrature, with `Δ_g` the second derivatives of the
+    //! functions themselves in dual numbers; the Gaussian ratio 5/3; floating ECGs at `s = 0`
+    //! equal to plain ECGs; `Σ_i p_{g_i}²/(2 m_i)` with `g_i = e_i − μ_i 1` equal to the family's
+    //! `T_TI`; ECG-GVR refused by `lookup`.
+    use nalgebra::{SMatrix, SymmetricEigen};
+    use num_dual::{Dual2_64, DualNum};
+
+    use super::*;
+    use crate::ecg::{Mat, Operators};
+    use crate::error::CoreError;
+    use crate::families::floating::fecg::{Centres, Fecg};
+    use crate::families::floating::FloatingEcg;
+    use crate::families::gvr::gvr_element::{Gvr, GvrOps};
+    use crate::families::gvr::EcgGvr;
+    use crate::families::plain::PlainEcg;
+    use crate::operators::fixtures::{close, exponent, D};
+    use crate::operators::{lookup, names};
+
+    /// Kinetic `Λ = g g^T`, no Coulomb pairs.
+    fn squared<const N: usize>(g: &Vector<N>) -> Operators<N> {
+        Operators { lambda: g * g.transpose(), pairs: vec![], cm_mass: None }
+    }
+
+    /// A plain ECG of the `PlainEcg` family (an ECG-GVR function at K = N = 0, `u` irrelevant).
+    fn plain<const N: usize>(a: Mat<N>, c_a: f64, go: &GvrOps<N>, index: usize) -> Gvr<N> {
+        Gvr::new(a, Vector::<N>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 }), 0, c_a, go, index).unwrap()
+    }
+
+    fn centres<const N: usize>(x: f64, spread: f64) -> Centres<N> {
+        Centres::<N>::from_fn(|i, c| spread * (x + i as f64 * 1.1 + c as f64 * 0.37).cos())
+    }
+
+    /// `g = e_1 − μ_1 1` of the masses (1836.15, 1, 1), and a vector without structure.
+    fn vectors() -> [Vector<D>; 2] {
+        let mu = Vector::<D>::new(1836.15267343, 1.0, 1.0) / 1838.15267343;
+        [Vector::<D>::new(1.0, 0.0, 0.0) - Vector::<D>::repeat(mu[0]), Vector::<D>::new(0.3, -1.1, 0.6)]
+    }
+
+    const SEEDS: [(f64, f64); 3] = [(0.1, 0.9), (1.3, 2.2), (0.4, 0.4)];
+
+    #[test]
+    fn p2_is_the_kinetic_element_with_lambda_g_g() {
+        let mut worst: f64 = 0.0;
+        for g in vectors() {
+            let go = GvrOps::new(squared(&g), 0, 0).unwrap();
+            for (si, sj) in SEEDS {
+                let (gi, gj) = (plain(exponent(si), 1.0, &go, 0), plain(exponent(sj), 1.0, &go, 1));
+                let got = p2::<D, PlainEcg>(&gi, &gj, &go, &g);
+                let want = <PlainEcg as Family<D>>::element(&gi, &gj, &go).t;
+                assert!(close(got, want, 1e-12), "plain: {got} vs {want}");
+                worst = worst.max((got / want - 1.0).abs());
+                for spread in [0.3, 1.5] {
+                    let fi = Fecg::new(exponent(si), centres(0.3, spread), 1.0, 0).unwrap();
+                    let fj = Fecg::new(exponent(sj), centres(2.1, spread), 1.0, 1).unwrap();
+                    let ops = squared(&g);
+                    let got = p2::<D, FloatingEcg>(&fi, &fj, &ops, &g);
+                    let want = <FloatingEcg as Family<D>>::element(&fi, &fj, &ops).t;
+                    assert!(close(got, want, 1e-12), "floating, spread {spread}: {got} vs {want}");
+                    worst = worst.max((got / want - 1.0).abs());
+                }
+            }
+        }
+        eprintln!("p2 against T(Λ = g gᵀ): largest relative deviation {worst:.1e}");
+    }
+
+    /// The nodes and weights of the 4-point Gauss–Hermite rule, `∫ e^{−y²} f(y) dy` (Golub–Welsch).
+    fn gauss_hermite() -> [(f64, f64); 4] {
+        let off = |i: usize, j: usize| (i.max(j) as f64 / 2.0).sqrt(); // (J)_{k−1,k} = √(k/2)
+        let jacobi = SMatrix::<f64, 4, 4>::from_fn(|i, j| if i.abs_diff(j) == 1 { off(i, j) } else { 0.0 });
+        let eig = SymmetricEigen::new(jacobi);
+        std::array::from_fn(|k| (eig.eigenvalues[k], std::f64::consts::PI.sqrt() * eig.eigenvectors[(0, k)].powi(2)))
+    }
+
+    /// `φ(r)` and `Δ_gφ(r) = Σ_c ∂²/∂t² φ(r + t g e_c^T)` of `φ = exp(−tr((r − s)^T A (r − s)))`,
+    /// the second derivative by dual numbers.
+    fn laplacian(a: &Mat<2>, s: &Centres<2>, r: &Centres<2>, g: &Vector<2>) -> (f64, f64) {
+        let along = |c: usize| {
+            let dt = |k: usize, l: usize| if l == c { g[k] } else { 0.0 };
+            let d = SMatrix::<Dual2_64, 2, 3>::from_fn(|k, l| Dual2_64::new(r[(k, l)] - s[(k, l)], dt(k, l), 0.0));
+            let mut e = Dual2_64::from_re(0.0);
+            for l in 0..3 {
+                for k in 0..2 {
+                    for m in 0..2 {
+                        e += d[(k, l)] * d[(m, l)] * a[(k, m)];
+                    }
+                }
+            }
+            (-e).exp()
+        };
+        (along(0).re, (0..3).map(|c| along(c).v2).sum())
+    }
+
+    /// `(∫ φ_Iφ_J, −∫ φ_I Δ_gφ_J, ∫ Δ_gφ_I Δ_gφ_J)` of unnormalised functions in two coordinates,
+    /// over the common factor `|A_I + A_J|^{−3/2}`: the 4-point Gauss–Hermite product rule in
+    /// `y = L^T (r − r̄)`, `L L^T = A_I + A_J`, `r̄ = (A_I + A_J)^{-1}(A_I s_I + A_J s_J)`, exact for
+    /// the Gaussian `φ_Iφ_J` times polynomials of degree ≤ 7 in `r`.
+    fn quadrature(ai: &Mat<2>, si: &Centres<2>, aj: &Mat<2>, sj: &Centres<2>, g: &Vector<2>) -> [f64; 3] {
+        let b = ai + aj;
+        let rbar = b.try_inverse().unwrap() * (ai * si + aj * sj);
+        let back = b.cholesky().unwrap().l().transpose().try_inverse().unwrap(); // r = r̄ + L^{-T} y
+        let rule = gauss_hermite();
+        let mut sums = [0.0; 3];
+        for index in 0..4usize.pow(6) {
+            let (mut y, mut weight) = (Centres::<2>::zeros(), 1.0);
+            for e in 0..6 {
+                let (node, w) = rule[index / 4usize.pow(e as u32) % 4];
+                y[(e % 2, e / 2)] = node;
+                weight *= w;
+            }
+            let r = rbar + back * y;
+            let weight = weight * y.norm_squared().exp();
+            let ((fi, lap_i), (fj, lap_j)) = (laplacian(ai, si, &r, g), laplacian(aj, sj, &r, g));
+            for (sum, term) in sums.iter_mut().zip([fi * fj, -fi * lap_j, lap_i * lap_j]) {
+                *sum += weight * term;
+            }
+        }
+        sums
+    }
+
+    #[test]
+    fn p2_and_p4_match_quadrature_of_the_laplacians() {
+        let g = Vector::<2>::new(0.8, -0.35);
+        let sub = |seed: f64| exponent(seed).fixed_view::<2, 2>(0, 0).into_owned();
+        let go = GvrOps::new(squared(&g), 0, 0).unwrap();
+        let mut worst: f64 = 0.0;
+        for (si, sj) in SEEDS {
+            let (ai, aj) = (sub(si), sub(sj));
+            let zero = Centres::<2>::zeros();
+            let (gi, gj) = (plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1));
+            let s = <PlainEcg as Family<2>>::overlap(&gi, &gj, &go);
+            let got = [p2::<2, PlainEcg>(&gi, &gj, &go, &g), p4::<2, PlainEcg>(&gi, &gj, &go, &g)];
+            let q = quadrature(&ai, &zero, &aj, &zero, &g);
+            for k in 0..2 {
+                let want = q[k + 1] / q[0] * s;
+                assert!(close(got[k], want, 1e-12), "plain, p{}: {} vs {want}", 2 * k + 2, got[k]);
+                worst = worst.max((got[k] / want - 1.0).abs());
+            }
+            for spread in [0.3, 1.5] {
+                let (ci, cj) = (centres::<2>(0.3, spread), centres::<2>(2.1, spread));
+                let ops = squared(&g);
+                let (fi, fj) = (Fecg::new(ai, ci, 1.0, 0).unwrap(), Fecg::new(aj, cj, 1.0, 1).unwrap());
+                let s = <FloatingEcg as Family<2>>::overlap(&fi, &fj, &ops);
+                let got = [p2::<2, FloatingEcg>(&fi, &fj, &ops, &g), p4::<2, FloatingEcg>(&fi, &fj, &ops, &g)];
+                let q = quadrature(&ai, &ci, &aj, &cj, &g);
+                for k in 0..2 {
+                    let want = q[k + 1] / q[0] * s;
+                    assert!(close(got[k], want, 1e-12), "floating, spread {spread}, p{}: {} vs {want}", 2 * k + 2, got[k]);
+                    worst = worst.max((got[k] / want - 1.0).abs());
+                }
+            }
+        }
+        eprintln!("p2, p4 against quadrature: largest relative deviation {worst:.1e}");
+    }
+
+    #[test]
+    fn a_gaussian_has_p4_over_p2_squared_five_thirds() {
+        let mut worst: f64 = 0.0;
+        for g in vectors() {
+            let go = GvrOps::new(squared(&g), 0, 0).unwrap();
+            for seed in [0.1, 1.3, 2.2] {
+                let f = plain(exponent(seed), 1.0, &go, 0);
+                let s = <PlainEcg as Family<D>>::overlap(&f, &f, &go);
+                let ratio = p4::<D, PlainEcg>(&f, &f, &go, &g) * s / p2::<D, PlainEcg>(&f, &f, &go, &g).powi(2);
+                assert!(close(ratio, 5.0 / 3.0, 1e-14), "{ratio}");
+                worst = worst.max((ratio * 0.6 - 1.0).abs());
+            }
+        }
+        eprintln!("p4 S/p2² against 5/3: largest relative deviation {worst:.1e}");
+    }
+
+    #[test]
+    fn floating_ecgs_at_zero_centres_are_plain_ecgs() {
+        let mut worst: f64 = 0.0;
+        for g in vectors() {
+            let (ops, go) = (squared(&g), GvrOps::new(squared(&g), 0, 0).unwrap());
+            for (si, sj) in SEEDS {
+                let (gi, gj) = (plain(exponent(si), 1.0, &go, 0), plain(exponent(sj), 1.0, &go, 1));
+                let fi = Fecg::new(exponent(si), Centres::<D>::zeros(), 1.0, 0).unwrap();
+                let fj = Fecg::new(exponent(sj), Centres::<D>::zeros(), 1.0, 1).unwrap();
+                let want = [p2::<D, PlainEcg>(&gi, &gj, &go, &g), p4::<D, PlainEcg>(&gi, &gj, &go, &g)];
+                let got = [p2::<D, FloatingEcg>(&fi, &fj, &ops, &g), p4::<D, FloatingEcg>(&fi, &fj, &ops, &g)];
+                assert!(close(got[0], want[0], 1e-13) && close(got[1], want[1], 1e-13), "{got:?} vs {want:?}");
+                worst = worst.max((got[0] / want[0] - 1.0).abs()).max((got[1] / want[1] - 1.0).abs());
+            }
+        }
+        eprintln!("floating ECGs at s = 0 against plain ECGs: largest relative deviation {worst:.1e}");
+    }
+
+    #[test]
+    fn the_momenta_in_the_centre_of_mass_frame_sum_to_the_translation_free_kinetic_energy() {
+        // Σ_i (p_i − μ_i P)²/(2 m_i) = T − P²/(2 m_tot) (§5) for CM-separable functions, A 1 = c_A μ:
+        // A = Π A_0 Π^T + c_A μ μ^T with Π = 1 − μ 1^T (Π^T 1 = 0)
+        let m = Vector::<D>::new(1836.15267343, 1.0, 1.0);
+        let (m_tot, mu) = (m.sum(), m / m.sum());
+        let pi = Mat::<D>::identity() - mu * Vector::<D>::repeat(1.0).transpose();
+        let separable = |seed: f64, c_a: f64| pi * exponent(seed) * pi.transpose() + mu * mu.transpose() * c_a;
+        let lambda = Mat::<D>::from_diagonal(&m.map(|x| 0.5 / x));
+        let ops = Operators { lambda, pairs: vec![], cm_mass: Some(m_tot) };
+        let go = GvrOps::new(ops.clone(), 0, 0).unwrap();
+        let g = |i: usize| Vector::<D>::ith(i, 1.0) - Vector::<D>::repeat(mu[i]);
+        let mut worst: f64 = 0.0;
+        for ((si, sj), (ci, cj)) in SEEDS.into_iter().zip([(0.7, 1.3), (0.7, 0.7), (2.0, 0.4)]) {
+            let (ai, aj) = (separable(si, ci), separable(sj, cj));
+            let (gi, gj) = (plain(ai, ci, &go, 0), plain(aj, cj, &go, 1));
+            let got = (0..D).map(|i| p2::<D, PlainEcg>(&gi, &gj, &go, &g(i)) / (2.0 * m[i])).sum::<f64>();
+            let want = <PlainEcg as Family<D>>::element(&gi, &gj, &go).t_ti;
+            assert!(close(got, want, 1e-12), "plain: {got} vs {want}");
+            worst = worst.max((got / want - 1.0).abs());
+            let fi = Fecg::new(ai, centres(0.3, 1.0), ci, 0).unwrap();
+            let fj = Fecg::new(aj, centres(2.1, 1.0), cj, 1).unwrap();
+            let got = (0..D).map(|i| p2::<D, FloatingEcg>(&fi, &fj, &ops, &g(i)) / (2.0 * m[i])).sum::<f64>();
+            let want = <FloatingEcg as Family<D>>::element(&fi, &fj, &ops).t_ti;
+            assert!(close(got, want, 1e-12), "floating: {got} vs {want}");
+            worst = worst.max((got / want - 1.0).abs());
+        }
+        eprintln!("Σ_i p2(e_i − μ_i 1)/(2 m_i) against T_TI: largest relative deviation {worst:.1e}");
+    }
+
+    #[test]
+    fn ecg_gvr_functions_are_refused_in_one_line() {
+        assert!(names().contains(&P2) && names().contains(&P4));
+        for name in [P2, P4] {
+            assert!(lookup::<D, PlainEcg>(name).is_ok() && lookup::<D, FloatingEcg>(name).is_ok());
+            match lookup::<D, EcgGvr>(name) {
+                Err(CoreError::Unsupported(msg)) => {
+                    assert!(msg.contains(name) && msg.contains("ecg-gvr") && !msg.contains('\n'), "{msg}")
+                }
+                other => panic!("{name}: {:?}", other.map(|_| ())),
+            }
+        }
+    }
+}
