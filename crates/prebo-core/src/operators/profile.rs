@@ -13,10 +13,8 @@
 use std::sync::OnceLock;
 
 use crate::ecg::{Mat, Vector};
-use crate::families::gvr::gvr_element::{gauss_legendre, legendre_rule};
+use crate::families::gvr::gvr_element::gauss_legendre;
 use crate::families::{Family, Shape};
-use crate::gradient::{seed, Dual};
-use nalgebra::{Const, U1};
 
 /// `G(u)` of one pair of functions and one vector `w`.
 pub struct Profile<'a, const D: usize, F: Family<D>> {
@@ -35,8 +33,13 @@ impl<'a, const D: usize, F: Family<D>> Profile<'a, D, F> {
     pub fn of(bra: &'a F::Function<f64>, ket: &'a F::Function<f64>, ctx: &'a F::Context, w: &Vector<D>) -> Self {
         let b = F::exponent(bra) + F::exponent(ket);
         let q = b.cholesky().map_or(f64::NAN, |c| w.dot(&c.solve(w)));
-        let s = F::overlap(bra, ket, ctx);
-        Self { bra, ket, ctx, ww: w * w.transpose(), s, q, shape: F::shape(bra, ket, ctx, w) }
+        let shape = F::shape(bra, ket, ctx, w);
+        // a polynomial profile's G(0) = Σ_k g_k; an exponential one's from the family's overlap
+        let s = match &shape {
+            Shape::Polynomial(g) => g.iter().sum(),
+            Shape::Exponential => F::overlap(bra, ket, ctx),
+        };
+        Self { bra, ket, ctx, ww: w * w.transpose(), s, q, shape }
     }
 
     /// The damping `α` of `u`.
@@ -47,14 +50,6 @@ impl<'a, const D: usize, F: Family<D>> Profile<'a, D, F> {
     /// `G(u)`, `0 ≤ u < 1`.
     pub fn at(&self, u: f64) -> f64 {
         F::overlap(self.bra, &F::damped(self.ket, &(self.ww * self.alpha(u))), self.ctx) / (1.0 - u).powf(1.5)
-    }
-
-    /// `−∂/∂α <φ_I| exp(−α r_w²) |φ_J>` at the `α` of `u`, over `(1 − u)^{3/2}` (`<r_w² exp(−α r_w²)>`).
-    pub fn slope(&self, u: f64) -> f64 {
-        let alpha: Dual<1> = seed(self.alpha(u), std::iter::once(1.0));
-        let damping = self.ww.map(|x| alpha * x);
-        let d = F::overlap(&F::cast::<Dual<1>>(self.bra), &F::damped(self.ket, &damping), self.ctx);
-        -d.eps.unwrap_generic(Const::<1>, U1)[0] / (1.0 - u).powf(1.5)
     }
 
     /// `G(1)`, the limit `α → ∞`: `g_0` of a polynomial profile, `G(½)² / S` for `S exp(−λu)`.
@@ -73,10 +68,32 @@ impl<'a, const D: usize, F: Family<D>> Profile<'a, D, F> {
         (2.0 * (self.s / self.at(0.5)).ln()).max(0.0)
     }
 
-    /// `∫_0^1 g(τ) dτ` of an even polynomial `g` of degree ≤ `2 degree` (Gauss–Legendre, exact).
-    pub fn even_integral(degree: usize, g: impl Fn(f64) -> f64) -> f64 {
-        legendre_rule(degree / 2 + 1).iter().map(|&(t, wt)| wt * g(t)).sum()
+    /// `<φ_I| |r_w|^n |φ_J>` of a polynomial profile, `n > −3`: the moment of the density (31)
+    /// (density.rs), `q^{n/2} Σ_k g_k Γ(k + 3/2 + n/2)/Γ(k + 3/2)` (docs/properties-derivations.md,
+    /// eq. 33; `Σ_k g_k = S` at n = 0); `None` for an exponential profile.
+    pub fn moment(&self, n: i32) -> Option<f64> {
+        let Shape::Polynomial(g) = &self.shape else { return None };
+        let shift = 0.5 * n as f64;
+        // Γ(k + 3/2 + n/2)/Γ(k + 3/2) from k = 0, times (k + 3/2 + n/2)/(k + 3/2) per step
+        let mut ratio = (ln_gamma(1.5 + shift) - ln_gamma(1.5)).exp();
+        let mut sum = 0.0;
+        for (k, gk) in g.iter().enumerate() {
+            sum += gk * ratio;
+            ratio *= (k as f64 + 1.5 + shift) / (k as f64 + 1.5);
+        }
+        Some(self.q.powf(shift) * sum)
     }
+}
+
+/// `ln Γ(x)` at the half-integers and integers `x ≥ ½` the moments need (exact recurrences from
+/// `Γ(½) = √π` and `Γ(1) = 1`).
+fn ln_gamma(x: f64) -> f64 {
+    let (mut value, mut y) = (0.0, x);
+    while y > 1.0 {
+        y -= 1.0;
+        value += y.ln();
+    }
+    value + if y == 0.5 { 0.5 * std::f64::consts::PI.ln() } else { 0.0 }
 }
 
 /// `∫_0^1 exp(−λ(1 − σ²)) dσ` (= Dawson's integral `D(√λ)/√λ`): 16-point Gauss–Legendre panels
@@ -116,8 +133,10 @@ mod tests {
     use crate::families::gvr::gvr_element::{Gvr, GvrOps};
     use crate::families::gvr::EcgGvr;
     use crate::families::plain::PlainEcg;
+    use crate::gradient::{seed, Dual};
     use crate::operators::fixtures::{close, exponent, operators, w, D};
     use crate::operators::{delta, distance, inverse, inverse_square};
+    use nalgebra::{Const, U1};
 
     type El<F> = fn(&<F as Family<D>>::Function<f64>, &<F as Family<D>>::Function<f64>, &<F as Family<D>>::Context, &Vector<D>) -> f64;
 
@@ -125,6 +144,15 @@ mod tests {
     fn four<F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context) -> [f64; 4] {
         let els: [El<F>; 4] = [delta::element::<D, F>, inverse::element::<D, F>, distance::element::<D, F>, inverse_square::element::<D, F>];
         els.map(|el| el(bra, ket, ctx, &w()))
+    }
+
+    /// `−∂/∂α <φ_I| exp(−α r_w²) |φ_J>` at the `α` of `u`, over `(1 − u)^{3/2}` (`<r_w² exp(−α r_w²)>`),
+    /// in dual numbers: the integrand of `<|r_w|>` (eq. 18) without the profile's coefficients.
+    fn slope<F: Family<D>>(p: &Profile<D, F>, u: f64) -> f64 {
+        let alpha: Dual<1> = seed(p.alpha(u), std::iter::once(1.0));
+        let damping = p.ww.map(|x| alpha * x);
+        let d = F::overlap(&F::cast::<Dual<1>>(p.bra), &F::damped(p.ket, &damping), p.ctx);
+        -d.eps.unwrap_generic(Const::<1>, U1)[0] / (1.0 - u).powf(1.5)
     }
 
     /// `∫_0^1 f` by an n-point Gauss–Legendre rule.
@@ -179,8 +207,8 @@ mod tests {
 
     #[test]
     fn global_vector_functions_match_rules_on_the_damped_overlap() {
-        for (ki, kj, n_ang) in [(1, 0, 0), (2, 1, 1), (1, 3, 2)] {
-            let go = GvrOps::new(operators(vec![(w(), 1.0)]), n_ang, 3).unwrap();
+        for (ki, kj, n_ang) in [(1, 0, 0), (2, 1, 1), (1, 3, 2), (12, 15, 1)] {
+            let go = GvrOps::new(operators(vec![(w(), 1.0)]), n_ang, 15).unwrap();
             let gi = Gvr::new(exponent(0.5), Vector::<D>::new(0.3, 1.0, -0.4), ki, 1.0, &go, 0).unwrap();
             let gj = Gvr::new(exponent(1.1), Vector::<D>::new(-0.7, 0.2, 0.9), kj, 1.0, &go, 1).unwrap();
             let p = Profile::<D, EcgGvr>::of(&gi, &gj, &go, &w());
@@ -191,7 +219,7 @@ mod tests {
             let alpha = |u: f64| u / (q * (1.0 - u));
             let inv_r = 2.0 / (PI * q).sqrt() * integral(60, |t| damped(alpha(t * t)) / (1.0 - t * t).powf(1.5));
             let inv_r2 = 2.0 / q * integral(60, |s| damped(alpha(1.0 - s * s)) / (s * s * s));
-            let r = 2.0 / (PI * q).sqrt() * integral(60, |t| p.slope(t * t));
+            let r = 2.0 / (PI * q).sqrt() * integral(60, |t| slope(&p, t * t));
             // (α/π)^{3/2} D(α) = δ (1 − 3/(2αq) + …), analytic in 1/α: Richardson over α = 2^j·64/q
             let mut table: Vec<f64> = (0..9).map(|j| {
                 let a = 64.0 * 2f64.powi(j) / q;

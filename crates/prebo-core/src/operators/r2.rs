@@ -3,9 +3,12 @@
 //!
 //! `exp(−α r_w²) = exp(−r^T (α w w^T ⊗ I_3) r)` is a Gaussian factor, so for every family
 //! `<φ_I|r_w²|φ_J> = −∂/∂α <φ_I|φ_J exp(−α r_w²)>` at α = 0 with the normalisation constants
-//! held fixed (`Family::damped`): one dual number through the family's overlap, exact.
+//! held fixed (`Family::damped`): one dual number through the family's overlap, exact; for a
+//! polynomial profile (profile.rs) the same as its moment n = 2, `q Σ_k g_k (k + 3/2)`, which is
+//! what is evaluated then (docs/properties-derivations.md, eq. 33).
 use nalgebra::{Const, U1};
 
+use super::profile::Profile;
 use crate::ecg::Vector;
 use crate::families::Family;
 use crate::gradient::{seed, Dual};
@@ -19,10 +22,12 @@ pub fn element<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     w: &Vector<D>,
 ) -> f64 {
-    let alpha: Dual<1> = seed(0.0, std::iter::once(1.0));
-    let damping = (w * w.transpose()).map(|x| alpha * x);
-    let s = F::overlap(&F::cast::<Dual<1>>(bra), &F::damped(ket, &damping), ctx);
-    -s.eps.unwrap_generic(Const::<1>, U1)[0]
+    Profile::<D, F>::of(bra, ket, ctx, w).moment(2).unwrap_or_else(|| {
+        let alpha: Dual<1> = seed(0.0, std::iter::once(1.0));
+        let damping = (w * w.transpose()).map(|x| alpha * x);
+        let s = F::overlap(&F::cast::<Dual<1>>(bra), &F::damped(ket, &damping), ctx);
+        -s.eps.unwrap_generic(Const::<1>, U1)[0]
+    })
 }
 
 #[cfg(test)]
