@@ -6,6 +6,8 @@ import sys
 import numpy as np
 import pytest
 
+from prebo.expectation import OPERATORS
+
 REQUIRED = {"energy", "energy_lab", "virial", "n_basis", "basis_type", "particles", "symmetry"}
 
 
@@ -31,6 +33,10 @@ def test_run_writes_result_and_basis(run_dir):
     assert [p["name"] for p in result["particles"]] == ["p", "e"]
     m = 1836.15267343
     assert -0.5 * m / (1 + m) < result["energy"] < -0.49  # variational, and a real optimisation
+    # the properties block: every operator plain ECGs evaluate, per pair or particle class
+    assert set(result["expectation"]) == set(OPERATORS) and set(result["expectation"]["p2"]) == {"p", "e"}
+    assert result["expectation"]["p2"]["e"] / (2 * 1.0) + result["expectation"]["p2"]["p"] / (2 * m) == \
+        pytest.approx(result["kinetic"], rel=1e-10)
     basis = json.loads((run_dir / "basis.json").read_text())
     assert basis["format"] == "prebo-basis" and len(basis["functions"]) == 6
     assert {"A", "c_A", "channel"} <= set(basis["functions"][0])

@@ -133,7 +133,8 @@ def _warn_if_unbound(r: dict) -> None:
 def cmd_run(args) -> int:
     """`prebo run INPUT [--out DIR] [--force]` or `prebo run --resume DIR`, either with `--budget
     SECONDS` (the wall time of the whole run, resumed parts included, in place of the input's or
-    checkpoint's): optimise, then write DIR/result.json (`_result`, energies in Eh) of the lowest
+    checkpoint's): optimise, then write DIR/result.json (`_result`, energies in Eh, and per level the
+    expectation values of every operator the basis family evaluates) of the lowest
     state at the size the run passed through, beside the checkpoint DIR/basis.json (and
     DIR/lowest.json if the run stands above that state); warn when the state is not bound in the
     basis. The run owns DIR from before it looks into it until it ends (io/lock.py). A new run
@@ -172,7 +173,8 @@ def cmd_run(args) -> int:
         title = title or basis.system.label()
         where = out / LOWEST if (out / LOWEST).exists() else out / CHECKPOINT  # the file of the state returned
         levels = basis.convergence.get("levels")  # where the targeted levels stand, if followed
-        r = _result(basis, where, opts.threshold, roots=None if levels is None else max(levels) + 1)
+        derived = [name for name, op in OPERATORS.items() if op.evaluates(basis.family)]  # the properties block
+        r = _result(basis, where, opts.threshold, operators=derived, roots=None if levels is None else max(levels) + 1)
         if levels is not None:
             r["targets"] = levels
         r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
