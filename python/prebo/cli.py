@@ -174,7 +174,12 @@ def cmd_run(args) -> int:
         where = out / LOWEST if (out / LOWEST).exists() else out / CHECKPOINT  # the file of the state returned
         levels = basis.convergence.get("levels")  # where the targeted levels stand, if followed
         derived = [name for name, op in OPERATORS.items() if op.evaluates(basis.family)]  # the properties block
-        r = _result(basis, where, opts.threshold, operators=derived, roots=None if levels is None else max(levels) + 1)
+        roots = None if levels is None else max(levels) + 1
+        try:
+            r = _result(basis, where, opts.threshold, operators=derived, roots=roots)
+        except NonFiniteError as exc:  # the energies stand without the properties: say so, write them
+            r = _result(basis, where, opts.threshold, roots=roots)
+            print(f"prebo: warning: result.json without expectation values: {exc}", file=sys.stderr)
         if levels is not None:
             r["targets"] = levels
         r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
