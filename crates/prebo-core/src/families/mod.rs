@@ -209,7 +209,7 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// (lower index as bra), so that rows patched into the matrices give the bits of `matrices`.
     const ORIENTED: bool = true;
     /// The element of the momentum operators `p_g²` and `p_g⁴` (`Momentum`), or `None` where the
-    /// family's is not derived (`operators::lookup` then refuses them).
+    /// family's `p_g⁴` is not derived (`operators::lookup` then refuses it).
     const MOMENTUM: Option<Momentum<D, Self>>;
     /// One function over the scalar `T`.
     type Function<T: Real>: Clone + Send + Sync + Transform<D, Self::Context>;
@@ -255,6 +255,13 @@ pub trait Family<const D: usize>: Sized + 'static {
 
     /// The Gaussian exponent `A` of `f`, `exp(−r^T (A ⊗ I_3) r)` (the representation's coordinates).
     fn exponent(f: &Self::Function<f64>) -> &Mat<D>;
+
+    /// `<phi_I| p_g² |phi_J>` (`operators::momentum`): `MOMENTUM`'s, or a family without it
+    /// gives its kinetic element with `Λ = g g^T`.
+    fn momentum_square(bra: &Self::Function<f64>, ket: &Self::Function<f64>, ctx: &Self::Context, g: &Vector<D>) -> f64 {
+        let element = Self::MOMENTUM.unwrap_or_else(|| panic!("p_g²: no element for {} functions", Self::NAME));
+        element(bra, ket, ctx, g).0
+    }
 
     /// How the damped overlap of `bra` and `ket` depends on the damping (`Shape`).
     fn shape(bra: &Self::Function<f64>, ket: &Self::Function<f64>, ctx: &Self::Context, w: &Vector<D>) -> Shape;

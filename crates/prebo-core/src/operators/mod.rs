@@ -31,15 +31,15 @@ pub type ElementFn<const D: usize, F> = fn(
 
 /// The registered operators: name and element function (`None`: not derived for the family `F`).
 fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, Option<ElementFn<D, F>>)> {
-    let derived = |element: ElementFn<D, F>| F::MOMENTUM.map(|_| element);
+    let quartic = |element: ElementFn<D, F>| F::MOMENTUM.map(|_| element);
     vec![
         (r2::NAME, Some(r2::element::<D, F>)),
         (distance::NAME, Some(distance::element::<D, F>)),
         (inverse::NAME, Some(inverse::element::<D, F>)),
         (inverse_square::NAME, Some(inverse_square::element::<D, F>)),
         (delta::NAME, Some(delta::element::<D, F>)),
-        (momentum::P2, derived(momentum::p2::<D, F>)),
-        (momentum::P4, derived(momentum::p4::<D, F>)),
+        (momentum::P2, Some(momentum::p2::<D, F>)),
+        (momentum::P4, quartic(momentum::p4::<D, F>)),
     ]
 }
 

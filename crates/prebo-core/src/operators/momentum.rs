@@ -4,28 +4,24 @@
 //! centre-of-mass frame, the `p_i` of the mass–velocity term (§5). `g` transforms like `∇`, not
 //! like `r`: in coordinates `x = U_x r` it is `U_x g`. The elements are the family's
 //! (`Family::MOMENTUM`): plain ECGs `6τ S_IJ` and `60τ² S_IJ`, `τ = g^T A_I (A_I + A_J)^{-1} A_J g`
-//! (eqs. 22–23); floating ECGs eq. (25). ECG-GVR has none (eq. 26 is not derived) and
-//! `operators::lookup` refuses both operators for it.
+//! (eqs. 22–23); floating ECGs eq. (25). ECG-GVR has `p_g²` as its kinetic element with
+//! `Λ = g g^T` and no `p_g⁴` (eq. 26 is not derived): `operators::lookup` refuses that for it.
 use crate::ecg::Vector;
 use crate::families::Family;
 
 pub const P2: &str = "p2";
 pub const P4: &str = "p4";
 
-/// `(<φ_I| p_g² |φ_J>, <φ_I| p_g⁴ |φ_J>)` of a family that has them (`operators::lookup` checks).
-fn moments<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> (f64, f64) {
-    let element = F::MOMENTUM.unwrap_or_else(|| panic!("p_g², p_g⁴: no element for {} functions", F::NAME));
-    element(bra, ket, ctx, g)
-}
-
-/// `<φ_I| p_g² |φ_J>` for normalised functions ((ħ/bohr)²).
+/// `<φ_I| p_g² |φ_J>` for normalised functions ((ħ/bohr)²; `Family::momentum_square`).
 pub fn p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
-    moments::<D, F>(bra, ket, ctx, g).0
+    F::momentum_square(bra, ket, ctx, g)
 }
 
-/// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴).
+/// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴) of a family that has it
+/// (`operators::lookup` checks).
 pub fn p4<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
-    moments::<D, F>(bra, ket, ctx, g).1
+    let element = F::MOMENTUM.unwrap_or_else(|| panic!("p_g⁴: no element for {} functions", F::NAME));
+    element(bra, ket, ctx, g).1
 }
 
 #[cfg(test)]
@@ -34,7 +30,7 @@ mod tests {
     //! against `∫ Δ_gφ_I Δ_gφ_J` by quadrature, with `Δ_g` the second derivatives of the
     //! functions themselves in dual numbers; the Gaussian ratio 5/3; floating ECGs at `s = 0`
     //! equal to plain ECGs; `Σ_i p_{g_i}²/(2 m_i)` with `g_i = e_i − μ_i 1` equal to the family's
-    //! `T_TI`; ECG-GVR refused by `lookup`.
+    //! `T_TI` (plain, floating and ECG-GVR functions); ECG-GVR's `p_g⁴` refused by `lookup`.
     use nalgebra::{SMatrix, SymmetricEigen};
     use num_dual::{Dual2_64, DualNum};
 
@@ -245,21 +241,30 @@ mod tests {
             let want = <FloatingEcg as Family<D>>::element(&fi, &fj, &ops).t_ti;
             assert!(close(got, want, 1e-12), "floating: {got} vs {want}");
             worst = worst.max((got / want - 1.0).abs());
+            // ECG-GVR (its kinetic element with Λ = g gᵀ), K = 2 and 3, N = 1, 1ᵀu = 0
+            let gvr_ops = GvrOps::new(ops.clone(), 1, 3).unwrap();
+            let (ui, uj) = (Vector::<D>::new(0.4, -1.0, 0.6), Vector::<D>::new(-0.9, 0.2, 0.7));
+            let (gi, gj) = (Gvr::new(ai, ui, 2, ci, &gvr_ops, 0).unwrap(), Gvr::new(aj, uj, 3, cj, &gvr_ops, 1).unwrap());
+            let got = (0..D).map(|i| p2::<D, EcgGvr>(&gi, &gj, &gvr_ops, &g(i)) / (2.0 * m[i])).sum::<f64>();
+            let want = <EcgGvr as Family<D>>::element(&gi, &gj, &gvr_ops).t_ti;
+            assert!(close(got, want, 1e-12), "ECG-GVR: {got} vs {want}");
+            worst = worst.max((got / want - 1.0).abs());
         }
         eprintln!("Σ_i p2(e_i − μ_i 1)/(2 m_i) against T_TI: largest relative deviation {worst:.1e}");
     }
 
     #[test]
-    fn ecg_gvr_functions_are_refused_in_one_line() {
+    fn ecg_gvr_functions_are_refused_p4_in_one_line() {
         assert!(names().contains(&P2) && names().contains(&P4));
         for name in [P2, P4] {
             assert!(lookup::<D, PlainEcg>(name).is_ok() && lookup::<D, FloatingEcg>(name).is_ok());
-            match lookup::<D, EcgGvr>(name) {
-                Err(CoreError::Unsupported(msg)) => {
-                    assert!(msg.contains(name) && msg.contains("ecg-gvr") && !msg.contains('\n'), "{msg}")
-                }
-                other => panic!("{name}: {:?}", other.map(|_| ())),
+        }
+        assert!(lookup::<D, EcgGvr>(P2).is_ok());
+        match lookup::<D, EcgGvr>(P4) {
+            Err(CoreError::Unsupported(msg)) => {
+                assert!(msg.contains(P4) && msg.contains("ecg-gvr") && !msg.contains('\n'), "{msg}")
             }
+            other => panic!("{P4}: {:?}", other.map(|_| ())),
         }
     }
 }

@@ -98,6 +98,12 @@ impl<const D: usize> GvrOps<D> {
         Ok(Self { ops, n_ang, legendre: (0..=d_max).map(|d| legendre_rule(d / 2 + 1)).collect() })
     }
 
+    /// This context with the kinetic matrix `Λ` replaced, no Coulomb pairs and no CM elimination:
+    /// its `T` is `<∇φ_I|Λ|∇φ_J>` alone.
+    pub fn with_kinetic(&self, lambda: Mat<D>) -> Self {
+        Self { ops: Operators { lambda, pairs: vec![], cm_mass: None }, n_ang: self.n_ang, legendre: self.legendre.clone() }
+    }
+
     fn k_max(&self) -> u32 {
         ((self.legendre.len() - 1) as u32 - self.n_ang) / 2
     }

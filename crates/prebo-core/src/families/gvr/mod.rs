@@ -76,6 +76,11 @@ impl<const D: usize> Family<D> for EcgGvr {
         &f.a
     }
 
+    /// The kinetic element with `Λ = g g^T` (`p_g⁴` is not derived: `MOMENTUM` is `None`).
+    fn momentum_square(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &Vector<D>) -> f64 {
+        element(bra, ket, &go.with_kinetic(g * g.transpose())).t
+    }
+
     fn shape(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &Vector<D>) -> Shape {
         Shape::Polynomial(gvr_element::profile(bra, ket, go, w))
     }
