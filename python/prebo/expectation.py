@@ -38,26 +38,18 @@ def pair_classes(system) -> dict[str, np.ndarray]:
     return {label: np.array(w) for label, w in out.items()}
 
 
-def particle_classes(system) -> dict[str, np.ndarray]:
-    """{"a": LFCC vectors w = e_i − μ of every particle i named a}, μ the mass fractions m/m_tot, so
-    that r_w = r_i − R is particle i's position about the centre of mass R."""
+def particle_classes(system, momentum: bool = False) -> dict[str, np.ndarray]:
+    """{"a": vectors of every particle i named a}: w = e_i − μ (μ the mass fractions m/m_tot), so
+    that r_w = r_i − R is particle i's position about the centre of mass R, or with `momentum`
+    g = e_i − μ_i 1, so that p_g = p_i − μ_i P is its momentum in the centre-of-mass frame (g
+    transforms like ∇, not like r)."""
+    mu = system.cm_vector
     out: dict[str, list] = {}
     for i, p in enumerate(system.particles):
-        w = -system.cm_vector
-        w[i] += 1.0
-        out.setdefault(p.name, []).append(w)
-    return {label: np.array(w) for label, w in out.items()}
-
-
-def momentum_classes(system) -> dict[str, np.ndarray]:
-    """{"a": vectors g = e_i − μ_i 1 of every particle i named a}: p_g = p_i − μ_i P, particle i's
-    momentum in the centre-of-mass frame (g transforms like ∇, not like r)."""
-    out: dict[str, list] = {}
-    for i, p in enumerate(system.particles):
-        g = np.full(system.n, -system.cm_vector[i])
-        g[i] += 1.0
-        out.setdefault(p.name, []).append(g)
-    return {label: np.array(g) for label, g in out.items()}
+        v = np.full(system.n, -mu[i]) if momentum else -mu
+        v[i] += 1.0
+        out.setdefault(p.name, []).append(v)
+    return {label: np.array(v) for label, v in out.items()}
 
 
 @dataclass(frozen=True)
@@ -79,8 +71,8 @@ class Operator:
         return self.acts_on == "particles"
 
     def classes(self, system) -> dict[str, np.ndarray]:
-        """Its vectors per class: `pair_classes` or `momentum_classes`."""
-        return momentum_classes(system) if self.momentum else pair_classes(system)
+        """Its vectors per class: `pair_classes`, or `particle_classes` of the momenta."""
+        return particle_classes(system, momentum=True) if self.momentum else pair_classes(system)
 
     def evaluates(self, family) -> bool:
         """Whether the core has this operator's element for the basis family `family`."""
