@@ -42,7 +42,8 @@ def test_the_tutorial_runs_as_written(tmp_path, monkeypatch, references):
     with contextlib.redirect_stdout(out):
         exec(compile(python, str(ROOT / "docs" / "tutorial.md"), "exec"), {"__name__": "tutorial"})
     energy, r_pp = map(float, out.getvalue().split())
-    assert energy == energies_of_stored_basis()[1] and 2.0 < r_pp < 3.0, (energy, r_pp)
+    # the stored result's energy, to the last bits a BLAS kernel may change
+    assert abs(energy - energies_of_stored_basis()[1]) < 1e-13 and 2.0 < r_pp < 3.0, (energy, r_pp)
 
 
 def energies_of_stored_basis() -> list[float]:
