@@ -177,16 +177,6 @@ pub enum Shape {
     Exponential,
 }
 
-impl Shape {
-    /// The degree of a polynomial profile.
-    pub fn degree(&self) -> Option<usize> {
-        match self {
-            Shape::Polynomial(g) => Some(g.len() - 1),
-            Shape::Exponential => None,
-        }
-    }
-}
-
 /// `(<phi_I| p_g² |phi_J>, <phi_I| p_g⁴ |phi_J>)` of normalised functions of family `F`, for
 /// `p_g = −i Σ_k g_k ∇_k` with a D-vector `g` (`operators::momentum`; docs/properties-derivations.md §5).
 pub type Momentum<const D: usize, F> = fn(
