@@ -39,7 +39,7 @@ def main() -> None:
             continue
         w = np.concatenate(list(op.classes(basis.system).values()))
         t = time.perf_counter()
-        rep.operator(name, basis, w, op.momentum)
+        rep.operator(name, basis, w, op.momenta)
         seconds = time.perf_counter() - t
         print(f"  {name}: {len(w)} vectors {seconds:.2f} s ({seconds / build:.0f}× the build)", flush=True)
     t = time.perf_counter()

@@ -137,8 +137,8 @@ def test_every_operator_is_the_same_in_lfcc_and_ticc(kind, name):
         with pytest.raises(prebo.errors.UnsupportedError, match=f"operator {name!r}.* not derived for {kind}"):
             prebo.evaluate(basis, operators=[name])
         return
-    lab = laboratory(system).operator(name, basis, w, op.momentum)
-    ti = translationally_invariant(system).operator(name, basis, w, op.momentum)
+    lab = laboratory(system).operator(name, basis, w, op.momenta)
+    ti = translationally_invariant(system).operator(name, basis, w, op.momenta)
     assert np.max(np.abs(lab - ti)) <= 1e-12 * np.max(np.abs(lab)), np.max(np.abs(lab - ti)) / np.max(np.abs(lab))
     assert np.max(np.abs(lab[0] - lab[0].T)) <= 1e-13 * np.max(np.abs(lab[0]))
 

@@ -79,9 +79,10 @@ class Engine:
 
     def operator(self, name: str, params: Params, w: ArrayLike) -> NDArray[np.float64]:
         """Symmetrised (p, nb, nb) matrices of the registered operator `name` (see `OPERATORS`)
-        between normalised functions, one per vector w (p, n) given in this representation like
-        the Coulomb vectors ("r2": r_w² = |Σ_k w_k r_k|² in a_0², with w = e_i − e_j in the
-        laboratory frame the squared distance r_ij²). Symmetrised like S, which is exact for
+        between normalised functions, one per instance of its vectors w (p, arity, n; (p, n) for
+        arity 1), given in this representation like the Coulomb vectors ("r2": r_w² =
+        |Σ_k w_k r_k|² in a_0², with w = e_i − e_j in the laboratory frame the squared distance
+        r_ij²). Symmetrised like S, which is exact for
         operators that commute with the symmetry operations."""
 
     def density(self, params: Params, w: ArrayLike, C: ArrayLike, r: ArrayLike) -> NDArray[np.float64]:

@@ -28,51 +28,81 @@ from . import _core
 from .errors import InputError, UnsupportedError
 
 
-def pair_classes(system) -> dict[str, np.ndarray]:
-    """{"a-b": LFCC vectors w = e_i − e_j (p, n) of every pair i < j of a particle named a and one
-    named b}, in the order the pairs first occur."""
+#: the kinds of operator vectors (`vector`)
+KINDS = frozenset({"r_ij", "r_i", "p_i", "p_j"})
+
+
+def vector(system, kind: str, i: int, j: int | None = None) -> np.ndarray:
+    """The LFCC vector of `kind` for particle i (of the pair i, j): "r_ij" w = e_i − e_j (r_ij =
+    r_i − r_j), "r_i" w = e_i − μ (r_i − R, the position about the centre of mass R; μ the mass
+    fractions m/m_tot), "p_i" or "p_j" g = e_k − μ_k 1 for k = i or j (p_k − μ_k P, the momentum in
+    the centre-of-mass frame, which transforms like ∇, not like r)."""
+    mu = system.cm_vector
+    if kind == "r_ij":
+        return np.eye(system.n)[i] - np.eye(system.n)[j]
+    if kind == "r_i":
+        return np.eye(system.n)[i] - mu
+    k = j if kind == "p_j" else i
+    return np.eye(system.n)[k] - mu[k]
+
+
+def classes(system, kinds: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """{label: vectors (instances, len(kinds), n)} of the `kinds` (see `vector`) per class of
+    equivalent pairs ("a-b": every pair i < j of a particle named a and one named b) if a kind
+    names a pair ("r_ij", "p_j"), else per class of particles ("a"), in the order of first
+    occurrence."""
     out: dict[str, list] = {}
-    for i, j, w in system.pairs():
-        names = sorted((system.particles[i].name, system.particles[j].name))
-        out.setdefault("-".join(names), []).append(w)
-    return {label: np.array(w) for label, w in out.items()}
+    if {"r_ij", "p_j"} & set(kinds):
+        for i, j, _ in system.pairs():
+            label = "-".join(sorted((system.particles[i].name, system.particles[j].name)))
+            out.setdefault(label, []).append([vector(system, kind, i, j) for kind in kinds])
+    else:
+        for i, p in enumerate(system.particles):
+            out.setdefault(p.name, []).append([vector(system, kind, i) for kind in kinds])
+    return {label: np.array(v) for label, v in out.items()}
+
+
+def pair_classes(system) -> dict[str, np.ndarray]:
+    """{"a-b": the vectors w = e_i − e_j (p, n) of the class's pairs} (`classes` of "r_ij")."""
+    return {label: v[:, 0] for label, v in classes(system, ("r_ij",)).items()}
 
 
 def particle_classes(system, momentum: bool = False) -> dict[str, np.ndarray]:
-    """{"a": vectors of every particle i named a}: w = e_i − μ (μ the mass fractions m/m_tot), so
-    that r_w = r_i − R is particle i's position about the centre of mass R, or with `momentum`
-    g = e_i − μ_i 1, so that p_g = p_i − μ_i P is its momentum in the centre-of-mass frame (g
-    transforms like ∇, not like r)."""
-    mu = system.cm_vector
-    out: dict[str, list] = {}
-    for i, p in enumerate(system.particles):
-        v = np.full(system.n, -mu[i]) if momentum else -mu
-        v[i] += 1.0
-        out.setdefault(p.name, []).append(v)
-    return {label: np.array(v) for label, v in out.items()}
+    """{"a": the vectors (p, n) of the class's particles}: e_i − μ of r_i − R, or with `momentum`
+    e_i − μ_i 1 of p_i − μ_i P (`classes` of "r_i" or "p_i")."""
+    return {label: v[:, 0] for label, v in classes(system, ("p_i",) if momentum else ("r_i",)).items()}
 
 
 @dataclass(frozen=True)
 class Operator:
-    """A registered operator, one expectation value per class of equivalent pairs (`pairs`) or
-    particles (momentum operators, `particles`).
+    """A registered operator, one expectation value per class of equivalent pairs or particles.
 
     name: the core's operator name; unit: of its expectation value; meaning: one line for reports;
-    acts_on: "pairs" or "particles"."""
+    vectors: the kinds of its vectors, in the core's order ("r_ij", "r_i", "p_i", "p_j": see
+    `vector`); an operator with an "r_ij" or "p_j" acts on pairs, otherwise on particles."""
 
     name: str
     unit: str
     meaning: str
-    acts_on: str = "pairs"
+    vectors: tuple[str, ...] = ("r_ij",)
+
+    def __post_init__(self):
+        if not isinstance(self.vectors, tuple) or not set(self.vectors) <= KINDS:
+            raise ValueError(f"operator {self.name!r}: vectors {self.vectors!r} must be a tuple of {sorted(KINDS)}")
 
     @property
-    def momentum(self) -> bool:
-        """Whether its vectors are momentum-like (g, transformed like ∇) rather than position-like."""
-        return self.acts_on == "particles"
+    def acts_on(self) -> str:
+        """"pairs" or "particles" (`classes`)."""
+        return "pairs" if {"r_ij", "p_j"} & set(self.vectors) else "particles"
+
+    @property
+    def momenta(self) -> tuple[bool, ...]:
+        """Per vector, whether it is momentum-like (transformed like ∇) rather than position-like."""
+        return tuple(kind.startswith("p") for kind in self.vectors)
 
     def classes(self, system) -> dict[str, np.ndarray]:
-        """Its vectors per class: `pair_classes`, or `particle_classes` of the momenta."""
-        return particle_classes(system, momentum=True) if self.momentum else pair_classes(system)
+        """Its vectors per class of equivalent pairs or particles, (instances, arity, n) each."""
+        return classes(system, self.vectors)
 
     def evaluates(self, family) -> bool:
         """Whether the core has this operator's element for the basis family `family`."""
@@ -87,9 +117,9 @@ OPERATORS: dict[str, Operator] = {
     "delta": Operator("delta", "bohr⁻³", "⟨δ³(r_ij)⟩, the density of particles i and j at one point "
                                          "(direct: converges slowly in Gaussians, which lack the cusp)"),
     "p2": Operator("p2", "ħ²/bohr²", "⟨p_i²⟩, particle i's mean square momentum in the centre-of-mass frame",
-                   "particles"),
+                   ("p_i",)),
     "p4": Operator("p4", "ħ⁴/bohr⁴", "⟨p_i⁴⟩, the mass–velocity term's −Σ⟨p_i⁴⟩/(8m_i³c²) per particle i",
-                   "particles"),
+                   ("p_i",)),
 }
 
 
@@ -113,7 +143,7 @@ def expectation(rep, basis, C: np.ndarray, name: str) -> list[dict[str, float]]:
     operator's unit}."""
     op = operator(name, basis.family)
     classes = op.classes(basis.system)
-    O = rep.operator(op.name, basis, np.concatenate(list(classes.values())), op.momentum)
+    O = rep.operator(op.name, basis, np.concatenate(list(classes.values())), op.momenta)
     states = []
     for c in C.T:
         values, k = {}, 0

@@ -98,12 +98,14 @@ class Representation:
             raise ValueError("row gradients are computed in the laboratory frame")
         return self.engine(f).row_gradient(self.arrays(f), dA, dv, self.arrays(basis))
 
-    def operator(self, name: str, f, w: np.ndarray, momentum: bool = False) -> np.ndarray:
+    def operator(self, name: str, f, v: np.ndarray, momenta=(False,)) -> np.ndarray:
         """Symmetrised (p, nb, nb) matrices of the core's registered operator `name` between the
         normalised functions of the basis `f` ("r2": r_w² = |Σ_k w_k r_k|², bohr²), one per
-        laboratory-frame vector w (p, n), position-like or, with `momentum`, momentum-like
-        (p_w = Σ_k w_k p_k)."""
-        return self.engine(f).operator(name, self.arrays(f), self.vectors(w, momentum))
+        instance of its laboratory-frame vectors v (p, arity, n; (p, n) for arity 1), the k-th
+        position-like or, with `momenta[k]`, momentum-like (p_w = Σ_k w_k p_k)."""
+        v = np.asarray(v, dtype=float).reshape(len(v), len(momenta), -1)
+        v = np.stack([self.vectors(v[:, k], m) for k, m in enumerate(momenta)], axis=1)
+        return self.engine(f).operator(name, self.arrays(f), np.ascontiguousarray(v))
 
     def density(self, f, w: np.ndarray, C: np.ndarray, r: np.ndarray) -> np.ndarray:
         """The spherically averaged densities (p, states, len(r)) of r_w (bohr⁻³) at the radii `r`

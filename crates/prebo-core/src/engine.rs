@@ -195,10 +195,10 @@ fn row_gradient_d<const D: usize, F: Family<D>>(
 }
 
 fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
-    let element = operators::lookup::<D, F>(name)?;
+    let (arity, element) = operators::lookup::<D, F>(name)?;
     let basis = F::params(basis)?;
     let (ops, sym) = e.rep.operators::<D>();
-    path::operator::<D, F>(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis, element, w)
+    path::operator::<D, F>(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis, element, arity, w)
 }
 
 fn density_d<const D: usize, F: Family<D>>(e: &Engine, basis: &[Column], w: &[f64], c: &[f64], radii: &[f64]) -> Result<Vec<f64>> {
@@ -272,7 +272,8 @@ impl Engine {
         dispatch!(self, row_gradient_d(self, trial, dir, basis))
     }
 
-    /// The symmetrised matrices of the registered operator `name`, one per vector `w` (`p x n`).
+    /// The symmetrised matrices of the registered operator `name`, one per instance of its
+    /// `arity` vectors `w` (`p x arity x n`).
     pub fn operator(&self, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
         dispatch!(self, operator_d(self, name, basis, w))
     }

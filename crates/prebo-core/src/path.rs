@@ -130,22 +130,24 @@ pub fn row_gradient<const D: usize, F: Family<D>>(
     })
 }
 
-/// The symmetrised matrix of one extra operator (`operators`, its element `<phi_I| O(w) |phi_J>`)
-/// for each vector `w` (`p x n`, flat): `p` row-major `nb x nb` blocks, upper triangle
-/// evaluated, mirrored.
+/// The symmetrised matrix of one extra operator (`operators`, its element `<phi_I| O(v) |phi_J>`
+/// of `arity` vectors) for each instance `v` (`p x arity x n`, flat): `p` row-major `nb x nb`
+/// blocks, upper triangle evaluated, mirrored.
 pub fn operator<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     sym: &Symmetry<D>,
     basis: &F::Params<'_>,
-    element: impl Fn(&F::Function<f64>, &F::Function<f64>, &F::Context, &Vector<D>) -> f64 + Sync,
-    w: &[f64],
+    element: impl Fn(&F::Function<f64>, &F::Function<f64>, &F::Context, &[Vector<D>]) -> f64 + Sync,
+    arity: usize,
+    v: &[f64],
 ) -> Result<Vec<f64>> {
-    check(w.len(), w.len() / D * D, "operator vectors")?;
+    let per = arity * D;
+    check(v.len(), v.len() / per * per, "operator vectors")?;
     let b = images::<D, F>(ctx, sym, basis)?;
-    let mut out = Vec::with_capacity(w.len() / D * b.len() * b.len());
-    for wk in w.chunks_exact(D) {
-        let wk = Vector::<D>::from_row_slice(wk);
-        out.extend(symmetric_scalar(&b, |x, y| element(x, y, ctx, &wk)));
+    let mut out = Vec::with_capacity(v.len() / per * b.len() * b.len());
+    for vk in v.chunks_exact(per) {
+        let vk: Vec<Vector<D>> = vk.chunks_exact(D).map(Vector::<D>::from_row_slice).collect();
+        out.extend(symmetric_scalar(&b, |x, y| element(x, y, ctx, &vk)));
     }
     Ok(out)
 }

@@ -4,8 +4,10 @@
 //! module here with an element function generic over the family, built from the family's
 //! primitives (`Family::overlap`, `Family::damped`, `Family::element`; for the operators of one
 //! pair vector beyond r², the damped overlap's profile in `profile`, which needs of a family only
-//! its exponent and the `Shape` of that profile), and one line in `registry`; `path::operator` symmetrises it and the binding exposes it by name
-//! (`Engine.operator(name, params, w)`).
+//! its exponent and the `Shape` of that profile), and one line in `registry` with its arity,
+//! the number of D-vectors it takes (a pair operator one, `w`; the orbit–orbit operator the pair
+//! vector and two momentum vectors). `path::operator` symmetrises it and the binding exposes it
+//! by name (`Engine.operator(name, params, v)`, `arity` vectors per instance).
 use crate::ecg::Vector;
 use crate::error::{CoreError, Result};
 use crate::families::plain::PlainEcg;
@@ -20,46 +22,58 @@ pub mod momentum;
 pub mod profile;
 pub mod r2;
 
-/// `<phi_I| O(w) |phi_J>` for normalised functions of family `F` and one operator vector `w`
-/// (in the representation's coordinates, like the Coulomb vectors).
+/// `<phi_I| O(v) |phi_J>` for normalised functions of family `F` and the operator's vectors `v`
+/// (its arity of them, in the representation's coordinates, like the Coulomb vectors; a pair
+/// operator has one, `w`).
 pub type ElementFn<const D: usize, F> = fn(
     &<F as Family<D>>::Function<f64>,
     &<F as Family<D>>::Function<f64>,
     &<F as Family<D>>::Context,
-    &Vector<D>,
+    &[Vector<D>],
 ) -> f64;
 
-/// The registered operators: name and element function (`None`: not derived for the family `F`).
-fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, Option<ElementFn<D, F>>)> {
-    let quartic = |element: ElementFn<D, F>| F::MOMENTUM.map(|_| element);
+/// An operator's element of one vector, as an `ElementFn` of arity 1.
+macro_rules! one_vector {
+    ($element:path) => {{
+        let element: ElementFn<D, F> = |bra, ket, ctx, v| $element(bra, ket, ctx, &v[0]);
+        Some(element)
+    }};
+}
+
+/// The registered operators: name, arity (vectors per operator) and element function (`None`:
+/// not derived for the family `F`).
+fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<ElementFn<D, F>>)> {
+    let quartic = F::MOMENTUM.and_then(|_| one_vector!(momentum::p4::<D, F>));
     vec![
-        (r2::NAME, Some(r2::element::<D, F>)),
-        (distance::NAME, Some(distance::element::<D, F>)),
-        (inverse::NAME, Some(inverse::element::<D, F>)),
-        (inverse_square::NAME, Some(inverse_square::element::<D, F>)),
-        (delta::NAME, Some(delta::element::<D, F>)),
-        (momentum::P2, Some(momentum::p2::<D, F>)),
-        (momentum::P4, quartic(momentum::p4::<D, F>)),
+        (r2::NAME, 1, one_vector!(r2::element::<D, F>)),
+        (distance::NAME, 1, one_vector!(distance::element::<D, F>)),
+        (inverse::NAME, 1, one_vector!(inverse::element::<D, F>)),
+        (inverse_square::NAME, 1, one_vector!(inverse_square::element::<D, F>)),
+        (delta::NAME, 1, one_vector!(delta::element::<D, F>)),
+        (momentum::P2, 1, one_vector!(momentum::p2::<D, F>)),
+        (momentum::P4, 1, quartic),
     ]
 }
 
 /// The names of the registered operators.
 pub fn names() -> Vec<&'static str> {
-    registry::<1, PlainEcg>().into_iter().map(|(name, _)| name).collect()
+    registry::<1, PlainEcg>().into_iter().map(|(name, ..)| name).collect()
 }
 
 /// The names of the registered operators the family `F` evaluates.
 pub fn derived<F: Family<1>>() -> Vec<&'static str> {
-    registry::<1, F>().into_iter().filter(|(_, element)| element.is_some()).map(|(name, _)| name).collect()
+    registry::<1, F>().into_iter().filter(|(.., element)| element.is_some()).map(|(name, ..)| name).collect()
 }
 
-/// The element function of the operator `name` for the family `F`.
-pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<ElementFn<D, F>> {
-    let (_, element) = registry::<D, F>()
+/// The arity and element function of the operator `name` for the family `F`.
+pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<(usize, ElementFn<D, F>)> {
+    let (_, arity, element) = registry::<D, F>()
         .into_iter()
-        .find(|(n, _)| *n == name)
+        .find(|(n, ..)| *n == name)
         .ok_or_else(|| CoreError::Unsupported(format!("operator {name:?} (registered: {:?})", names())))?;
-    element.ok_or_else(|| CoreError::Unsupported(format!("operator {name:?} is not derived for {} functions", F::NAME)))
+    let element =
+        element.ok_or_else(|| CoreError::Unsupported(format!("operator {name:?} is not derived for {} functions", F::NAME)))?;
+    Ok((arity, element))
 }
 
 /// What the operators' tests share: three coordinates, random exponents, the pair vector `e_1 − e_2`.
