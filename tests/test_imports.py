@@ -100,3 +100,16 @@ def test_the_optimiser_imports_without_a_circle():
 def test_no_module_imports_itself_through_others():
     found = cycle(graph())
     assert found is None, "import circle: " + " → ".join(found)
+
+
+def test_one_process_imports_nothing_of_mpi():
+    """Without an MPI launcher prebo runs as one process and never imports mpi4py (parallel.py),
+    through a whole command."""
+    import os
+    import subprocess
+    import sys
+    env = {k: v for k, v in os.environ.items() if k not in ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "PMIX_SIZE")}
+    code = ("import sys, prebo.cli; status = prebo.cli.main(['energy', 'tests/data/ecgpack/ecgpack-Li7-100.inout.txt']); "
+            "print('mpi4py' in sys.modules, status)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=ROOT)
+    assert r.stdout.split()[-2:] == ["False", "0"], r.stdout + r.stderr

@@ -14,11 +14,13 @@ import math
 import os
 import sys
 import time
+from contextlib import nullcontext
 from dataclasses import replace
 from pathlib import Path
 
 from .errors import NonFiniteError, OutputError, PreboError
 from .expectation import OPERATORS
+from .parallel import stop_all, world
 from .validation import path_name
 
 RESULT = "result.json"
@@ -160,12 +162,14 @@ def cmd_run(args) -> int:
         job = toml.load(args.input)
         out = given(args.out, Path("runs") / Path(args.input).stem, "a folder")
         title, source = job.title, str(args.input)
-    with owned(out):
+    root = world().root  # under MPI, rank 0 alone owns and writes the folder (parallel.py)
+    with owned(out) if root else nullcontext():
         try:
             if args.resume is not None:
                 basis, opts = resume_from(out, progress=not args.quiet, budget=args.budget)
             else:
-                claim(out, args.force)
+                if root:
+                    claim(out, args.force)
                 opts = job.optimiser if args.budget is None else replace(job.optimiser, budget=args.budget)
                 basis = optimise(job.system, opts, out=out, progress=not args.quiet)
         except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
@@ -184,7 +188,10 @@ def cmd_run(args) -> int:
             r["targets"] = levels
         r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
               "convergence": basis.convergence}
-        write_json_atomic(out / RESULT, r)
+        if root:
+            write_json_atomic(out / RESULT, r)
+    if not root:
+        return 0
     if not args.quiet:
         _print_result(r)
         print(f"wrote {out / RESULT} ({where.name}: the lowest state at the size; "
@@ -640,13 +647,14 @@ def command(argv) -> int:
     """The exit status of the command `argv` (main); SystemExit from argparse."""
     args = parser().parse_args(argv)
     try:
+        world()  # under MPI: the ranks' threads set before the core first runs (parallel.py)
         return args.func(args)
     except PreboError as exc:
         print("prebo: error: " + " ".join(str(exc).split("\n")), file=sys.stderr)  # one line, always
-        return 2
+        return stop_all(2)
     except KeyboardInterrupt:
         print("prebo: interrupted (the last accepted step is saved)", file=sys.stderr)
-        return 130
+        return stop_all(130)
 
 
 if __name__ == "__main__":

@@ -57,6 +57,7 @@ w_ij = c_i² c_j² (Σ_terms t_ij² + E² S_ij²); `energy_uncertainty` uses ε 
 from __future__ import annotations
 
 import contextlib
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,6 +66,7 @@ from threadpoolctl import ThreadpoolController
 
 from . import _core
 from .errors import LinearDependenceError, NonFiniteError, NotPositiveDefiniteError
+from .parallel import world
 
 #: relative error assumed for every stored matrix element: 4 unit roundoffs (a few ulp)
 ELEMENT_ERROR = 4 * 2.0**-53
@@ -94,8 +96,12 @@ _POOLS = ThreadpoolController()  # the loaded BLAS libraries, found once (a limi
 
 
 def lapack_threads(nb: int):
-    """A context in which LAPACK and BLAS use one thread if `nb` < SERIAL_BELOW, their own count otherwise."""
-    return _POOLS.limit(limits=1, user_api="blas") if nb < SERIAL_BELOW else contextlib.nullcontext()
+    """A context in which LAPACK and BLAS use one thread if `nb` < SERIAL_BELOW, their own count
+    otherwise (under MPI the rank's share of the node, parallel.py)."""
+    if nb < SERIAL_BELOW:
+        return _POOLS.limit(limits=1, user_api="blas")
+    share = os.environ.get("RAYON_NUM_THREADS", "") if world().size > 1 else ""
+    return _POOLS.limit(limits=int(share), user_api="blas") if share.isdigit() else contextlib.nullcontext()
 
 
 @dataclass

@@ -10,7 +10,8 @@
   matrix μ, exponents 𝒜 (possible only when every function shares one c_A).
 
 Each representation returns dict(S, T, T_ti, V) of normalised functions (hartree atomic units)
-from the engine of the basis's family (`Family.engine`, one per family and N).
+from the engine of the basis's family (`Family.engine`, one per family and N); under MPI the
+ranks share a build's or a row's elements (parallel.py), with the bits of one process.
 
 Cancellation: an element is a sum over the symmetriser's images, each at most 1 for normalised
 functions, and T_ti is T less the CM kinetic energy. A function the symmetriser nearly annihilates
@@ -32,6 +33,7 @@ import numpy as np
 
 from .coordinates import CoordinateSet, jacobi
 from .errors import CancellationError, SeparabilityError
+from .parallel import world
 from .system import System
 
 #: smallest S_nn / Σ_P |c_P| of a function (module docstring, cancellation)
@@ -79,7 +81,7 @@ class Representation:
 
     def matrices(self, f) -> dict:
         """Symmetrised S, T, T_ti, V (nb x nb, hartree) of the normalised functions of the basis `f`."""
-        return self.engine(f).matrices(self.arrays(f))
+        return world().matrices(self.engine(f), self.arrays(f))
 
     def rows(self, trials, f, position: int | None = None) -> tuple[dict, np.ndarray]:
         """Rows (k x nb) of `trials` against the basis `f`, and the trials' diagonals [S, T, T_ti, V].
@@ -87,7 +89,7 @@ class Representation:
         `position`: where a trial would sit in the basis (default: appended). Where the family's
         engine is `oriented`, rows are evaluated in the orientation of a full build, so patching
         them into the matrices gives the bits of `matrices`; otherwise the trial is the bra."""
-        return self.engine(f).rows(self.arrays(trials), self.arrays(f), position)
+        return world().rows(self.engine(f), self.arrays(trials), self.arrays(f), position)
 
     def row_gradient(self, f, dA: np.ndarray, dv: np.ndarray | None, basis) -> tuple[dict, np.ndarray]:
         """Row of the one-function basis `f` against `basis` (f as bra) and its diagonal, with the
@@ -96,7 +98,7 @@ class Representation:
         (1 + P) x 4 diagonal. Laboratory frame only."""
         if self.coords is not None:
             raise ValueError("row gradients are computed in the laboratory frame")
-        return self.engine(f).row_gradient(self.arrays(f), dA, dv, self.arrays(basis))
+        return world().row_gradient(self.engine(f), self.arrays(f), dA, dv, self.arrays(basis))
 
     def operator(self, name: str, f, v: np.ndarray, momenta=(False,)) -> np.ndarray:
         """Symmetrised (p, nb, nb) matrices of the core's registered operator `name` between the

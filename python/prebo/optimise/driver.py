@@ -25,6 +25,7 @@ from ..errors import InputError, OutputError, StalledError
 from ..integrals import laboratory
 from ..io.files import remove_stale_temporaries
 from ..io.lock import owned
+from ..parallel import world
 from ..system import System
 from ..thresholds import lowest as lowest_threshold
 from ..validation import path_name
@@ -75,12 +76,15 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         raise InputError(f"optimise: opts = {opts!r}: must be a prebo.Optimiser")
     if out is not None:
         path_name(out, "optimise: out", "a folder (a str or path), or None")
+    ranks = world()
+    if not ranks.root:  # rank 0 alone writes (parallel.py); the others run the same steps
+        out, progress = None, False
     with nullcontext() if out is None else owned(out):
-        return _run(system, opts, out, progress, resume)
+        return _run(system, opts, out, progress, resume, ranks)
 
 
-def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resume: dict | None) -> Basis:
-    """The run of `optimise`, in the folder `out` it owns (if any)."""
+def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resume: dict | None, ranks) -> Basis:
+    """The run of `optimise`, in the folder `out` it owns (if any), on the MPI `ranks`."""
     held = None if out is None or resume is not None else checkpoint_in(out)
     if held:
         raise OutputError(f"optimise: out = {str(out)!r} holds a run's checkpoint ({held.name}): continue that run "
@@ -109,8 +113,9 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     t_start = time.perf_counter()
 
     def wall() -> float:
-        """Seconds of optimisation so far, over all segments of a resumed run."""
-        return round(elapsed + time.perf_counter() - t_start, 1)
+        """Seconds of optimisation so far, over all segments of a resumed run: rank 0's clock, so
+        that every rank decides alike by time."""
+        return ranks.agreed(round(elapsed + time.perf_counter() - t_start, 1))
 
     def expansion(b: Basis, objective: Levels) -> Expansion:
         """The expansion of basis `b` with the run's representation and linear-dependence settings."""
@@ -126,8 +131,8 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     steps = methods(opts)
 
     def checkpoint():
+        ex.basis.coefficients = ex.coefficients if ex.eig is not None else None
         if out is not None:
-            ex.basis.coefficients = ex.coefficients if ex.eig is not None else None
             energy = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
             ex.basis.save(Path(out) / CHECKPOINT, {
                 "energy": energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
@@ -182,8 +187,9 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
 def resume_from(folder: Path, progress: bool = True, budget: float | None = None) -> tuple[Basis, Optimiser]:
     """Continue the run whose checkpoint is folder/basis.json, with `budget` (seconds of the whole
     run) in place of the checkpoint's if given; the finished basis and its settings."""
-    with owned(path_name(folder, "resume_from: folder", "a folder (a str or path)")):  # before it is read
-        d, system, opts = load_checkpoint(folder)
+    folder, ranks = path_name(folder, "resume_from: folder", "a folder (a str or path)"), world()
+    with owned(folder) if ranks.root else nullcontext():  # before it is read
+        d, system, opts = ranks.agreed(load_checkpoint(folder) if ranks.root else None)  # rank 0 reads
         if budget is not None:
             opts = replace(opts, budget=budget)
         return optimise(system, opts, out=Path(folder), progress=progress, resume=d), opts

@@ -1,0 +1,78 @@
+"""MPI ranks sharing a run (parallel.py), on this machine's loopback with `mpiexec -n 2`: integrals
+equal one process's bit for bit, a 2-rank run equals a 1-rank one, a killed 2-rank run resumes to
+the same basis, and a failing rank stops every rank in bounded time. Needs prebo's MPI extra
+(pip install ".[mpi]"), which the README's test command installs."""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from test_optimise import INPUT, functions
+
+pytest.importorskip("mpi4py")
+MPIEXEC = shutil.which("mpiexec") or pytest.skip("no mpiexec on the PATH", allow_module_level=True)
+WORKER = Path(__file__).parent / "mpi_worker.py"
+#: one core per rank: 2 ranks x 1 thread on the 2-core machine
+ENV = os.environ | {"RAYON_NUM_THREADS": "1"}
+
+
+def mpi(ranks: int, *args, **kw) -> subprocess.Popen:
+    return subprocess.Popen([MPIEXEC, "-n", str(ranks), *map(str, args)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=ENV, **kw)
+
+
+def prebo_run(ranks: int, *args, **kw) -> subprocess.Popen:
+    return mpi(ranks, sys.executable, "-m", "prebo", "run", *args, "--quiet", **kw)
+
+
+def finished(p: subprocess.Popen, timeout: float) -> str:
+    out, err = p.communicate(timeout=timeout)
+    assert p.returncode == 0, err
+    return out
+
+
+def test_two_ranks_evaluate_the_integrals_of_one_process_bit_for_bit():
+    out = finished(mpi(2, sys.executable, WORKER, "integrals"), 300)
+    assert "2 ranks equal one process bit for bit" in out
+
+
+def test_a_failing_rank_stops_every_rank_with_an_error():
+    p = mpi(2, sys.executable, WORKER, "raise")
+    try:
+        _, err = p.communicate(timeout=60)  # bounded: never a hang
+    except subprocess.TimeoutExpired:
+        p.kill()
+        pytest.fail("the ranks still ran 60 s after one failed")
+    assert p.returncode != 0 and "a deliberate failure on the last rank" in err
+
+
+def test_a_two_rank_run_equals_a_one_rank_run_and_resumes_after_a_kill(tmp_path):
+    (tmp_path / "in.toml").write_text(INPUT)
+    finished(prebo_run(1, tmp_path / "in.toml", "--out", tmp_path / "one"), 300)
+    finished(prebo_run(2, tmp_path / "in.toml", "--out", tmp_path / "two"), 300)
+    assert functions(tmp_path / "two") == functions(tmp_path / "one")
+
+    killed = prebo_run(2, tmp_path / "in.toml", "--out", tmp_path / "killed", start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline:  # kill every rank in the middle of the schedule
+        try:
+            progress = json.loads((tmp_path / "killed" / "basis.json").read_text())["progress"]
+            if progress["phase"] != "grow" or len(functions(tmp_path / "killed")) >= 6:
+                break
+        except (OSError, json.JSONDecodeError, KeyError):
+            pass
+        time.sleep(0.01)
+    os.killpg(killed.pid, signal.SIGKILL)
+    killed.communicate()
+    cut = json.loads((tmp_path / "killed" / "basis.json").read_text())["progress"]
+    assert cut["phase"] != "done", "the run ended before it was killed: nothing tested"
+    finished(prebo_run(2, "--resume", tmp_path / "killed"), 300)
+    assert functions(tmp_path / "killed") == functions(tmp_path / "one")
+    energies = [json.loads((tmp_path / k / "result.json").read_text())["energy"] for k in ("one", "two", "killed")]
+    assert energies[0] == energies[1] == energies[2]
