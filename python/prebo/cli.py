@@ -136,7 +136,9 @@ def cmd_run(args) -> int:
     """`prebo run INPUT [--out DIR] [--force]` or `prebo run --resume DIR`, either with `--budget
     SECONDS` (the wall time of the whole run, resumed parts included, in place of the input's or
     checkpoint's): optimise, then write DIR/result.json (`_result`, energies in Eh, and per level the
-    expectation values of every operator the basis family evaluates) of the lowest
+    expectation values of the operators the basis family evaluates (`properties.reported`), with
+    their `corrections`:
+    the Breit–Pauli correction and Drachmann's δ where the family has their operators) of the lowest
     state at the size the run passed through, beside the checkpoint DIR/basis.json (and
     DIR/lowest.json if the run stands above that state); warn when the state is not bound in the
     basis. The run owns DIR from before it looks into it until it ends (io/lock.py). A new run
@@ -147,6 +149,7 @@ def cmd_run(args) -> int:
     from .io import toml
     from .io.lock import owned
     from .optimise import optimise, resume_from
+    from .properties import corrections, reported
     from .optimise.checkpoint import CHECKPOINT, LOWEST
 
     t0 = time.perf_counter()
@@ -177,13 +180,15 @@ def cmd_run(args) -> int:
         title = title or basis.system.label()
         where = out / LOWEST if (out / LOWEST).exists() else out / CHECKPOINT  # the file of the state returned
         levels = basis.convergence.get("levels")  # where the targeted levels stand, if followed
-        derived = [name for name, op in OPERATORS.items() if op.evaluates(basis.family)]  # the properties block
+        derived = reported(basis.family)  # the properties block
         roots = None if levels is None else max(levels) + 1
         try:
             r = _result(basis, where, opts.threshold, operators=derived, roots=roots)
         except NonFiniteError as exc:  # the energies stand without the properties: say so, write them
             r = _result(basis, where, opts.threshold, roots=roots)
             print(f"prebo: warning: result.json without expectation values: {exc}", file=sys.stderr)
+        for level in r.get("levels", [r]):  # each level's Breit–Pauli correction and regularised δ
+            level |= corrections(basis, level)
         if levels is not None:
             r["targets"] = levels
         r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
@@ -379,8 +384,8 @@ def cmd_energy(args) -> int:
 
 def cmd_properties(args) -> int:
     """`prebo properties BASIS [--root K] [--coordinates lab|ti] [--threshold T] [--json]`: the
-    energy of level K of a stored basis and the expectation value of every registered operator per
-    class of equivalent pairs (properties.py)."""
+    energy of level K of a stored basis, the expectation value of every registered operator per
+    class of equivalent pairs (properties.py) and the level's Breit–Pauli correction (relativistic.py)."""
     from rich.console import Console
     from rich.table import Table
 
@@ -412,9 +417,19 @@ def cmd_properties(args) -> int:
             table = Table("operator", *classes, "unit", title=f"expectation values per class of equivalent {acts_on}")
             for name in names:
                 table.add_row(name, *(f"{p['expectation'][name][c]:.10g}" for c in classes), p["units"][name])
+            if acts_on == "pairs" and "delta_regularised" in p:  # drachmann.py
+                table.add_row("delta (Drachmann)", *(f"{p['delta_regularised'][c]:.10g}" for c in classes), "bohr⁻³")
             Console().print(table)
+    if "breit_pauli" in p:  # relativistic.py: each term, per class and summed
+        bp = p["breit_pauli"]
+        table = Table("term", "Eh", "cm⁻¹", "per class (Eh)", title=f"Breit–Pauli correction (α = {bp['alpha']})")
+        for term, e in bp["Eh"].items():
+            per = ", ".join(f"{c} {v:.6e}" for c, v in bp["classes"].get(term, {}).items())
+            table.add_row(term.replace("_", "–"), f"{e:.6e}", f"{bp['cm-1'][term]:.6f}", per)
+        Console().print(table)
     if p["not_derived"]:
-        Console().print(f"not derived for {basis.family.name} functions: {', '.join(p['not_derived'])}")
+        Console().print(f"not derived for {basis.family.name} functions: {', '.join(p['not_derived'])}"
+                        + ("" if "breit_pauli" in p else " (so neither is the Breit–Pauli correction)"))
     return 0
 
 

@@ -120,6 +120,12 @@ OPERATORS: dict[str, Operator] = {
                    ("p_i",)),
     "p4": Operator("p4", "ħ⁴/bohr⁴", "⟨p_i⁴⟩, the mass–velocity term's −Σ⟨p_i⁴⟩/(8m_i³c²) per particle i",
                    ("p_i",)),
+    "coulomb_inv_r": Operator("coulomb_inv_r", "Eh/bohr", "⟨V/r_ij⟩, the Coulomb potential over r_ij "
+                                                         "(a term of Drachmann's ⟨δ³(r_ij)⟩, prebo.drachmann)"),
+    "gradient_inv_r": Operator("gradient_inv_r", "Eh/bohr", "⟨∇Ψ|Λ/r_ij|∇Ψ⟩, the kinetic energy density over r_ij "
+                                                           "(a term of Drachmann's ⟨δ³(r_ij)⟩, prebo.drachmann)"),
+    "orbit_orbit": Operator("orbit_orbit", "ħ²/bohr³", "⟨p_i·(1 + r̂_ij r̂_ij)/r_ij·p_j⟩, the Breit–Pauli orbit–orbit "
+                                                     "term −(α²/2) q_i q_j/(m_i m_j) ⟨…⟩ per pair", ("r_ij", "p_i", "p_j")),
 }
 
 

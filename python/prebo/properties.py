@@ -5,7 +5,8 @@
   ⟨r_ij²⟩, ⟨1/r_ij⟩, ⟨1/r_ij²⟩, ⟨δ³(r_ij)⟩) per class of equivalent pairs — what `prebo properties
   BASIS --root k` prints and `prebo.properties(basis, root=k)` returns. ⟨δ³(r_ij)⟩ is the direct
   expectation value, which Gaussians, lacking the cusp, reach slowly (hydrogen 1s in 80
-  even-tempered Gaussians: 1.8e-4 low, against 2e-11 for ⟨r⟩).
+  even-tempered Gaussians: 1.8e-4 low, against 2e-11 for ⟨r⟩). With them, the level's
+  Breit–Pauli correction (relativistic.py) where the family evaluates its operators.
 - `densities`: the pictures of several levels — the distribution P(r) = 4πr²ρ̄(r) of every
   inter-particle distance and of every particle's distance from the centre of mass, ρ̄ the
   spherically averaged density (`expectation.densities`), on a grid; `csv` its text, which
@@ -19,10 +20,11 @@ import math
 
 import numpy as np
 
-from . import eigen
+from . import drachmann, eigen
 from .basis import Basis
 from .errors import InputError
 from .expectation import OPERATORS
+from .relativistic import NEEDS, breit_pauli, missing
 from .results import evaluate, grids
 from .validation import Integer, checked
 
@@ -32,24 +34,50 @@ def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float 
 
     Returns {"root", "energy", "energy_uncertainty" (Eh), "virial", "bound", "expectation":
     {operator: {class: value}}, "units": {operator: unit}, "not_derived": [operators]} (and "n2",
-    ⟨N²⟩_TI in ħ², for floating ECGs): every registered operator the basis family evaluates, per
-    class of equivalent pairs "a-b" or particles "a", and those it has no element for. InputError
+    ⟨N²⟩_TI in ħ², for floating ECGs): the `reported` operators of the basis family, per
+    class of equivalent pairs "a-b" or particles "a", and those it has no element for; and
+    the level's `corrections` ("breit_pauli", "delta_regularised") where the family evaluates
+    their operators. InputError
     for a root that is not a non-negative integer below the basis size; the errors of
     `results.evaluate` otherwise."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"properties: basis = {basis!r}: must be a prebo.Basis with at least one function")
     root = checked(Integer(0, len(basis) - 1), root, "properties: root", f"roots of a basis of {len(basis)} functions")
-    names = [name for name, op in OPERATORS.items() if op.evaluates(basis.family)]
+    names = reported(basis.family)
     r = evaluate(basis, coordinates=coordinates, threshold=threshold, operators=names, roots=root + 1)
     level = r["levels"][root] if "levels" in r else r
     keys = ("root", "energy", "energy_uncertainty", "virial", "bound", "n2", "expectation")
-    return {k: level[k] for k in keys if k in level} | {
+    return {k: level[k] for k in keys if k in level} | corrections(basis, level) | {
         "root": root, "units": {k: OPERATORS[k].unit for k in names},
-        "not_derived": [k for k in OPERATORS if k not in names]}
+        "not_derived": [k for k, op in OPERATORS.items() if not op.evaluates(basis.family)]}
 
 
 #: the points of the default grid of `densities`, and its reach in root-mean-square distances
 POINTS, REACH = 400, 5.0
+
+
+def reported(family) -> list[str]:
+    """The operators a level's properties hold for a basis of `family` (`properties`, `prebo run`'s
+    result.json): every one the family evaluates, but Drachmann's terms only where it evaluates them
+    all, since they serve the regularised ⟨δ³(r_ij)⟩ alone (ECG-GVR's ⟨∇Ψ|Λ/r_ij|∇Ψ⟩ would take
+    128 s of H2-500's 139 s, with no ⟨V/r_ij⟩ to make the δ of it)."""
+    names = [name for name, op in OPERATORS.items() if op.evaluates(family)]
+    if not set(drachmann.TERMS) <= set(names):
+        names = [name for name in names if name not in drachmann.TERMS or name == "inv_r"]
+    return names
+
+
+def corrections(basis, level: dict) -> dict:
+    """What the expectation values of a level of `basis` ({"energy", "expectation": {operator:
+    {class: value}}}, a level of `results.evaluate`) give beyond themselves, where they hold the
+    operators: "breit_pauli", its Breit–Pauli correction (`relativistic.breit_pauli`), and
+    "delta_regularised", {pair class: Drachmann's ⟨δ³(r_ij)⟩} (`drachmann.regularised`)."""
+    out, have = {}, set(level.get("expectation", {}))
+    if not missing(basis.family) and set(NEEDS) <= have:
+        out["breit_pauli"] = breit_pauli(basis, level["expectation"])
+    if set(drachmann.TERMS) <= have:
+        out["delta_regularised"] = drachmann.regularised(basis.system, level["expectation"], level["energy"])
+    return out
 
 
 def densities(basis, roots=(0,), r=None, points: int = POINTS, coordinates: str = "lab",

@@ -20,6 +20,7 @@ use nalgebra::SMatrix;
 
 use crate::cache::{Cache, Keyed};
 use crate::ecg::{Element, Mat, Operators, Real, Vector};
+use crate::families::floating::fecg::Centres;
 use crate::error::{CoreError, Result};
 use crate::gradient::Dual;
 use crate::images::Transform;
@@ -177,6 +178,19 @@ pub enum Shape {
     Exponential,
 }
 
+/// What a family's function is beside its Gaussian `exp(−tr((r − s)ᵀ A (r − s)))`: the operators
+/// whose elements are written for a bare Gaussian (`operators::orbit`, `operators::drachmann`)
+/// ask this of a family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Form {
+    /// The Gaussian about the origin (plain ECGs).
+    Plain,
+    /// The Gaussian about centres `s` (`Family::centres`; floating ECGs).
+    Floating,
+    /// The Gaussian times a polynomial of a global vector (ECG-GVR).
+    GlobalVector,
+}
+
 /// `(<phi_I| p_g² |phi_J>, <phi_I| p_g⁴ |phi_J>)` of normalised functions of family `F`, for
 /// `p_g = −i Σ_k g_k ∇_k` with a D-vector `g` (`operators::momentum`; docs/properties-derivations.md §5).
 pub type Momentum<const D: usize, F> = fn(
@@ -198,6 +212,8 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// Whether `rows(.., position)` evaluates every element in the orientation of a full build
     /// (lower index as bra), so that rows patched into the matrices give the bits of `matrices`.
     const ORIENTED: bool = true;
+    /// What a function is beside its Gaussian (`Form`).
+    const FORM: Form;
     /// The element of the momentum operators `p_g²` and `p_g⁴` (`Momentum`), or `None` where the
     /// family's `p_g⁴` is not derived (`operators::lookup` then refuses it).
     const MOMENTUM: Option<Momentum<D, Self>>;
@@ -245,6 +261,14 @@ pub trait Family<const D: usize>: Sized + 'static {
 
     /// The Gaussian exponent `A` of `f`, `exp(−r^T (A ⊗ I_3) r)` (the representation's coordinates).
     fn exponent(f: &Self::Function<f64>) -> &Mat<D>;
+
+    /// The centres `s` of the Gaussian of `f` (zero but for `Form::Floating`).
+    fn centres(_f: &Self::Function<f64>) -> Centres<D> {
+        Centres::<D>::zeros()
+    }
+
+    /// The Hamiltonian's operators (Λ, the Coulomb pairs, the CM mass) the context holds.
+    fn operators(ctx: &Self::Context) -> &Operators<D>;
 
     /// `<phi_I| p_g² |phi_J>` (`operators::momentum`): `MOMENTUM`'s, or a family without it
     /// gives its kinetic element with `Λ = g g^T`.

@@ -16,9 +16,11 @@ use crate::families::Family;
 pub mod delta;
 pub mod density;
 pub mod distance;
+pub mod drachmann;
 pub mod inverse;
 pub mod inverse_square;
 pub mod momentum;
+pub mod orbit;
 pub mod profile;
 pub mod r2;
 
@@ -52,6 +54,9 @@ fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<
         (delta::NAME, 1, one_vector!(delta::element::<D, F>)),
         (momentum::P2, 1, one_vector!(momentum::p2::<D, F>)),
         (momentum::P4, 1, quartic),
+        (drachmann::COULOMB, 1, drachmann::coulomb::<D, F>()),
+        (drachmann::GRADIENT, 1, Some(drachmann::gradient_inv_r::<D, F>)),
+        (orbit::NAME, 3, orbit::element_for::<D, F>()),
     ]
 }
 

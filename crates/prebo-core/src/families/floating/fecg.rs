@@ -72,10 +72,14 @@ impl<const D: usize, T: Real> Fecg<D, T> {
 
 impl<const D: usize> Fecg<D> {
     /// `(r-s)^T A (r-s) + r^T M r = r^T (A+M) r - 2 r^T A s + s^T A s`: `A` grows, `A s`, `s^T A s`
-    /// and `ln|A|` (the normalisation) stay (`Family::damped`).
+    /// and `ln|A|` (the normalisation) stay (`Family::damped`); the centre moves to `(A+M)⁻¹ A s`,
+    /// which the kinetic element reads (docs/properties-derivations.md, eq. 30).
     pub fn damped<T: Real>(&self, m: &SMatrix<T, D, D>) -> Fecg<D, T> {
         let mut g: Fecg<D, T> = self.cast();
         g.a += m;
+        if let Some(chol) = g.a.cholesky() {
+            g.s = chol.solve(&g.a_s);
+        }
         g
     }
 }

@@ -11,7 +11,7 @@ use nalgebra::SMatrix;
 use crate::cache::Cache;
 use crate::ecg::{re, Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Momentum, Shape, Symmetry};
+use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Form, Momentum, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::matrices::Matrices;
 use crate::path;
@@ -28,6 +28,7 @@ impl<const D: usize> Family<D> for FloatingEcg {
     const NAME: &'static str = "fecg";
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("s"), Field::floats("c_A")];
     /// Eq. (25) of docs/properties-derivations.md (`fecg::momentum`).
+    const FORM: Form = Form::Floating;
     const MOMENTUM: Option<Momentum<D, Self>> = Some(fecg::momentum::<D>);
     type Function<T: Real> = Fecg<D, T>;
     type Context = Operators<D>;
@@ -65,6 +66,14 @@ impl<const D: usize> Family<D> for FloatingEcg {
 
     fn exponent(f: &Fecg<D>) -> &Mat<D> {
         &f.a
+    }
+
+    fn centres(f: &Fecg<D>) -> Centres<D> {
+        f.s
+    }
+
+    fn operators(ctx: &Self::Context) -> &Operators<D> {
+        ctx
     }
 
     fn shape(_bra: &Fecg<D>, _ket: &Fecg<D>, _ctx: &Operators<D>, _w: &Vector<D>) -> Shape {

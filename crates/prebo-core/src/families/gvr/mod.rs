@@ -14,7 +14,7 @@ use nalgebra::SMatrix;
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Momentum, Shape, Symmetry};
+use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Form, Momentum, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
@@ -39,6 +39,7 @@ impl<const D: usize> Family<D> for EcgGvr {
     const FIELDS: &'static [Field] =
         &[Field::floats("A"), Field::floats("u"), Field::naturals("K"), Field::floats("c_A")];
     /// Not derived (docs/properties-derivations.md eq. 26).
+    const FORM: Form = Form::GlobalVector;
     const MOMENTUM: Option<Momentum<D, Self>> = None;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
@@ -74,6 +75,10 @@ impl<const D: usize> Family<D> for EcgGvr {
 
     fn exponent(f: &Gvr<D>) -> &Mat<D> {
         &f.a
+    }
+
+    fn operators(ctx: &Self::Context) -> &Operators<D> {
+        &ctx.ops
     }
 
     /// The kinetic element with `Λ = g g^T` (`p_g⁴` is not derived: `MOMENTUM` is `None`).

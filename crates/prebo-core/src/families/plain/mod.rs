@@ -11,7 +11,7 @@ use super::gvr::gvr_element::{self, Gvr, GvrOps};
 use crate::cache::Cache;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Momentum, Parameters, Shape, Symmetry};
+use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Form, Momentum, Parameters, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::images::Images;
 use crate::isa::best_isa;
@@ -42,6 +42,7 @@ impl<const D: usize> Family<D> for PlainEcg {
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("c_A")];
     /// Rows in full-build orientation from the SIMD kernel (`pecg_build::rows`).
     const ORIENTED: bool = true;
+    const FORM: Form = Form::Plain;
     const MOMENTUM: Option<Momentum<D, Self>> = Some(momentum::<D>);
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
@@ -81,6 +82,10 @@ impl<const D: usize> Family<D> for PlainEcg {
 
     fn exponent(f: &Gvr<D>) -> &Mat<D> {
         &f.a
+    }
+
+    fn operators(ctx: &Self::Context) -> &Operators<D> {
+        &ctx.ops
     }
 
     fn shape(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, _w: &Vector<D>) -> Shape {

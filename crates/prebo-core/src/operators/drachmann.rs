@@ -1,0 +1,344 @@
+//! The two elements Drachmann's regularised contact density needs beside `1/|r_w|`
+//! (docs/properties-derivations.md §6, eq. 27):
+//!
+//! `<δ³(r_ij)> = (μ_ij/π) [ <(E − V)/r_ij> − <∇Ψ| Λ/r_ij |∇Ψ> ]`,
+//!
+//! an identity for eigenstates of `T_TI + V` whose right side converges faster in Gaussians,
+//! which lack the cusp (`prebo.drachmann` assembles it per state).
+//!
+//! - `coulomb_inv_r`: `<φ_I| V/|r_w| |φ_J> = Σ_{k<l} q_k q_l <1/(|r_kl| |r_w|)>` over the Coulomb
+//!   pairs of the context, each by eq. (19), `S 4 arcsin(ρ)/(πρ √(q₁₁q₂₂))` (eq. 13, `2S/q`, for
+//!   a pair parallel to `w`). Plain ECGs only: for floating ECGs and ECG-GVR the product is a
+//!   two-dimensional integral not derived (§4).
+//! - `gradient_inv_r`: `<∇φ_I| Λ/|r_w| |∇φ_J>` with the `Λ` of the context's `T_TI` (the CM part
+//!   removed: `1^T w = 0`, so `w^T Λ w = 1/(2μ_ij)` either way), from `1/|y| = π^{−1/2}∫t^{−1/2}e^{−ty²}dt`
+//!   and eq. (30): with `g = exp(−α r_w²)`, `D(α) = <φ_I|g|φ_J>` and `R = −∂D/∂α`,
+//!   `<∇φ_I| g Λ |∇φ_J> = ½[T_TI(gφ_I, φ_J) + T_TI(φ_I, gφ_J)] + ½ w^TΛw (4α²R − 6αD)`,
+//!   the kinetic elements of the family's damped functions (`Family::damped`). Divided by
+//!   `(1 − u)^{3/2}` it is a polynomial of degree `M + 1` in `u = αq/(1 + αq)` for a profile of
+//!   degree M (eq. 28; plain ECGs M = 0), integrated exactly by the rule of eq. (18); for an
+//!   exponential profile (floating ECGs) `S e^{−λu}` times a quadratic (eq. 28), whose
+//!   coefficients three values fix, integrated with Boys functions (eq. 29); the damped floating
+//!   ECG is centred at `(A + M)^{-1} A s`, which its kinetic element needs (`Fecg::damped`).
+//!   Every family.
+use std::f64::consts::PI;
+
+use nalgebra::{Const, U1};
+
+use super::profile::Profile;
+use super::ElementFn;
+use crate::ecg::{Mat, Vector};
+use crate::families::floating::fecg::erf;
+use crate::families::gvr::gvr_element::legendre_rule;
+use crate::families::{Family, Form, Shape};
+use crate::gradient::{seed, Dual};
+
+pub const COULOMB: &str = "coulomb_inv_r";
+pub const GRADIENT: &str = "gradient_inv_r";
+
+/// `coulomb_inv_r`'s element where it is derived: plain ECGs.
+pub fn coulomb<const D: usize, F: Family<D>>() -> Option<ElementFn<D, F>> {
+    (F::FORM == Form::Plain).then_some(coulomb_inv_r::<D, F> as ElementFn<D, F>)
+}
+
+/// `<φ_I| V/|r_w| |φ_J>` of plain ECGs (hartree/bohr; `v = [w]`).
+pub fn coulomb_inv_r<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
+    let Some(chol) = (F::exponent(bra) + F::exponent(ket)).cholesky() else { return f64::NAN };
+    let whiten = |w: &Vector<D>| chol.l().solve_lower_triangular(w).unwrap_or_else(|| Vector::<D>::repeat(f64::NAN));
+    let a = whiten(&v[0]);
+    let s = F::overlap(bra, ket, ctx);
+    F::operators(ctx).pairs.iter().map(|(w, charge)| charge * inverse_product(&a, &whiten(w))).sum::<f64>() * s
+}
+
+/// `<1/(|r_w| |r_w'|)>/S = 4 arcsin(ρ)/(πρ √(q₁₁q₂₂))` (eq. 19) of `a = L^{-1}w`, `b = L^{-1}w'`
+/// (`L L^T = A_I + A_J`): `q₁₂ = a·b`, `ρ√(q₁₁q₂₂) = q₁₂` and `arcsin ρ = atan2(q₁₂, |a ∧ b|)`,
+/// exact also for parallel vectors (`|a ∧ b| = 0`, eq. 13) and orthogonal ones (`q₁₂ = 0`).
+fn inverse_product<const D: usize>(a: &Vector<D>, b: &Vector<D>) -> f64 {
+    let q12 = a.dot(b);
+    let mut wedge = 0.0;
+    for i in 0..D {
+        for j in i + 1..D {
+            wedge += (a[i] * b[j] - a[j] * b[i]).powi(2);
+        }
+    }
+    let wedge = wedge.sqrt();
+    if q12 == 0.0 { 4.0 / (PI * wedge) } else { 4.0 * q12.atan2(wedge) / (PI * q12) }
+}
+
+/// `<∇φ_I| Λ/|r_w| |∇φ_J>` (hartree/bohr; `v = [w]`; module docs).
+pub fn gradient_inv_r<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
+    let w = &v[0];
+    let p = Profile::<D, F>::of(bra, ket, ctx, w);
+    let (q, ww) = (p.q, w * w.transpose());
+    let wlw = w.dot(&(F::operators(ctx).lambda * w));
+    // <∇φ_I| g Λ |∇φ_J> / (1 − u)^{3/2} at u (eq. 30)
+    let h = |u: f64| {
+        let alpha = u / (q * (1.0 - u));
+        let damping: Mat<D> = ww * alpha;
+        let t = 0.5 * (F::element(&F::damped(bra, &damping), ket, ctx).t_ti + F::element(bra, &F::damped(ket, &damping), ctx).t_ti);
+        let a: Dual<1> = seed(alpha, std::iter::once(1.0));
+        let d = F::overlap(&F::cast::<Dual<1>>(bra), &F::damped(ket, &ww.map(|x| a * x)), ctx);
+        let r = -d.eps.unwrap_generic(Const::<1>, U1)[0];
+        (t + 0.5 * wlw * (4.0 * alpha * alpha * r - 6.0 * alpha * d.re)) / (1.0 - u).powf(1.5)
+    };
+    let integral: f64 = match &p.shape {
+        // degree M + 1 in u = τ²: exact with ⌊(M + 1)/2⌋ + 1 positive nodes (eq. 18)
+        Shape::Polynomial(g) => legendre_rule(g.len() / 2 + 1).iter().map(|&(tau, wt)| wt * h(tau * tau)).sum(),
+        // S e^{−λu}(f₀ + f₁u + f₂u²) (eq. 28): the quadratic through u = 0, ¼, ½, then
+        // Σ_j f_j F_j(λ) (eq. 29)
+        Shape::Exponential => {
+            let lambda = p.lambda();
+            let [y0, y1, y2] = [0.0, 0.25, 0.5].map(|u| h(u) * (lambda * u).exp());
+            let f = [y0, -2.0 * (3.0 * y0 - 4.0 * y1 + y2), 8.0 * (y0 - 2.0 * y1 + y2)];
+            (0..3).map(|j| f[j] * boys(j, lambda)).sum()
+        }
+    };
+    2.0 / (PI * q).sqrt() * integral
+}
+
+/// The Boys function `F_j(λ) = ∫_0^1 τ^{2j} e^{−λτ²} dτ`: below λ = j + 8 the series of positive
+/// terms `e^{−λ} Σ_k (2λ)^k/((2j + 1)(2j + 3)⋯(2j + 2k + 1))` (from integrating by parts), above
+/// it `F_0 = √π erf(√λ)/(2√λ)` and the upward recurrence `F_{i+1} = ((2i + 1)F_i − e^{−λ})/(2λ)`,
+/// which damps rounding there (`2i + 1 < 2λ`).
+pub(super) fn boys(j: usize, lambda: f64) -> f64 {
+    if lambda < j as f64 + 8.0 {
+        let (mut term, mut sum, mut k) = (1.0 / (2 * j + 1) as f64, 0.0, 0);
+        while term > 1e-17 * sum {
+            sum += term;
+            k += 1;
+            term *= 2.0 * lambda / (2 * (j + k) + 1) as f64;
+        }
+        return (-lambda).exp() * sum;
+    }
+    let mut f = 0.5 * (PI / lambda).sqrt() * erf(lambda.sqrt());
+    for i in 0..j {
+        f = ((2 * i + 1) as f64 * f - (-lambda).exp()) / (2.0 * lambda);
+    }
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    //! Plain ECGs of 2 and 3 particles (laboratory frame, with and without the CM elimination)
+    //! against what uses neither eq. (19) nor eq. (30): `coulomb_inv_r` against the double
+    //! integral `(1/π)∫∫(αβ)^{−1/2} <φ_I| e^{−α r_w² − β r_w'²} |φ_J> dα dβ` over the exact damped
+    //! overlaps (a pair parallel to `w`: the `inv_r2` element); `gradient_inv_r` against
+    //! `π^{−1/2}∫α^{−1/2} 6 Tr(W (B + α w w^T)^{-1}) <φ_I|e^{−α r_w²}|φ_J> dα`, `W = A_I Λ_TI A_J`, by
+    //! quadrature, and against eq. (29). ECG-GVR at K = N = 0 and floating ECGs at zero shift
+    //! equal plain ECGs (floating ECGs with centres: operators/orbit.rs's quadrature); the Boys
+    //! functions against quadrature.
+    use super::*;
+    use crate::ecg::Operators;
+    use crate::families::floating::FloatingEcg;
+    use crate::families::gvr::gvr_element::GvrOps;
+    use crate::families::plain::PlainEcg;
+    use crate::operators::lookup;
+    use crate::families::floating::fecg::{Centres, Fecg};
+    use crate::families::gvr::gvr_element::{gauss_legendre, Gvr};
+    use crate::families::gvr::EcgGvr;
+    use crate::operators::fixtures::close;
+    use crate::operators::inverse_square;
+
+    /// A positive-definite exponent varied by `seed`; with `mu`, CM-separable: `A 1 = c_A μ`,
+    /// `A = P^T A_0 P + c_A μ μ^T`, `P = I − 1 μ^T`.
+    fn exponent<const N: usize>(seed: f64, cm: Option<(&Vector<N>, f64)>) -> Mat<N> {
+        let l = Mat::<N>::from_fn(|i, j| if j <= i { ((i * 3 + j) as f64 * 0.7 + seed).sin() } else { 0.0 });
+        let a0 = l * l.transpose() + Mat::<N>::identity() * 0.3;
+        match cm {
+            None => a0,
+            Some((mu, c)) => {
+                let p = Mat::<N>::identity() - Vector::<N>::repeat(1.0) * mu.transpose();
+                p.transpose() * a0 * p + mu * mu.transpose() * c
+            }
+        }
+    }
+
+    /// The laboratory frame of particles of `masses` and `charges`: `Λ = diag(1/2m)`, the Coulomb
+    /// pairs `e_k − e_l`, with or without the CM elimination.
+    fn laboratory<const N: usize>(masses: [f64; N], charges: [f64; N], cm: bool) -> Operators<N> {
+        let mut pairs = vec![];
+        for k in 0..N {
+            for l in k + 1..N {
+                pairs.push((Vector::<N>::from_fn(|i, _| (i == k) as i32 as f64 - (i == l) as i32 as f64), charges[k] * charges[l]));
+            }
+        }
+        let lambda = Mat::<N>::from_diagonal(&Vector::<N>::from_fn(|i, _| 0.5 / masses[i]));
+        Operators { lambda, pairs, cm_mass: cm.then(|| masses.iter().sum()) }
+    }
+
+    fn plain<const N: usize>(a: Mat<N>, c_a: f64, go: &GvrOps<N>, index: usize) -> Gvr<N> {
+        Gvr::new(a, Vector::<N>::from_fn(|i, _| (i == 0) as i32 as f64), 0, c_a, go, index).unwrap()
+    }
+
+    /// `∫_0^{π/2} f` by an n-point Gauss–Legendre rule.
+    fn quarter(n: usize, f: impl Fn(f64) -> f64) -> f64 {
+        gauss_legendre(n).iter().map(|&(x, wt)| 0.25 * PI * wt * f(0.25 * PI * (x + 1.0))).sum()
+    }
+
+    /// `q = w^T (A_I + A_J)^{-1} w`.
+    fn variance<const N: usize>(ai: &Mat<N>, aj: &Mat<N>, w: &Vector<N>) -> f64 {
+        w.dot(&((ai + aj).try_inverse().unwrap() * w))
+    }
+
+    /// `Σ_kl q_kl <1/(r_kl r_w)>` by the double integral (module docs) with α = tan²θ/q₁₁,
+    /// β = tan²ϑ/q₂₂, and the `inv_r2` element for a pair parallel to `w`.
+    fn coulomb_by_quadrature<const N: usize>(gi: &Gvr<N>, gj: &Gvr<N>, go: &GvrOps<N>, w: &Vector<N>, n: usize) -> f64 {
+        let q11 = variance(&gi.a, &gj.a, w);
+        let mut total = 0.0;
+        for (wp, charge) in &go.ops.pairs {
+            if wp == w || *wp == -w {
+                total += charge * inverse_square::element::<N, PlainEcg>(gi, gj, go, w);
+                continue;
+            }
+            let q22 = variance(&gi.a, &gj.a, wp);
+            let (ww, wpwp) = (w * w.transpose(), wp * wp.transpose());
+            let inner = |theta: f64| {
+                quarter(n, |vartheta: f64| {
+                    let damping = ww * (theta.tan().powi(2) / q11) + wpwp * (vartheta.tan().powi(2) / q22);
+                    let d = <PlainEcg as Family<N>>::overlap(gi, &gj.damped(&damping), go);
+                    d / (theta.cos() * vartheta.cos()).powi(2)
+                })
+            };
+            total += charge * 4.0 / (PI * (q11 * q22).sqrt()) * quarter(n, inner);
+        }
+        total
+    }
+
+    /// `π^{−1/2}∫α^{−1/2} X(α) dα`, `X = 6 Tr(W B_α^{-1}) D(α)` (module docs), α = tan²θ/q.
+    fn gradient_by_quadrature<const N: usize>(gi: &Gvr<N>, gj: &Gvr<N>, go: &GvrOps<N>, w: &Vector<N>) -> f64 {
+        let ops = &go.ops;
+        let lambda = ops.lambda - ops.cm_mass.map_or(Mat::<N>::zeros(), |m| Mat::<N>::repeat(0.5 / m));
+        let wt = gi.a * lambda * gj.a;
+        let q = variance(&gi.a, &gj.a, w);
+        2.0 / (PI * q).sqrt()
+            * quarter(200, |theta: f64| {
+                let damping = w * w.transpose() * (theta.tan().powi(2) / q);
+                let d = <PlainEcg as Family<N>>::overlap(gi, &gj.damped(&damping), go);
+                let b_alpha = (gi.a + gj.a + damping).try_inverse().unwrap();
+                6.0 * (wt * b_alpha).trace() * d / theta.cos().powi(2)
+            })
+    }
+
+    /// Eq. (29) for plain ECGs: `(2S/√(πq)) (6 Tr(B^{-1}W) − 2 b^T W b/q)`, `b = B^{-1} w`.
+    fn gradient_closed_form<const N: usize>(gi: &Gvr<N>, gj: &Gvr<N>, go: &GvrOps<N>, w: &Vector<N>) -> f64 {
+        let ops = &go.ops;
+        let lambda = ops.lambda - ops.cm_mass.map_or(Mat::<N>::zeros(), |m| Mat::<N>::repeat(0.5 / m));
+        let wt = gi.a * lambda * gj.a;
+        let binv = (gi.a + gj.a).try_inverse().unwrap();
+        let (b, q) = (binv * w, variance(&gi.a, &gj.a, w));
+        let s = <PlainEcg as Family<N>>::overlap(gi, gj, go);
+        2.0 * s / (PI * q).sqrt() * (6.0 * (binv * wt).trace() - 2.0 * b.dot(&(wt * b)) / q)
+    }
+
+    /// Both elements of plain ECGs against the references for the pairs `(i, j)` of `N` particles.
+    fn check_plain<const N: usize>(masses: [f64; N], charges: [f64; N], pairs: &[(usize, usize)]) {
+        let mu = Vector::<N>::from_row_slice(&masses) / masses.iter().sum::<f64>();
+        for cm in [false, true] {
+            let go = GvrOps::new(laboratory(masses, charges, cm), 0, 0).unwrap();
+            for (si, sj) in [(0.1, 0.9), (1.3, 2.2), (0.4, 0.4)] {
+                let (ai, aj) = if cm {
+                    (exponent(si, Some((&mu, 0.7))), exponent(sj, Some((&mu, 1.3))))
+                } else {
+                    (exponent(si, None), exponent(sj, None))
+                };
+                let (gi, gj) = (plain(ai, 0.7, &go, 0), plain(aj, 1.3, &go, 1));
+                for &(i, j) in pairs {
+                    let w = Vector::<N>::from_fn(|k, _| (k == i) as i32 as f64 - (k == j) as i32 as f64);
+                    let label = format!("N = {N}, CM {cm}, seeds ({si}, {sj}), pair ({i}, {j})");
+                    let got = coulomb_inv_r::<N, PlainEcg>(&gi, &gj, &go, &[w]);
+                    let want = coulomb_by_quadrature(&gi, &gj, &go, &w, 80);
+                    assert!(close(got, want, 1e-9), "{label}: coulomb_inv_r {got} vs {want}");
+                    let got = gradient_inv_r::<N, PlainEcg>(&gi, &gj, &go, &[w]);
+                    let (numerical, closed) = (gradient_by_quadrature(&gi, &gj, &go, &w), gradient_closed_form(&gi, &gj, &go, &w));
+                    assert!(close(got, numerical, 1e-11), "{label}: gradient_inv_r {got} vs quadrature {numerical}");
+                    assert!(close(got, closed, 1e-12), "{label}: gradient_inv_r {got} vs eq. (29) {closed}");
+                    // ECG-GVR at K = N = 0: the same functions
+                    let gvr = gradient_inv_r::<N, EcgGvr>(&gi, &gj, &go, &[w]);
+                    assert!(close(gvr, got, 1e-13), "{label}: ECG-GVR {gvr} vs {got}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn two_particles_match_the_quadratures() {
+        check_plain([1836.15267343, 1.0], [1.0, -1.0], &[(0, 1), (1, 0)]);
+    }
+
+    #[test]
+    fn three_particles_match_the_quadratures() {
+        check_plain([7294.29954142, 1.0, 1.0], [2.0, -1.0, -1.0], &[(0, 1), (0, 2), (1, 2)]);
+    }
+
+    /// ECG-GVR with K, N > 0: the rule of `gradient_inv_r` against
+    /// `(2/√(πq))∫_0^1 (1 − τ²)^{−3/2} X(α(τ²)) dτ` by a 24-point Gauss–Legendre rule on [0, 1] (a
+    /// polynomial of degree 2M + 2 in τ: exact too), with `X` split symmetrically,
+    /// `h = exp(−α r_w²/2)`: `X = T_TI(hφ_I, hφ_J) + w^TΛw (α²R − 3αD)` (another combination than
+    /// eq. 30).
+    #[test]
+    fn global_vector_functions_match_a_rule_on_the_symmetric_split() {
+        let masses = [7294.29954142, 1.0, 1.0];
+        let mu = Vector::<3>::from_row_slice(&masses) / masses.iter().sum::<f64>();
+        for (ki, kj, n_ang) in [(1, 0, 0), (2, 1, 1), (1, 3, 2)] {
+            for cm in [false, true] {
+                let go = GvrOps::new(laboratory(masses, [2.0, -1.0, -1.0], cm), n_ang, 3).unwrap();
+                let gi = Gvr::new(exponent(0.5, Some((&mu, 0.7))), Vector::<3>::new(0.3, 1.0, -0.4), ki, 0.7, &go, 0).unwrap();
+                let gj = Gvr::new(exponent(1.1, Some((&mu, 1.3))), Vector::<3>::new(-0.7, 0.2, 0.9), kj, 1.3, &go, 1).unwrap();
+                for w in [Vector::<3>::new(1.0, -1.0, 0.0), Vector::<3>::new(0.0, 1.0, -1.0)] {
+                    let (q, ww, wlw) = (variance(&gi.a, &gj.a, &w), w * w.transpose(), w.dot(&(go.ops.lambda * w)));
+                    let x = |tau: f64| {
+                        let alpha = tau * tau / (q * (1.0 - tau * tau));
+                        let half = ww * (0.5 * alpha);
+                        let t = <EcgGvr as Family<3>>::element(&gi.damped(&half), &gj.damped(&half), &go).t_ti;
+                        let a: Dual<1> = seed(alpha, std::iter::once(1.0));
+                        let d = <EcgGvr as Family<3>>::overlap(&gi.cast::<Dual<1>>(), &gj.damped(&ww.map(|x| a * x)), &go);
+                        let r = -d.eps.unwrap_generic(Const::<1>, U1)[0];
+                        (t + wlw * (alpha * alpha * r - 3.0 * alpha * d.re)) / (1.0 - tau * tau).powf(1.5)
+                    };
+                    let rule: f64 = gauss_legendre(24).iter().map(|&(y, wt)| 0.5 * wt * x(0.5 * (y + 1.0))).sum();
+                    let want = 2.0 / (PI * q).sqrt() * rule;
+                    let got = gradient_inv_r::<3, EcgGvr>(&gi, &gj, &go, &[w]);
+                    assert!(close(got, want, 1e-11), "K = ({ki}, {kj}), N = {n_ang}, CM {cm}: {got} vs {want}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn floating_ecgs_at_zero_shift_are_plain_ecgs() {
+        let ops = laboratory([7294.29954142, 1.0, 1.0], [2.0, -1.0, -1.0], false);
+        let go = GvrOps::new(ops.clone(), 0, 0).unwrap();
+        let (ai, aj) = (exponent::<3>(0.2, None), exponent::<3>(1.7, None));
+        let (fi, fj) = (Fecg::new(ai, Centres::<3>::zeros(), 1.0, 0).unwrap(), Fecg::new(aj, Centres::<3>::zeros(), 1.0, 1).unwrap());
+        let w = Vector::<3>::new(1.0, -1.0, 0.0);
+        let got = gradient_inv_r::<3, FloatingEcg>(&fi, &fj, &ops, &[w]);
+        let want = gradient_inv_r::<3, PlainEcg>(&plain(ai, 1.0, &go, 0), &plain(aj, 1.0, &go, 1), &go, &[w]);
+        assert!(close(got, want, 1e-12), "{got} vs {want}");
+    }
+
+    #[test]
+    fn boys_functions_match_quadrature() {
+        for lambda in [0.0, 1e-3, 0.7, 1.0, 3.5, 7.99, 8.0, 12.9, 13.1, 40.0] {
+            for j in 0..6 {
+                let want: f64 = gauss_legendre(60).iter().map(|&(x, wt)| {
+                    let t = 0.5 * (x + 1.0);
+                    0.5 * wt * t.powi(2 * j as i32) * (-lambda * t * t).exp()
+                }).sum();
+                assert!(close(boys(j, lambda), want, 1e-13), "F_{j}({lambda}) = {} vs {want}", boys(j, lambda));
+            }
+        }
+    }
+
+    #[test]
+    fn the_registry_has_them_where_derived() {
+        assert!(coulomb::<3, PlainEcg>().is_some() && coulomb::<3, EcgGvr>().is_none() && coulomb::<3, FloatingEcg>().is_none());
+        for name in [COULOMB, GRADIENT] {
+            assert!(lookup::<3, PlainEcg>(name).is_ok());
+        }
+        assert!(lookup::<3, EcgGvr>(GRADIENT).is_ok() && lookup::<3, FloatingEcg>(GRADIENT).is_ok());
+        assert!(lookup::<3, EcgGvr>(COULOMB).is_err() && lookup::<3, FloatingEcg>(COULOMB).is_err());
+    }
+}
+
+
+
