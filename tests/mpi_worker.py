@@ -1,7 +1,7 @@
 """Run by tests/test_mpi.py under `mpiexec -n R python tests/mpi_worker.py MODE`.
 
-integrals: every family's full build, rows of many trials and of one (at several positions) and a
-row gradient, split among the ranks (parallel.py), against the same engine's calls in this one
+integrals: every family's full build, rows of many trials and of one (at several positions), a
+row gradient, every operator's matrices and a density, split among the ranks (parallel.py), against the same engine's calls in this one
 process: equal bit for bit on every rank, or an AssertionError (and every rank stopped).
 raise: the last rank raises while the others enter a build that needs it.
 """
@@ -13,6 +13,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).parent))
 
 import prebo  # noqa: E402
+from prebo.expectation import OPERATORS  # noqa: E402
 from prebo.integrals import laboratory  # noqa: E402
 from prebo.parallel import world  # noqa: E402
 from test_operators import _p, family_basis  # noqa: E402
@@ -47,6 +48,14 @@ def integrals() -> None:
         want = engine.row_gradient(rep.arrays(f), dA, dv, params)
         same(got[0], want[0], f"{kind} N={N} row gradient")
         assert np.array_equal(got[1], want[1])
+        for name, op in OPERATORS.items():
+            if op.evaluates(basis.family):
+                v = np.concatenate(list(op.classes(system).values()))
+                got = rep.operator(name, basis, v, op.momenta)
+                want = engine.operator(name, params, np.stack([rep.vectors(v[:, k], m) for k, m in enumerate(op.momenta)], 1))
+                assert np.array_equal(got, want), f"{kind} N={N} operator {name}"
+        w, C, r = system.pairs()[0][2][None].repeat(3, 0), rng.normal(size=(13, 2)), np.linspace(0.1, 3.0, 7)
+        assert np.array_equal(rep.density(basis, w, C, r), engine.density(params, w, C, r)), f"{kind} density"
     if ranks.root:
         print(f"integrals: {ranks.size} ranks equal one process bit for bit")
 

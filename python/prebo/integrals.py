@@ -107,13 +107,15 @@ class Representation:
         position-like or, with `momenta[k]`, momentum-like (p_w = Σ_k w_k p_k)."""
         v = np.asarray(v, dtype=float).reshape(len(v), len(momenta), -1)
         v = np.stack([self.vectors(v[:, k], m) for k, m in enumerate(momenta)], axis=1)
-        return self.engine(f).operator(name, self.arrays(f), np.ascontiguousarray(v))
+        engine, params = self.engine(f), self.arrays(f)
+        return world().instances(lambda part: engine.operator(name, params, part), np.ascontiguousarray(v))
 
     def density(self, f, w: np.ndarray, C: np.ndarray, r: np.ndarray) -> np.ndarray:
         """The spherically averaged densities (p, states, len(r)) of r_w (bohr⁻³) at the radii `r`
         (bohr) in the states Σ_k C_ks Yφ_k of the basis `f`, one per laboratory-frame vector w (p, n)."""
-        C = np.ascontiguousarray(C, dtype=float)
-        return self.engine(f).density(self.arrays(f), self.vectors(w), C, np.ascontiguousarray(r, dtype=float))
+        C, r = np.ascontiguousarray(C, dtype=float), np.ascontiguousarray(r, dtype=float)
+        engine, params = self.engine(f), self.arrays(f)
+        return world().instances(lambda part: engine.density(params, part, C, r), self.vectors(w))
 
     def vectors(self, w: np.ndarray, momentum: bool = False) -> np.ndarray:
         """Laboratory-frame operator vectors w (p, n) in this representation: in TICC a position-like

@@ -9,7 +9,9 @@ among the ranks and gathered, so that every rank goes on with the same bits:
   columns, in the orientation of the full row (`Representation.rows`, position);
 - a full build: the upper triangle in blocks of rows of about equal area, each block's part left
   of it as rows of the block against the functions before it and its diagonal block as a build
-  of the block alone, dealt to the ranks in turn.
+  of the block alone, dealt to the ranks in turn;
+- the expectation values and densities of a result: blocks of the operator's instances (its
+  pairs or particles).
 
 Every element is evaluated by the core exactly as in one process, so the matrices and rows of R
 ranks equal one rank's bit for bit; what is done with them (eigen-solutions, objectives,
@@ -154,6 +156,14 @@ class Ranks:
         if self.size == 1 or len(params[0]) < self.size:
             return engine.row_gradient(f, dA, dv, params)
         return self._columns(lambda basis, _: engine.row_gradient(f, dA, dv, basis), params, None)
+
+    def instances(self, evaluate, v: np.ndarray) -> np.ndarray:
+        """`evaluate(v)` of an operator's or a density's instances `v` (first axis), one contiguous
+        block of them per rank, joined in order (`Representation.operator`, `.density`)."""
+        if self.size == 1 or len(v) < self.size:
+            return evaluate(v)
+        mine = [(r, evaluate(np.ascontiguousarray(v[s]))) for r, s in enumerate(slices(len(v), self.size)) if r == self.rank]
+        return np.concatenate([x for _, x in self.gathered(mine)], axis=0)
 
     def _columns(self, evaluate, params: tuple, position: int | None) -> tuple[dict, np.ndarray]:
         """Rows evaluated by blocks of the basis's columns, one per rank, each with the position
