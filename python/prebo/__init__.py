@@ -8,11 +8,13 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.integrals`, `prebo.eigen`: matrices and the generalised eigenproblem;
 - `prebo.optimise`: `Optimiser` settings and `optimise`, the stochastic variational driver;
 - `prebo.results`: `evaluate`, the energies of a basis;
-- `prebo.properties`: `properties`, a level's energy and expectation values; `densities`, the
-  distance distributions of levels;
+- `prebo.properties`: `properties`, a level's energy, expectation values and their corrections
+  (`prebo.relativistic`, the Breit–Pauli terms; `prebo.drachmann`, the regularised δ); `densities`,
+  the distance distributions of levels;
 - `prebo.thresholds`: the lowest dissociation threshold, below which a state is bound;
 - `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
-- `prebo.cli`, `prebo.plot`: the command line and convergence plots.
+- `prebo.cli`, `prebo.plot`: the command line and convergence plots;
+- `prebo.parallel`: MPI ranks sharing a run's integrals (`mpiexec -n R prebo run`; docs/mpi.md).
 
 Hartree atomic units: energies in Eh, lengths in bohr, masses in m_e. The method is that of
 Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018).
