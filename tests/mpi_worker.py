@@ -4,6 +4,7 @@ integrals: every family's full build, rows of many trials and of one (at several
 row gradient, every operator's matrices and a density, split among the ranks (parallel.py), against the same engine's calls in this one
 process: equal bit for bit on every rank, or an AssertionError (and every rank stopped).
 raise: the last rank raises while the others enter a build that needs it.
+diverge: the ranks build matrices of different bases (as ranks whose copies of a run differ would).
 """
 import sys
 from pathlib import Path
@@ -70,5 +71,12 @@ def fail() -> None:
     laboratory(system).matrices(basis)
 
 
+def diverge() -> None:
+    e, p = _p("e", 1.0, -1.0), _p("p", 1836.15267343, 1.0)
+    system = prebo.System([p, e, e], state=prebo.State(N=0, parity=1, spin={"e": 0}))
+    basis = family_basis("pecg", system, np.random.default_rng(1), nb=20 + world().rank)
+    laboratory(system).matrices(basis)
+
+
 if __name__ == "__main__":
-    {"integrals": integrals, "raise": fail}[sys.argv[1]]()
+    {"integrals": integrals, "raise": fail, "diverge": diverge}[sys.argv[1]]()

@@ -52,6 +52,14 @@ def test_a_failing_rank_stops_every_rank_with_an_error():
     assert p.returncode != 0 and "a deliberate failure on the last rank" in err
 
 
+def test_ranks_whose_copies_differ_stop_with_an_error_naming_it():
+    """Replicated state: ranks that make different calls (a run's copies that drifted apart) are
+    caught at the next gathering, never joined into wrong matrices."""
+    p = mpi(2, sys.executable, WORKER, "diverge")
+    _, err = p.communicate(timeout=60)
+    assert p.returncode != 0 and "MPI ranks diverged" in err
+
+
 def test_a_two_rank_run_equals_a_one_rank_run_and_resumes_after_a_kill(tmp_path):
     (tmp_path / "in.toml").write_text(INPUT)
     finished(prebo_run(1, tmp_path / "in.toml", "--out", tmp_path / "one"), 300)

@@ -56,3 +56,8 @@ class NonFiniteError(PreboError):
 
 class StalledError(PreboError):
     """An optimisation that cannot proceed with its settings (every trial rejected)."""
+
+
+class RanksDivergedError(PreboError):
+    """MPI ranks that no longer make the same calls: their replicated state differs (nodes of
+    different CPUs or BLAS; parallel.py)."""

@@ -35,7 +35,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .errors import UnsupportedError
+from .errors import RanksDivergedError, UnsupportedError
 
 #: environment variables by which MPI launchers (MPICH/Hydra and Slurm's PMI, Open MPI, PMIx) give
 #: the number of ranks
@@ -107,15 +107,21 @@ class Ranks:
         """Whether this is rank 0, the one that writes checkpoints, results and progress."""
         return self.rank == 0
 
-    def agreed(self, value):
-        """Rank 0's `value` on every rank (a collective call: every rank makes it)."""
-        return value if self.comm is None else self.comm.bcast(value, root=0)
+    def agreed(self, value, what: str = "value"):
+        """Rank 0's `value` on every rank (a collective call: every rank makes it, for the same
+        `what`; RanksDivergedError otherwise, as for `gathered`)."""
+        return value if self.comm is None else self.gathered([(self.rank, value)], ("agreed", what))[0][1]
 
-    def gathered(self, mine: list) -> list:
-        """The (index, item) pairs of every rank, ordered by index."""
+    def gathered(self, mine: list, call: tuple) -> list:
+        """The (index, item) pairs of every rank, ordered by index; `call` names what they are
+        (the kind of call and its sizes), and RanksDivergedError if the ranks made different ones."""
         if self.comm is None:
             return sorted(mine, key=lambda x: x[0])
-        return sorted((x for part in self.comm.allgather(mine) for x in part), key=lambda x: x[0])
+        parts = self.comm.allgather((call, mine))
+        if any(c != call for c, _ in parts):
+            raise RanksDivergedError(f"MPI ranks diverged: they made the calls {[c for c, _ in parts]} together "
+                                     "(their copies of the run differ: nodes of different CPUs or BLAS? docs/mpi.md)")
+        return sorted((x for _, part in parts for x in part), key=lambda x: x[0])
 
     def matrices(self, engine, params: tuple) -> dict:
         """`engine.matrices(params)`, its row blocks evaluated by the ranks in turn."""
@@ -129,7 +135,7 @@ class Ranks:
             left = engine.rows(take(params, s), take(params, slice(0, s.start)), None)[0] if s.start else None
             mine.append((k, left, engine.matrices(take(params, s))))
         out = {}
-        for k, left, square in self.gathered(mine):
+        for k, left, square in self.gathered(mine, ("matrices", nb)):
             s = blocks[k]
             for name, block in square.items():
                 M = out.setdefault(name, np.zeros((nb, nb)))
@@ -148,14 +154,15 @@ class Ranks:
         if k >= self.size:
             parts = [(r, engine.rows(take(trials, s), params, position))
                      for r, s in enumerate(slices(k, self.size)) if r == self.rank]
-            return self._joined(parts, axis=0)
-        return self._columns(lambda basis, at: engine.rows(trials, basis, at), params, position)
+            return self._joined(parts, axis=0, call=("rows", k, nb, position))
+        return self._columns(lambda basis, at: engine.rows(trials, basis, at), params, position, ("row", k, nb, position))
 
     def row_gradient(self, engine, f: tuple, dA, dv, params: tuple) -> tuple[dict, np.ndarray]:
         """`engine.row_gradient(f, dA, dv, params)`, blocks of its columns evaluated by the ranks."""
         if self.size == 1 or len(params[0]) < self.size:
             return engine.row_gradient(f, dA, dv, params)
-        return self._columns(lambda basis, _: engine.row_gradient(f, dA, dv, basis), params, None)
+        return self._columns(lambda basis, _: engine.row_gradient(f, dA, dv, basis), params, None,
+                             ("row gradient", len(params[0]), len(dA)))
 
     def instances(self, evaluate, v: np.ndarray) -> np.ndarray:
         """`evaluate(v)` of an operator's or a density's instances `v` (first axis), one contiguous
@@ -163,22 +170,22 @@ class Ranks:
         if self.size == 1 or len(v) < self.size:
             return evaluate(v)
         mine = [(r, evaluate(np.ascontiguousarray(v[s]))) for r, s in enumerate(slices(len(v), self.size)) if r == self.rank]
-        return np.concatenate([x for _, x in self.gathered(mine)], axis=0)
+        return np.concatenate([x for _, x in self.gathered(mine, ("instances", v.shape))], axis=0)
 
-    def _columns(self, evaluate, params: tuple, position: int | None) -> tuple[dict, np.ndarray]:
+    def _columns(self, evaluate, params: tuple, position: int | None, call: tuple) -> tuple[dict, np.ndarray]:
         """Rows evaluated by blocks of the basis's columns, one per rank, each with the position
         of the function within the block (clipped), so in the orientation of the full row."""
         nb = len(params[0])
         at = nb if position is None else position
         s = slices(nb, self.size)[self.rank]
         rows, diag = evaluate(take(params, s), min(max(at - s.start, 0), s.stop - s.start))
-        joined, _ = self._joined([(self.rank, (rows, diag))], axis=1)
+        joined, _ = self._joined([(self.rank, (rows, diag))], axis=1, call=call)
         return joined, diag
 
-    def _joined(self, parts: list, axis: int) -> tuple[dict, np.ndarray]:
+    def _joined(self, parts: list, axis: int, call: tuple) -> tuple[dict, np.ndarray]:
         """Every rank's (rows, diagonal) parts joined in rank order along `axis` of the rows (and
         the diagonals along axis 0 for blocks of trials)."""
-        gathered = [part for _, part in self.gathered(parts)]
+        gathered = [part for _, part in self.gathered(parts, call)]
         rows = {name: np.concatenate([r[name] for r, _ in gathered], axis=axis) for name in gathered[0][0]}
         diag = np.concatenate([d for _, d in gathered], axis=0) if axis == 0 else gathered[0][1]
         return rows, diag

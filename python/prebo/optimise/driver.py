@@ -115,7 +115,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     def wall() -> float:
         """Seconds of optimisation so far, over all segments of a resumed run: rank 0's clock, so
         that every rank decides alike by time."""
-        return ranks.agreed(round(elapsed + time.perf_counter() - t_start, 1))
+        return ranks.agreed(round(elapsed + time.perf_counter() - t_start, 1), "clock")
 
     def expansion(b: Basis, objective: Levels) -> Expansion:
         """The expansion of basis `b` with the run's representation and linear-dependence settings."""
@@ -132,11 +132,12 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
 
     def checkpoint():
         ex.basis.coefficients = ex.coefficients if ex.eig is not None else None
+        seconds = wall()  # on every rank: the clock is agreed among the ranks
         if out is not None:
             energy = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
             ex.basis.save(Path(out) / CHECKPOINT, {
                 "energy": energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
-                "rng": rng.bit_generator.state, "history": history, "elapsed": wall(),
+                "rng": rng.bit_generator.state, "history": history, "elapsed": seconds,
                 "schedule": schedule.to_dict(), "stopped": stopped, "momentum": run.momentum.to_dict()}
                 | ({} if ex.objective.lowest else {"levels": list(ex.objective.roots), "followed": followed}))
 
