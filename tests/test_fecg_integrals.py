@@ -130,7 +130,7 @@ def check(label, got, ref, tol, scale=None):
 def prebo_all(system, basis):
     lab = laboratory(system).matrices(basis)
     internal = laboratory(system, kinetic="internal").matrices(basis)
-    n2 = laboratory(system).angular(basis, system.cm_vector)
+    n2 = laboratory(system).operator("n2", basis, system.cm_vector[None])[0]
     return lab, internal, n2
 
 
@@ -175,7 +175,7 @@ def test_two_particle_quadrature(charges):
     assert np.min(np.abs(ref["S"])) > 1e-3  # every pair overlaps: off-diagonal elements are tested
     assert np.min(np.abs(ref["N2"])) > 1e-4
     # sensitivity: the laboratory-frame L² (no R × P term, μ -> 0) is far from prebo's N_TI²
-    n2 = laboratory(s).angular(fecg_basis(s, A, cA, centres), mu)
+    n2 = laboratory(s).operator("n2", fecg_basis(s, A, cA, centres), mu[None])[0]
     nrm = [gh_pair((a, c), (a, c), {}, 0 * mu, 3)["S"] for a, c in zip(A, centres)]
     l2 = np.array([[gh_pair((A[i], centres[i]), (A[j], centres[j]), {}, 0 * mu, 3)["N2"] for j in range(4)]
                    for i in range(4)]) / np.sqrt(np.outer(nrm, nrm))

@@ -92,10 +92,6 @@ class Engine:
         correlation function of r_ij; for w = e_i − μ (mass fractions) the density of particle i
         about the centre of mass."""
 
-    def angular(self, params: Params, mu: ArrayLike) -> NDArray[np.float64]:
-        """Symmetrised (nb, nb) matrix of the translation-free <N²> (ħ² = 1) of a floating-ECG
-        basis in the laboratory frame; mu (n,): mass fractions m_i/m_tot. Error for other families."""
-
 
 def roots_with_added(e: ArrayLike, c: ArrayLike, h: ArrayLike, s: ArrayLike, h_nn: ArrayLike,
                      s_nn: ArrayLike, min_norm: float, roots: list[int]) -> NDArray[np.float64]:

@@ -5,7 +5,9 @@ generic path (`prebo._core.Engine.operator`, crates/prebo-core/src/operators/; `
 names the operators of each family), in the laboratory frame or in translationally invariant
 coordinates; `results.evaluate(basis, operators=...)` and `prebo energy --operator NAME` report it
 for the state they solve. A new operator is one core module plus one registration line per layer
-(docs/architecture.md, "Add an operator").
+(docs/architecture.md, "Add an operator"). The core's "n2", ⟨N²⟩_TI of floating ECGs, is an
+operator of the whole system (its vector the mass fractions), reported per level by
+`results.evaluate`, not per class here.
 
 Pair operators act on r_w = Σ_k w_k r_k with w = e_i − e_j, the inter-particle vector
 r_ij = r_i − r_j (hartree atomic units: lengths in bohr). Particle operators act on particle i's

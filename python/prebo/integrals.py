@@ -174,13 +174,6 @@ class Representation:
         """Whether `rows(..., position)` reproduces full-build bits for the family of basis `f`."""
         return self.engine(f).oriented
 
-    def angular(self, f, mu: np.ndarray) -> np.ndarray:
-        """The symmetrised translation-free <N²> matrix of a basis whose family does not conserve
-        the angular momentum (floating ECGs; laboratory frame); `mu` the kinetic matrix μ."""
-        if f.family.conserves_L or self.coords is not None:
-            raise ValueError("<N²> matrices are computed for floating ECGs in the laboratory frame")
-        return self.engine(f).angular(self.arrays(f), mu)
-
 
 def laboratory(system: System, kinetic: str = "M") -> Representation:
     """The laboratory-frame representation of `system`: kinetic matrix M = diag(1/(2 m_i)) with the

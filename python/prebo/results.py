@@ -117,7 +117,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         raise InputError(f"evaluate: coordinates = {coordinates!r}: must be 'lab' or 'ti'")
     ti = eigen.solve(m["T_ti"] + m["V"], m["S"], threshold, roots)
     low = lowest(system)
-    n2 = None if basis.family.conserves_L else laboratory(system).angular(basis, system.cm_vector)
+    n2 = None if basis.family.conserves_L else laboratory(system).operator("n2", basis, system.cm_vector[None])[0]
     values = {name: expectation(rep, basis, ti.vectors[:, :roots], name) for name in operators}
     rho = None if radii is None else densities(rep, basis, ti.vectors[:, :roots], radii)
     levels = [level(ti, k, m, low.energy, threshold, n2, {name: v[k] for name, v in values.items()})

@@ -5,7 +5,7 @@
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Vector, MAX_DIM};
 use crate::error::{CoreError, Result};
-use crate::families::floating::{fecg, FloatingEcg};
+use crate::families::floating::FloatingEcg;
 use crate::families::gvr::EcgGvr;
 use crate::families::plain::PlainEcg;
 use crate::families::{check, Column, Directions, Family, Field, Parameters};
@@ -215,18 +215,6 @@ fn density_d<const D: usize, F: Family<D>>(e: &Engine, basis: &[Column], w: &[f6
     Ok(out)
 }
 
-fn angular_d<const D: usize, F>(e: &Engine, basis: &[Column], mu: &[f64]) -> Result<Vec<f64>>
-where
-    F: Family<D, Function<f64> = fecg::Fecg<D>, Context = Operators<D>>,
-{
-    check(mu.len(), D, "mass fractions")?;
-    let mu = Vector::<D>::from_row_slice(mu);
-    let basis = F::params(basis)?;
-    let (ops, sym) = e.rep.operators::<D>();
-    let b = path::images::<D, F>(&ops, &sym, &basis)?;
-    Ok(path::symmetric_scalar(&b, |x, y| fecg::angular(x, y, &mu)))
-}
-
 impl Engine {
     /// Checks the representation (shapes, `1 <= n <= MAX_DIM`); `n_ang` must be 0 except for ECG-GVR.
     pub fn new(kind: Kind, rep: Representation, n_ang: u32) -> Result<Self> {
@@ -283,16 +271,5 @@ impl Engine {
     /// (`p x ns x radii`).
     pub fn density(&self, basis: &[Column], w: &[f64], c: &[f64], radii: &[f64]) -> Result<Vec<f64>> {
         dispatch!(self, density_d(self, basis, w, c, radii))
-    }
-
-    /// The symmetrised `<phi_I|N_TI²|phi_J>` matrix of a floating-ECG basis (LFCC; `mu` = m/m_tot).
-    pub fn angular(&self, basis: &[Column], mu: &[f64]) -> Result<Vec<f64>> {
-        if self.kind != Kind::Fecg {
-            return Err(CoreError::Unsupported(format!(
-                "<N²> matrices of {} functions (fecg only)",
-                self.kind.name()
-            )));
-        }
-        dispatch!(@dim self, angular_d, FloatingEcg, (self, basis, mu))
     }
 }

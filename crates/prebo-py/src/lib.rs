@@ -148,19 +148,6 @@ impl Engine {
         Ok(Array3::from_shape_vec((p, ns, r.len()), d).expect("p x ns x radii values").into_pyarray(py))
     }
 
-    fn angular<'py>(
-        &self,
-        py: Python<'py>,
-        params: &Bound<'py, PyAny>,
-        mu: &Bound<'py, PyAny>,
-    ) -> Result<Bound<'py, PyArray2<f64>>> {
-        let basis = columns(self.core.kind, params)?;
-        let mu = floats(mu, "mu")?;
-        let nb = self.core.count(&basis)?;
-        let m = py.allow_threads(|| self.core.angular(&basis, &mu))?;
-        Ok(matrix(py, nb, nb, m))
-    }
-
     fn __repr__(&self) -> String {
         format!("Engine({:?}, n={}, N={})", self.core.kind.name(), self.core.rep.n, self.core.n_ang)
     }

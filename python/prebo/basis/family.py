@@ -82,7 +82,7 @@ class Family:
     def engine(self, ops: tuple, N: int) -> _core.Engine:
         """The core's engine of this family for the representation's operators `ops` = (Λ, pair_w,
         pair_q, sym_t, sym_c, cm_mass) and the state's N: `.matrices(params)`, `.rows(trials, basis,
-        position)`, `.row_gradient(f, dA, dv, basis)`, `.angular(params, mu)`, `.oriented`."""
+        position)`, `.row_gradient(f, dA, dv, basis)`, `.operator(name, params, v)`, `.oriented`."""
         return _core.Engine(self.name, *ops, N=N)
 
     # --- sampling ------------------------------------------------------------------

@@ -1,8 +1,8 @@
 """Floating ECGs ("fecg"): φ(r) = exp(-(r - s)^T (A ⊗ I_3)(r - s)), centres s (n x 3) per function.
 
 Not eigenfunctions of the angular momentum: they take the label N = 0 (the core evaluates no
-other) with either parity, and the results report the translation-free <N²> (the engine's
-`angular`). The sampler and refinement keep the CM centre μ^T s at 0, so the functions separate
+other) with either parity, and the results report the translation-free <N²> (the core's
+operator "n2"). The sampler and refinement keep the CM centre μ^T s at 0, so the functions separate
 in the CM coordinate.
 """
 from __future__ import annotations

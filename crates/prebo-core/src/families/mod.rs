@@ -191,6 +191,10 @@ pub enum Form {
     GlobalVector,
 }
 
+/// `<phi_I| N_TI² |phi_J>` of normalised functions of family `F` (`operators::angular`), `μ` the
+/// mass fractions.
+pub type Angular<const D: usize, F> = fn(&<F as Family<D>>::Function<f64>, &<F as Family<D>>::Function<f64>, &Vector<D>) -> f64;
+
 /// `(<phi_I| p_g² |phi_J>, <phi_I| p_g⁴ |phi_J>)` of normalised functions of family `F`, for
 /// `p_g = −i Σ_k g_k ∇_k` with a D-vector `g` (`operators::momentum`; docs/properties-derivations.md §5).
 pub type Momentum<const D: usize, F> = fn(
@@ -217,6 +221,9 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// The element of the momentum operators `p_g²` and `p_g⁴` (`Momentum`), or `None` where the
     /// family's `p_g⁴` is not derived (`operators::lookup` then refuses it).
     const MOMENTUM: Option<Momentum<D, Self>>;
+    /// The element of `N_TI²` where the functions are not its eigenfunctions (`Angular`), `None`
+    /// where they are (`N_TI² φ = N(N + 1) φ`).
+    const ANGULAR: Option<Angular<D, Self>> = None;
     /// One function over the scalar `T`.
     type Function<T: Real>: Clone + Send + Sync + Transform<D, Self::Context>;
     /// What the elements need beside the functions (operators, quadrature rules, N).

@@ -13,6 +13,7 @@ use crate::error::{CoreError, Result};
 use crate::families::plain::PlainEcg;
 use crate::families::Family;
 
+pub mod angular;
 pub mod delta;
 pub mod density;
 pub mod distance;
@@ -57,6 +58,7 @@ fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<
         (drachmann::COULOMB, 1, drachmann::coulomb::<D, F>()),
         (drachmann::GRADIENT, 1, Some(drachmann::gradient_inv_r::<D, F>)),
         (orbit::NAME, 3, orbit::element_for::<D, F>()),
+        (angular::NAME, 1, F::ANGULAR.and_then(|_| one_vector!(angular::element::<D, F>))),
     ]
 }
 
