@@ -136,21 +136,13 @@ mod tests {
     use crate::families::floating::fecg::{Centres, Fecg};
     use crate::families::gvr::gvr_element::{gauss_legendre, Gvr};
     use crate::families::gvr::EcgGvr;
-    use crate::operators::fixtures::close;
+    use crate::operators::fixtures::{self, close, plain, separable};
     use crate::operators::inverse_square;
 
-    /// A positive-definite exponent varied by `seed`; with `mu`, CM-separable: `A 1 = c_A μ`,
-    /// `A = P^T A_0 P + c_A μ μ^T`, `P = I − 1 μ^T`.
+    /// A positive-definite exponent varied by `seed`; with `mu`, CM-separable (`A 1 = c_A μ`).
     fn exponent<const N: usize>(seed: f64, cm: Option<(&Vector<N>, f64)>) -> Mat<N> {
-        let l = Mat::<N>::from_fn(|i, j| if j <= i { ((i * 3 + j) as f64 * 0.7 + seed).sin() } else { 0.0 });
-        let a0 = l * l.transpose() + Mat::<N>::identity() * 0.3;
-        match cm {
-            None => a0,
-            Some((mu, c)) => {
-                let p = Mat::<N>::identity() - Vector::<N>::repeat(1.0) * mu.transpose();
-                p.transpose() * a0 * p + mu * mu.transpose() * c
-            }
-        }
+        let a0 = fixtures::exponent(seed);
+        cm.map_or(a0, |(mu, c_a)| separable(&a0, mu, c_a))
     }
 
     /// The laboratory frame of particles of `masses` and `charges`: `Λ = diag(1/2m)`, the Coulomb
@@ -164,10 +156,6 @@ mod tests {
         }
         let lambda = Mat::<N>::from_diagonal(&Vector::<N>::from_fn(|i, _| 0.5 / masses[i]));
         Operators { lambda, pairs, cm_mass: cm.then(|| masses.iter().sum()) }
-    }
-
-    fn plain<const N: usize>(a: Mat<N>, c_a: f64, go: &GvrOps<N>, index: usize) -> Gvr<N> {
-        Gvr::new(a, Vector::<N>::from_fn(|i, _| (i == 0) as i32 as f64), 0, c_a, go, index).unwrap()
     }
 
     /// `∫_0^{π/2} f` by an n-point Gauss–Legendre rule.

@@ -83,17 +83,37 @@ pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<(usize, Elemen
     Ok((arity, element))
 }
 
-/// What the operators' tests share: three coordinates, random exponents, the pair vector `e_1 − e_2`.
+/// What the operators' tests share: three coordinates, random exponents and centres, plain ECGs
+/// of the ECG-GVR form, the pair vector `e_1 − e_2`.
 #[cfg(test)]
 pub(crate) mod fixtures {
     use crate::ecg::{Mat, Operators, Vector};
+    use crate::families::floating::fecg::Centres;
+    use crate::families::gvr::gvr_element::{Gvr, GvrOps};
 
     pub const D: usize = 3;
 
-    /// A positive-definite exponent `L Lᵀ + 0.3` with `L` lower-triangular, varied by `seed`.
-    pub fn exponent(seed: f64) -> Mat<D> {
-        let l = Mat::<D>::from_fn(|i, j| if j <= i { ((i * 3 + j) as f64 * 0.7 + seed).sin() } else { 0.0 });
-        l * l.transpose() + Mat::<D>::identity() * 0.3
+    /// A positive-definite exponent `L Lᵀ + 0.3` with `L` lower-triangular, varied by `seed` (for
+    /// N < 3 the leading block of N = 3's).
+    pub fn exponent<const N: usize>(seed: f64) -> Mat<N> {
+        let l = Mat::<N>::from_fn(|i, j| if j <= i { ((i * 3 + j) as f64 * 0.7 + seed).sin() } else { 0.0 });
+        l * l.transpose() + Mat::<N>::identity() * 0.3
+    }
+
+    /// `a0` made CM-separable, `A 1 = c_A μ`: `A = Pᵀ a0 P + c_A μ μᵀ`, `P = I − 1 μᵀ`.
+    pub fn separable<const N: usize>(a0: &Mat<N>, mu: &Vector<N>, c_a: f64) -> Mat<N> {
+        let p = Mat::<N>::identity() - Vector::<N>::repeat(1.0) * mu.transpose();
+        p.transpose() * a0 * p + mu * mu.transpose() * c_a
+    }
+
+    /// Centres `s` of spread `spread`, varied by `x`.
+    pub fn centres<const N: usize>(x: f64, spread: f64) -> Centres<N> {
+        Centres::<N>::from_fn(|i, c| spread * (x + i as f64 * 1.1 + c as f64 * 0.37).cos())
+    }
+
+    /// A plain ECG of the `PlainEcg` family (an ECG-GVR function at K = N = 0, `u` irrelevant).
+    pub fn plain<const N: usize>(a: Mat<N>, c_a: f64, go: &GvrOps<N>, index: usize) -> Gvr<N> {
+        Gvr::new(a, Vector::<N>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 }), 0, c_a, go, index).unwrap()
     }
 
     /// Kinetic `Λ = ½` and the Coulomb `pairs`.

@@ -85,7 +85,7 @@ mod tests {
     use crate::families::floating::FloatingEcg;
     use crate::families::gvr::EcgGvr;
     use crate::families::plain::PlainEcg;
-    use crate::operators::fixtures::{close, exponent};
+    use crate::operators::fixtures::{centres, close, exponent, plain, separable};
     use crate::operators::lookup;
 
     /// `φ(r) = exp(−Σ_c (r − s)_c^T A (r − s)_c)` and `∇_g φ` (a 3-vector): the derivatives in `t_c`
@@ -162,14 +162,6 @@ mod tests {
         2.0 / (std::f64::consts::PI * q).sqrt() * t_integral / overlap
     }
 
-    fn plain<const N: usize>(a: Mat<N>, c_a: f64, go: &GvrOps<N>, index: usize) -> Gvr<N> {
-        Gvr::new(a, Vector::<N>::from_fn(|i, _| (i == 0) as i32 as f64), 0, c_a, go, index).unwrap()
-    }
-
-    fn centres<const N: usize>(x: f64, spread: f64) -> Centres<N> {
-        Centres::<N>::from_fn(|i, c| spread * (x + i as f64 * 1.1 + c as f64 * 0.37).cos())
-    }
-
     /// `[w, g_i, g_j]` of the pair (i, j): `w = e_i − e_j`, `g_k = e_k − μ_k 1`.
     fn vectors<const N: usize>(mu: &Vector<N>, i: usize, j: usize) -> [Vector<N>; 3] {
         let e = |k: usize| Vector::<N>::from_fn(|l, _| (l == k) as i32 as f64);
@@ -180,10 +172,9 @@ mod tests {
     /// `masses`; CM-separable exponents (`A 1 = c_A μ`) when `cm`. The largest relative deviation.
     fn check<const N: usize>(masses: [f64; N], pairs: &[(usize, usize)], cm: bool, seeds: &[(f64, f64)], spreads: &[f64]) -> f64 {
         let mu = Vector::<N>::from_row_slice(&masses) / masses.iter().sum::<f64>();
-        let pi = Mat::<N>::identity() - mu * Vector::<N>::repeat(1.0).transpose();
         let a = |seed: f64, c_a: f64| {
-            let a0 = exponent(seed).fixed_view::<N, N>(0, 0).into_owned();
-            if cm { pi * a0 * pi.transpose() + mu * mu.transpose() * c_a } else { a0 }
+            let a0 = exponent::<N>(seed);
+            if cm { separable(&a0, &mu, c_a) } else { a0 }
         };
         let ops = Operators { lambda: Mat::<N>::identity() * 0.5, pairs: vec![], cm_mass: None };
         let go = GvrOps::new(ops.clone(), 0, 0).unwrap();
@@ -303,11 +294,10 @@ mod tests {
     fn floating_gradient_inv_r_matches_quadrature() {
         const N: usize = 3;
         let mu = Vector::<N>::new(7294.29954142, 1.0, 1.0) / 7296.29954142;
-        let pi = Mat::<N>::identity() - mu * Vector::<N>::repeat(1.0).transpose();
         let mut worst: f64 = 0.0;
         for (seed, spread) in [(0.1, 0.3), (1.3, 1.5), (0.4, 2.5)] {
-            let ai = pi * exponent(seed) * pi.transpose() + mu * mu.transpose() * 0.7;
-            let aj = pi * exponent(seed + 0.8) * pi.transpose() + mu * mu.transpose() * 1.3;
+            let ai = separable(&exponent(seed), &mu, 0.7);
+            let aj = separable(&exponent(seed + 0.8), &mu, 1.3);
             let (ci, cj) = (centres::<N>(0.3, spread), centres::<N>(2.1, spread));
             let (fi, fj) = (Fecg::new(ai, ci, 0.7, 0).unwrap(), Fecg::new(aj, cj, 1.3, 1).unwrap());
             let [w, g, _] = vectors(&mu, 0, 1);
