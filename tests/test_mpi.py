@@ -8,12 +8,11 @@ import shutil
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
 
-from test_optimise import INPUT, functions
+from test_optimise import INPUT, functions, mid_schedule
 
 pytest.importorskip("mpi4py")
 MPIEXEC = shutil.which("mpiexec") or pytest.skip("no mpiexec on the PATH", allow_module_level=True)
@@ -67,16 +66,8 @@ def test_a_two_rank_run_equals_a_one_rank_run_and_resumes_after_a_kill(tmp_path)
     assert functions(tmp_path / "two") == functions(tmp_path / "one")
 
     killed = prebo_run(2, tmp_path / "in.toml", "--out", tmp_path / "killed", start_new_session=True)
-    deadline = time.time() + 120
-    while time.time() < deadline:  # kill every rank in the middle of the schedule
-        try:
-            progress = json.loads((tmp_path / "killed" / "basis.json").read_text())["progress"]
-            if progress["phase"] != "grow" or len(functions(tmp_path / "killed")) >= 6:
-                break
-        except (OSError, json.JSONDecodeError, KeyError):
-            pass
-        time.sleep(0.01)
-    os.killpg(killed.pid, signal.SIGKILL)
+    mid_schedule(tmp_path / "killed")
+    os.killpg(killed.pid, signal.SIGKILL)  # every rank
     killed.communicate()
     cut = json.loads((tmp_path / "killed" / "basis.json").read_text())["progress"]
     assert cut["phase"] != "done", "the run ended before it was killed: nothing tested"

@@ -46,21 +46,27 @@ def functions(folder):
     return json.loads((folder / "basis.json").read_text())["functions"]
 
 
+def mid_schedule(folder, seconds: float = 120) -> None:
+    """Wait, at most `seconds`, until the run writing folder/basis.json has left growth or holds six
+    functions: a point in the middle of INPUT's schedule to kill it at."""
+    deadline = time.time() + seconds
+    while time.time() < deadline:
+        try:
+            progress = json.loads((folder / "basis.json").read_text())["progress"]
+            if progress["phase"] != "grow" or len(functions(folder)) >= 6:
+                return
+        except (OSError, json.JSONDecodeError, KeyError):
+            pass
+        time.sleep(0.01)
+
+
 def test_a_killed_run_resumes_to_the_same_basis(tmp_path):
     (tmp_path / "in.toml").write_text(INPUT)
     whole = run(tmp_path / "in.toml", "--out", tmp_path / "whole")
     assert whole.wait(timeout=300) == 0, whole.stderr.read()
 
     killed = run(tmp_path / "in.toml", "--out", tmp_path / "killed")
-    deadline = time.time() + 120
-    while time.time() < deadline:  # kill it in the middle of the schedule
-        try:
-            progress = json.loads((tmp_path / "killed" / "basis.json").read_text())["progress"]
-            if progress["phase"] != "grow" or len(functions(tmp_path / "killed")) >= 6:
-                break
-        except (OSError, json.JSONDecodeError, KeyError):
-            pass
-        time.sleep(0.01)
+    mid_schedule(tmp_path / "killed")
     killed.send_signal(signal.SIGKILL)
     killed.wait()
     cut = json.loads((tmp_path / "killed" / "basis.json").read_text())["progress"]

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .expectation import classes, expectation, operator
+from .expectation import expectation, members, operator
 from .system import reduced_mass
 
 #: the operators of eq. (27): ⟨1/r_ij⟩, ⟨V/r_ij⟩, ⟨∇Ψ|Λ/r_ij|∇Ψ⟩
@@ -34,9 +34,7 @@ def regularised(system, expectation: dict, energy: float) -> dict[str, float]:
     """{pair class "a-b": the regularised ⟨δ³(r_ij)⟩ (bohr⁻³)} of one eigenstate of `system` with
     the energy `energy` (Eh) from its expectation values of TERMS ({operator: {class: value}}, as
     `results.evaluate` gives them)."""
-    # a class's pairs have the same two masses: those of its first pair, w = e_i − e_j
-    mu = {label: reduced_mass(*system.masses[np.flatnonzero(w[0, 0])])
-          for label, w in classes(system, ("r_ij",)).items()}
+    mu = {label: reduced_mass(*system.masses[list(ms[0])]) for label, ms in members(system, pairs=True).items()}
     inv_r, potential, gradient = (expectation[name] for name in TERMS)
     return {label: float(mu[label] / np.pi * (energy * inv_r[label] - potential[label] - gradient[label]))
             for label in inv_r}

@@ -48,20 +48,27 @@ def vector(system, kind: str, i: int, j: int | None = None) -> np.ndarray:
     return np.eye(system.n)[k] - mu[k]
 
 
-def classes(system, kinds: tuple[str, ...]) -> dict[str, np.ndarray]:
-    """{label: vectors (instances, len(kinds), n)} of the `kinds` (see `vector`) per class of
-    equivalent pairs ("a-b": every pair i < j of a particle named a and one named b) if a kind
-    names a pair ("r_ij", "p_j"), else per class of particles ("a"), in the order of first
-    occurrence."""
+def members(system, pairs: bool) -> dict[str, list[tuple[int, ...]]]:
+    """{label: its members} of every class of equivalent pairs ("a-b": every pair (i, j), i < j, of
+    a particle named a and one named b) or, without `pairs`, of particles ("a": every (i,) named a),
+    in the order of first occurrence. A class's members share their masses, charges and spins."""
     out: dict[str, list] = {}
-    if {"r_ij", "p_j"} & set(kinds):
+    if pairs:
         for i, j, _ in system.pairs():
-            label = "-".join(sorted((system.particles[i].name, system.particles[j].name)))
-            out.setdefault(label, []).append([vector(system, kind, i, j) for kind in kinds])
+            out.setdefault("-".join(sorted((system.particles[i].name, system.particles[j].name))), []).append((i, j))
     else:
         for i, p in enumerate(system.particles):
-            out.setdefault(p.name, []).append([vector(system, kind, i) for kind in kinds])
-    return {label: np.array(v) for label, v in out.items()}
+            out.setdefault(p.name, []).append((i,))
+    return out
+
+
+def classes(system, kinds: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """{label: vectors (instances, len(kinds), n)} of the `kinds` (see `vector`) per class of
+    equivalent pairs if a kind names a pair ("r_ij", "p_j"), else per class of particles
+    (`members`)."""
+    pairs = bool({"r_ij", "p_j"} & set(kinds))
+    return {label: np.array([[vector(system, kind, *m) for kind in kinds] for m in ms])
+            for label, ms in members(system, pairs).items()}
 
 
 def pair_classes(system) -> dict[str, np.ndarray]:

@@ -110,18 +110,25 @@ class Ranks:
     def agreed(self, value, what: str = "value"):
         """Rank 0's `value` on every rank (a collective call: every rank makes it, for the same
         `what`; RanksDivergedError otherwise, as for `gathered`)."""
-        return value if self.comm is None else self.gathered([(self.rank, value)], ("agreed", what))[0][1]
+        return value if self.comm is None else self.each(value, ("agreed", what))[0]
 
     def gathered(self, mine: list, call: tuple) -> list:
-        """The (index, item) pairs of every rank, ordered by index; `call` names what they are
-        (the kind of call and its sizes), and RanksDivergedError if the ranks made different ones."""
-        if self.comm is None:
-            return sorted(mine, key=lambda x: x[0])
+        """The (index, item) pairs of every rank, ordered by index (a collective call); `call`
+        names what they are (the kind of call and its sizes), and RanksDivergedError if the ranks
+        made different ones."""
         parts = self.comm.allgather((call, mine))
         if any(c != call for c, _ in parts):
             raise RanksDivergedError(f"MPI ranks diverged: they made the calls {[c for c, _ in parts]} together "
                                      "(their copies of the run differ: nodes of different CPUs or BLAS? docs/mpi.md)")
         return sorted((x for _, part in parts for x in part), key=lambda x: x[0])
+
+    def each(self, value, call: tuple) -> list:
+        """Every rank's `value`, in rank order (`gathered`)."""
+        return [x for _, x in self.gathered([(self.rank, value)], call)]
+
+    def mine(self, n: int) -> slice:
+        """This rank's block of `n` items (`slices`)."""
+        return slices(n, self.size)[self.rank]
 
     def matrices(self, engine, params: tuple) -> dict:
         """`engine.matrices(params)`, its row blocks evaluated by the ranks in turn."""
@@ -129,13 +136,13 @@ class Ranks:
         if self.size == 1 or nb < 2 * self.size:
             return engine.matrices(params)
         blocks = triangle_blocks(nb, BLOCKS_PER_RANK * self.size)
-        mine = []
+        dealt = []  # this rank's blocks
         for k in range(self.rank, len(blocks), self.size):
             s = blocks[k]
             left = engine.rows(take(params, s), take(params, slice(0, s.start)), None)[0] if s.start else None
-            mine.append((k, left, engine.matrices(take(params, s))))
+            dealt.append((k, left, engine.matrices(take(params, s))))
         out = {}
-        for k, left, square in self.gathered(mine, ("matrices", nb)):
+        for k, left, square in self.gathered(dealt, ("matrices", nb)):
             s = blocks[k]
             for name, block in square.items():
                 M = out.setdefault(name, np.zeros((nb, nb)))
@@ -152,9 +159,8 @@ class Ranks:
         if self.size == 1 or max(k, nb) < self.size:
             return engine.rows(trials, params, position)
         if k >= self.size:
-            parts = [(r, engine.rows(take(trials, s), params, position))
-                     for r, s in enumerate(slices(k, self.size)) if r == self.rank]
-            return self._joined(parts, axis=0, call=("rows", k, nb, position))
+            parts = self.each(engine.rows(take(trials, self.mine(k)), params, position), ("rows", k, nb, position))
+            return joined([rows for rows, _ in parts], axis=0), np.concatenate([diag for _, diag in parts])
         return self._columns(lambda basis, at: engine.rows(trials, basis, at), params, position, ("row", k, nb, position))
 
     def row_gradient(self, engine, f: tuple, dA, dv, params: tuple) -> tuple[dict, np.ndarray]:
@@ -169,26 +175,22 @@ class Ranks:
         block of them per rank, joined in order (`Representation.operator`, `.density`)."""
         if self.size == 1 or len(v) < self.size:
             return evaluate(v)
-        mine = [(r, evaluate(np.ascontiguousarray(v[s]))) for r, s in enumerate(slices(len(v), self.size)) if r == self.rank]
-        return np.concatenate([x for _, x in self.gathered(mine, ("instances", v.shape))], axis=0)
+        return np.concatenate(self.each(evaluate(np.ascontiguousarray(v[self.mine(len(v))])), ("instances", v.shape)))
 
     def _columns(self, evaluate, params: tuple, position: int | None, call: tuple) -> tuple[dict, np.ndarray]:
         """Rows evaluated by blocks of the basis's columns, one per rank, each with the position
-        of the function within the block (clipped), so in the orientation of the full row."""
+        of the function within the block (clipped), so in the orientation of the full row; the
+        diagonal, which every rank evaluates alike, is this rank's."""
         nb = len(params[0])
         at = nb if position is None else position
-        s = slices(nb, self.size)[self.rank]
+        s = self.mine(nb)
         rows, diag = evaluate(take(params, s), min(max(at - s.start, 0), s.stop - s.start))
-        joined, _ = self._joined([(self.rank, (rows, diag))], axis=1, call=call)
-        return joined, diag
+        return joined(self.each(rows, call), axis=1), diag
 
-    def _joined(self, parts: list, axis: int, call: tuple) -> tuple[dict, np.ndarray]:
-        """Every rank's (rows, diagonal) parts joined in rank order along `axis` of the rows (and
-        the diagonals along axis 0 for blocks of trials)."""
-        gathered = [part for _, part in self.gathered(parts, call)]
-        rows = {name: np.concatenate([r[name] for r, _ in gathered], axis=axis) for name in gathered[0][0]}
-        diag = np.concatenate([d for _, d in gathered], axis=0) if axis == 0 else gathered[0][1]
-        return rows, diag
+
+def joined(parts: list[dict], axis: int) -> dict:
+    """Rows {name: array} of consecutive parts joined along `axis`."""
+    return {name: np.concatenate([part[name] for part in parts], axis=axis) for name in parts[0]}
 
 
 def stop_all(status: int) -> int:

@@ -24,7 +24,7 @@ from . import drachmann, eigen
 from .basis import Basis
 from .errors import InputError
 from .expectation import OPERATORS
-from .relativistic import NEEDS, breit_pauli, missing
+from .relativistic import NEEDS, breit_pauli
 from .results import evaluate, grids
 from .validation import Integer, checked
 
@@ -73,7 +73,7 @@ def corrections(basis, level: dict) -> dict:
     operators: "breit_pauli", its Breit–Pauli correction (`relativistic.breit_pauli`), and
     "delta_regularised", {pair class: Drachmann's ⟨δ³(r_ij)⟩} (`drachmann.regularised`)."""
     out, have = {}, set(level.get("expectation", {}))
-    if not missing(basis.family) and set(NEEDS) <= have:
+    if set(NEEDS) <= have:
         out["breit_pauli"] = breit_pauli(basis, level["expectation"])
     if set(drachmann.TERMS) <= have:
         out["delta_regularised"] = drachmann.regularised(basis.system, level["expectation"], level["energy"])

@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 
 from .errors import UnsupportedError
-from .expectation import OPERATORS, pair_classes, particle_classes
+from .expectation import OPERATORS, members
 from .results import HARTREE_CM
 
 #: the fine-structure constant, CODATA 2018 (E. Tiesinga et al., Rev. Mod. Phys. 93, 025010 (2021))
@@ -72,12 +72,12 @@ def terms(system, expectation: dict, delta: dict | None = None) -> dict:
     a2 = ALPHA**2
     delta = expectation["delta"] if delta is None else delta
     classes = {term: {} for term in TERMS}
-    for label, g in particle_classes(system).items():
-        m = next(p.mass for p in system.particles if p.name == label)
-        classes["mass_velocity"][label] = -a2 / 8 * len(g) * expectation["p4"][label] / m**3
-    for label, w in pair_classes(system).items():
-        a, b = (system.particles[int(k)] for k in (w[0].argmax(), w[0].argmin()))
-        qq, pairs = a.charge * b.charge, len(w)
+    for label, ms in members(system, pairs=False).items():
+        m = system.particles[ms[0][0]].mass
+        classes["mass_velocity"][label] = -a2 / 8 * len(ms) * expectation["p4"][label] / m**3
+    for label, ms in members(system, pairs=True).items():
+        a, b = (system.particles[k] for k in ms[0])
+        qq, pairs = a.charge * b.charge, len(ms)
         classes["darwin"][label] = (-math.pi * a2 / 2 * pairs * qq * (dirac(a) / a.mass**2 + dirac(b) / b.mass**2)
                                     * delta[label])
         classes["orbit_orbit"][label] = -a2 / 2 * pairs * qq / (a.mass * b.mass) * expectation["orbit_orbit"][label]
