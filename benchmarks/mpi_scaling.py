@@ -9,8 +9,10 @@ full build; the rows of 64 trials (the basis's own first functions, drawn again 
 the basis, as `Expansion.candidates` evaluates a growth or replacement step; one function's row
 gradient against the basis, as every energy-and-gradient evaluation of a refinement; REFINED
 refinements of one function (L-BFGS, at most EVALUATIONS energies each, with the eigen-updates
-every rank repeats). Each timed after one warm-up, best of REPEATS (the refinements once, in
-order); the bytes each rank receives per build are reported beside. Rank 0 prints the lines.
+every rank repeats), one after the other with every rank on each, and in batches of one function
+per rank (methods.together, a run's default `batch`), each rank refining its own. Each timed after
+one warm-up, best of REPEATS (the refinements once, in order); the bytes each rank receives per
+build are reported beside. Rank 0 prints the lines.
 """
 import sys
 import time
@@ -21,6 +23,7 @@ import numpy as np
 from prebo.eigen import lapack_threads
 from prebo.integrals import laboratory
 from prebo.optimise.expansion import Expansion
+from prebo.optimise.methods import together
 from prebo.optimise.refine import refine_function
 from prebo import Basis
 from prebo.parallel import world
@@ -64,6 +67,12 @@ def measure(folder: str) -> None:
     for i in range(REFINED):  # the middle functions, as a refinement sweep meets them
         refine_function(ex, nb // 3 + i, max_evaluations=EVALUATIONS)
     refine = ranks.agreed(time.perf_counter() - start) / REFINED
+    ex = Expansion(basis.subset(list(range(nb))), rep, 1e-13)
+    start = time.perf_counter()
+    for i in range(0, REFINED, ranks.size):
+        together(ex, range(nb // 3 + i, nb // 3 + i + ranks.size),
+                 lambda twin, k: refine_function(twin, k, max_evaluations=EVALUATIONS))
+    batched = ranks.agreed(time.perf_counter() - start) / REFINED
     rows = best(lambda: rep.rows(trials, basis))
     gradient = best(lambda: rep.row_gradient(f, dA, dv, basis))
     if ranks.root:
@@ -75,6 +84,7 @@ def measure(folder: str) -> None:
         print(f"  {TRIALS} trials' energies     {step:8.3f} s   (rows and objective: a growth or replacement step)")
         print(f"  one row gradient      {gradient:8.4f} s   {1 / gradient:8.1f} evaluations/s ({1 + P} x {nb} x 4 values)")
         print(f"  refinement of one function ({EVALUATIONS} evaluations)  {refine:8.3f} s   {60 / refine:8.1f} per minute")
+        print(f"  the same in batches of {ranks.size}            {batched:8.3f} s   {60 / batched:8.1f} per minute")
 
 
 if __name__ == "__main__":

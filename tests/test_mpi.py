@@ -1,7 +1,8 @@
 """MPI ranks sharing a run (parallel.py), on this machine's loopback with `mpiexec -n 2`: integrals
-equal one process's bit for bit, a 2-rank run equals a 1-rank one, a killed 2-rank run resumes to
-the same basis, and a failing rank stops every rank in bounded time. Needs prebo's MPI extra
-(pip install ".[mpi]"), which the README's test command installs."""
+equal one process's bit for bit, a 2-rank run equals a 1-rank one refining the same batches, a
+killed 2-rank run resumes to the same basis on 2 ranks or 1, and a failing rank stops every rank in
+bounded time. Needs prebo's MPI extra (pip install ".[mpi]"), which the README's test command
+installs."""
 import json
 import os
 import shutil
@@ -59,11 +60,16 @@ def test_ranks_whose_copies_differ_stop_with_an_error_naming_it():
     assert p.returncode != 0 and "MPI ranks diverged" in err
 
 
-def test_a_two_rank_run_equals_a_one_rank_run_and_resumes_after_a_kill(tmp_path):
+def test_a_two_rank_run_equals_a_one_rank_run_of_its_batch_and_resumes_after_a_kill_on_any_rank_count(tmp_path):
+    """Two ranks refine two functions at once (batch defaults to the rank count): one process
+    with batch = 2 gives the same basis bit for bit, and so does the 2-rank run killed
+    mid-way and resumed on 2 ranks or on 1 (the batch is kept in the checkpoint)."""
     (tmp_path / "in.toml").write_text(INPUT)
-    finished(prebo_run(1, tmp_path / "in.toml", "--out", tmp_path / "one"), 300)
+    (tmp_path / "batch.toml").write_text(INPUT + "batch = 2\n")
+    finished(prebo_run(1, tmp_path / "batch.toml", "--out", tmp_path / "one"), 300)
     finished(prebo_run(2, tmp_path / "in.toml", "--out", tmp_path / "two"), 300)
     assert functions(tmp_path / "two") == functions(tmp_path / "one")
+    assert json.loads((tmp_path / "two" / "basis.json").read_text())["optimiser"]["batch"] == 2
 
     killed = prebo_run(2, tmp_path / "in.toml", "--out", tmp_path / "killed", start_new_session=True)
     mid_schedule(tmp_path / "killed")
@@ -71,7 +77,10 @@ def test_a_two_rank_run_equals_a_one_rank_run_and_resumes_after_a_kill(tmp_path)
     killed.communicate()
     cut = json.loads((tmp_path / "killed" / "basis.json").read_text())["progress"]
     assert cut["phase"] != "done", "the run ended before it was killed: nothing tested"
+    shutil.copytree(tmp_path / "killed", tmp_path / "on-one")
     finished(prebo_run(2, "--resume", tmp_path / "killed"), 300)
-    assert functions(tmp_path / "killed") == functions(tmp_path / "one")
-    energies = [json.loads((tmp_path / k / "result.json").read_text())["energy"] for k in ("one", "two", "killed")]
-    assert energies[0] == energies[1] == energies[2]
+    finished(prebo_run(1, "--resume", tmp_path / "on-one"), 300)
+    for folder in ("killed", "on-one"):
+        assert functions(tmp_path / folder) == functions(tmp_path / "one")
+    energies = [json.loads((tmp_path / k / "result.json").read_text())["energy"] for k in ("one", "two", "killed", "on-one")]
+    assert len(set(energies)) == 1

@@ -173,12 +173,65 @@ def test_each_phase_has_its_method_configured_by_the_settings():
                      "refine": Refine(Minimiser(200, "gradient")), "polish": Polish(9)}
     refined = methods(Optimiser(trials=3, refine=1, refine_evaluations=40, refine_method="powell"))
     assert refined["grow"] == Grow(3, Minimiser(40, "powell")) and refined["sweep"].newcomer == Minimiser(40, "powell")
-    grouped = methods(Optimiser(refine=1, refine_evaluations=40, refine_group=2))  # refinement sweeps only
+    grouped = methods(resolved(Optimiser(refine=1, refine_evaluations=40, refine_group=2), he))  # refinement sweeps only
     assert grouped["refine"] == Refine(Minimiser(40, "gradient", 2)) and grouped["sweep"].newcomer == Minimiser(40, "gradient")
+    batched = methods(resolved(Optimiser(refine=1, batch=4), he))
+    assert batched["refine"] == Refine(Minimiser(200, "gradient"), 4)
     adaptive = methods(resolved(Optimiser(trials=5), he))  # the adaptive schedule refines every new function
     assert adaptive["grow"] == Grow(5, Minimiser(30, "gradient")) and adaptive["sweep"] == Replace(5, Minimiser(30, "gradient"))
     assert adaptive["prune"] == PrunePass(PruneStep(Grow(5, Minimiser(30, "gradient")), Minimiser(30, "gradient", 3)))
     assert adaptive["momentum"] == MomentumMove() and "momentum" not in plain  # the adaptive schedule's moves
+
+
+def test_a_batch_keeps_each_change_only_if_it_still_gains_after_the_ones_before(monkeypatch):
+    """methods.Refine with a batch of three: each function's refinement is done on a copy of the
+    same basis and the changes are put in order, re-checked against the basis the ones before
+    changed (methods.together). Functions 0 and 3 are first moved away from where they belong.
+    Here function 1's unit refines function 0 less far than function
+    0's own (it gains against the basis it started from, not after function 0's refinement): it is
+    refused; function 2's refines function 3, and is kept; the matrices are those of a full build."""
+    from prebo.integrals import laboratory
+    from prebo.optimise import Expansion, Minimiser, Refine
+    from prebo.optimise import methods as m
+    from prebo.optimise.refine import accept, FunctionEnergy, minimise
+    from prebo.optimise.report import Reporter
+    system = prebo.System(["p", "e", "e"], spin={"e": 0})
+    basis = prebo.optimise(system, Optimiser(size=8, trials=5, seed=4), progress=False)
+    basis.A[[0, 3]] *= 2.0  # functions 0 and 3 moved far from where they belong
+    rep = laboratory(system)
+
+    def unit(ex, i, *args):  # the function refined by unit i, and with how many energies
+        j, evaluations = {0: (0, 200), 1: (0, 2), 2: (3, 200)}[i]
+        obj = FunctionEnergy(ex, j)
+        minimise(obj, evaluations, "gradient")
+        accept(ex, j, obj)
+
+    def fresh():
+        return Expansion(basis.subset(slice(None)), rep, 1e-13)
+
+    def energy(*units):  # the units done one after the other
+        ex = fresh()
+        for i in units:
+            unit(ex, i)
+        return ex.energy
+
+    def changes(*units):  # each unit done from the same basis, their changes put in order
+        ex, out = fresh(), fresh()
+        for i in units:
+            draft = ex.draft()
+            unit(draft, i)
+            assert out.put_group(*draft.changes(ex))
+        return out.energy
+
+    ex = fresh()
+    assert energy(0) < energy(1) < ex.energy and energy(0, 1) == energy(0)
+    monkeypatch.setattr(m, "refine_group", unit)
+    opts = resolved(Optimiser(size=8, refine=1), system)
+    visited = Refine(Minimiser(200, "gradient"), batch=3).step(m.Run(ex, None, Reporter(opts, False, 8)),
+                                                                Cursor("refine"))
+    assert visited == 3 and ex.energy == changes(0, 2) < energy(0)
+    rebuilt = rep.matrices(ex.basis)
+    assert all(np.array_equal(rebuilt[k], ex.m[k]) for k in rebuilt)
 
 
 def test_refinement_and_learning_lower_the_energy():

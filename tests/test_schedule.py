@@ -18,6 +18,7 @@ from prebo.optimise.defaults import GROUP, TRIALS, resolved
 from prebo.optimise.sampler import pair_lengths
 from prebo.optimise.momentum import EVERY
 from prebo.optimise.adaptive import CHUNK, PRUNE, RATIO, REVISIT, Adaptive, Pass, pruned
+from prebo.optimise.fixed import Fixed
 from prebo.optimise.history import Step
 
 from conftest import ROOT
@@ -71,6 +72,8 @@ def test_explicit_settings_override_and_any_schedule_setting_fixes_the_schedule(
     assert fixed.refine_evaluations == 200 and fixed.refine_group == 1
     assert resolved(Optimiser(refine_group=1), h2).refine_group == 1  # given, it stays
     assert resolved(fixed, h2) == fixed and resolved(opts, h2) == opts  # a checkpoint's settings stay
+    assert opts.batch == fixed.batch == 1  # one process: a function at a time
+    assert resolved(Optimiser(batch=4), h2).batch == 4
 
 
 # --- lengths from the physics --------------------------------------------------------------
@@ -149,6 +152,21 @@ def test_a_pass_ends_after_a_chunk_and_the_next_sweep_goes_on_where_it_stopped()
     assert s.next["refine"] == (100 + CHUNK) % 120 and s.begin("refine", 120, 6).index == 30
     grow = Cursor("grow", sweep=10, cycle=7)
     assert s.advance(grow, 9, -3.0, 21.0) == grow  # growth goes on to its target size
+
+
+def test_a_batch_of_refinements_moves_a_sweep_on_by_the_functions_it_visited():
+    """methods.Refine with batch > 1 visits several functions in one unit of work; both
+    schedules go on after them, and the adaptive pass ends once it visited a chunk."""
+    opts = resolved(Optimiser(size=120), prebo.System(["alpha", "e", "e"]))
+    s = Adaptive(opts)
+    passes(s, ("grow", 120, None, 1.0), ("refine", 120, 1e-3, 1.0), ("sweep", 120, 1e-3, 1.0), ("polish", 120, 1, 1))
+    c = s.advance(Cursor("refine", index=100, cycle=4), 120, -3.0, 20.0, functions=20)
+    assert (c.phase, c.sweep, c.index) == ("refine", 20, 0)
+    c = s.advance(c, 120, -3.0, 20.0, functions=CHUNK - 20)
+    assert s.passes[-1].functions == CHUNK and s.next["refine"] == CHUNK - 20 and c.cycle == 5
+    fixed = Fixed(resolved(Optimiser(size=5, refine=2), prebo.System(["p", "e"])))
+    assert fixed.advance(Cursor("refine", 0, 0), 5, -0.5, 1.0, functions=3) == Cursor("refine", 0, 3)
+    assert fixed.advance(Cursor("refine", 0, 3), 5, -0.5, 1.0, functions=2) == Cursor("refine", 1, 0)
 
 
 def test_a_pruning_is_one_pass_of_one_step_at_full_size():

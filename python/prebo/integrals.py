@@ -27,13 +27,13 @@ the exact one.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .coordinates import CoordinateSet, jacobi
 from .errors import CancellationError, SeparabilityError
-from .parallel import world
+from .parallel import Ranks, world
 from .system import System
 
 #: smallest S_nn / Σ_P |c_P| of a function (module docstring, cancellation)
@@ -52,7 +52,8 @@ class Representation:
     and pair_q: (p,) charge products q of V = Σ q/|w^T r|; sym_t: (o, n, n) symmetry operations T_P
     and sym_c: (o,) their Young-operator coefficients c_P; cm_mass: total mass (electron masses)
     for the elimination of the CM kinetic energy (T_ti), None without a CM coordinate; coords:
-    the coordinate set of a TICC representation (None: laboratory frame)."""
+    the coordinate set of a TICC representation (None: laboratory frame); ranks: the MPI ranks
+    that share its integrals (None: every rank of the run, parallel.world())."""
 
     lam: np.ndarray
     pair_w: np.ndarray
@@ -61,8 +62,18 @@ class Representation:
     sym_c: np.ndarray
     cm_mass: float | None
     coords: CoordinateSet | None = None  # None: laboratory frame
+    ranks: Ranks | None = field(default=None, compare=False, repr=False)
 
     _engines: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def shared(self) -> Ranks:
+        """The MPI ranks that share this representation's integrals (parallel.py)."""
+        return world() if self.ranks is None else self.ranks
+
+    def alone(self) -> Representation:
+        """This representation (its engines shared) with the integrals evaluated by this process
+        alone (`Expansion.draft`)."""
+        return replace(self, ranks=Ranks())
 
     def arrays(self, f) -> tuple:
         """The core's parameter tuple of a function set `f` (a Basis) in this representation:
@@ -81,7 +92,7 @@ class Representation:
 
     def matrices(self, f) -> dict:
         """Symmetrised S, T, T_ti, V (nb x nb, hartree) of the normalised functions of the basis `f`."""
-        return world().matrices(self.engine(f), self.arrays(f))
+        return self.shared().matrices(self.engine(f), self.arrays(f))
 
     def rows(self, trials, f, position: int | None = None) -> tuple[dict, np.ndarray]:
         """Rows (k x nb) of `trials` against the basis `f`, and the trials' diagonals [S, T, T_ti, V].
@@ -89,7 +100,7 @@ class Representation:
         `position`: where a trial would sit in the basis (default: appended). Where the family's
         engine is `oriented`, rows are evaluated in the orientation of a full build, so patching
         them into the matrices gives the bits of `matrices`; otherwise the trial is the bra."""
-        return world().rows(self.engine(f), self.arrays(trials), self.arrays(f), position)
+        return self.shared().rows(self.engine(f), self.arrays(trials), self.arrays(f), position)
 
     def row_gradient(self, f, dA: np.ndarray, dv: np.ndarray | None, basis) -> tuple[dict, np.ndarray]:
         """Row of the one-function basis `f` against `basis` (f as bra) and its diagonal, with the
@@ -98,7 +109,7 @@ class Representation:
         (1 + P) x 4 diagonal. Laboratory frame only."""
         if self.coords is not None:
             raise ValueError("row gradients are computed in the laboratory frame")
-        return world().row_gradient(self.engine(f), self.arrays(f), dA, dv, self.arrays(basis))
+        return self.shared().row_gradient(self.engine(f), self.arrays(f), dA, dv, self.arrays(basis))
 
     def operator(self, name: str, f, v: np.ndarray, momenta=(False,)) -> np.ndarray:
         """Symmetrised (p, nb, nb) matrices of the core's registered operator `name` between the
@@ -108,14 +119,14 @@ class Representation:
         v = np.asarray(v, dtype=float).reshape(len(v), len(momenta), -1)
         v = np.stack([self.vectors(v[:, k], m) for k, m in enumerate(momenta)], axis=1)
         engine, params = self.engine(f), self.arrays(f)
-        return world().instances(lambda part: engine.operator(name, params, part), np.ascontiguousarray(v))
+        return self.shared().instances(lambda part: engine.operator(name, params, part), np.ascontiguousarray(v))
 
     def density(self, f, w: np.ndarray, C: np.ndarray, r: np.ndarray) -> np.ndarray:
         """The spherically averaged densities (p, states, len(r)) of r_w (bohr⁻³) at the radii `r`
         (bohr) in the states Σ_k C_ks Yφ_k of the basis `f`, one per laboratory-frame vector w (p, n)."""
         C, r = np.ascontiguousarray(C, dtype=float), np.ascontiguousarray(r, dtype=float)
         engine, params = self.engine(f), self.arrays(f)
-        return world().instances(lambda part: engine.density(params, part, C, r), self.vectors(w))
+        return self.shared().instances(lambda part: engine.density(params, part, C, r), self.vectors(w))
 
     def vectors(self, w: np.ndarray, momentum: bool = False) -> np.ndarray:
         """Laboratory-frame operator vectors w (p, n) in this representation: in TICC a position-like

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 from functools import lru_cache
 
 import numpy as np
@@ -42,6 +43,9 @@ from .errors import RanksDivergedError, UnsupportedError
 LAUNCHERS = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "PMIX_SIZE")
 #: blocks of a full build per rank (`Ranks.matrices`): more even work, more calls
 BLOCKS_PER_RANK = 4
+#: seconds a failing rank waits before it stops every rank, for the launcher to forward its report
+#: (a rank stopped at once by another's abort can lose the lines it wrote last)
+FORWARD = 0.5
 
 
 def launched() -> int:
@@ -113,9 +117,11 @@ class Ranks:
         return value if self.comm is None else self.each(value, ("agreed", what))[0]
 
     def gathered(self, mine: list, call: tuple) -> list:
-        """The (index, item) pairs of every rank, ordered by index (a collective call); `call`
-        names what they are (the kind of call and its sizes), and RanksDivergedError if the ranks
-        made different ones."""
+        """The (index, item) pairs of every rank, ordered by index (a collective call; one process:
+        its own); `call` names what they are (the kind of call and its sizes), and
+        RanksDivergedError if the ranks made different ones."""
+        if self.comm is None:
+            return sorted(mine, key=lambda x: x[0])
         parts = self.comm.allgather((call, mine))
         if any(c != call for c, _ in parts):
             raise RanksDivergedError(f"MPI ranks diverged: they made the calls {[c for c, _ in parts]} together "
@@ -195,13 +201,15 @@ def joined(parts: list[dict], axis: int) -> dict:
 
 def stop_all(status: int) -> int:
     """`status`, after a failure reported on this rank; under MPI every rank is stopped first (exit
-    status `status`), since the others would wait for this one in a collective call for ever."""
+    status `status`), since the others would wait for this one in a collective call for ever; the
+    abort waits FORWARD seconds, in which the launcher forwards the report."""
     try:
         ranks = world()
     except UnsupportedError:  # no MPI to stop with: every rank ends by itself
         return status
     if ranks.comm is not None:
         sys.stderr.flush()
+        time.sleep(FORWARD)
         ranks.comm.Abort(status)
     return status
 

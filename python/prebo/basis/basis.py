@@ -120,6 +120,11 @@ class Basis:
         return cls(first.system, np.concatenate([f.A for f in fs]), np.concatenate([f.c_A for f in fs]),
                    [c for f in fs for c in f.channels], kind=first.kind, **extra)
 
+    def differs(self, other: "Basis") -> np.ndarray:
+        """The indices of the functions that differ from those of `other` (as many, of one kind)."""
+        pairs = [(self.A, other.A), (self.c_A, other.c_A)] + [(v, getattr(other, k)) for k, v in self.parameters.items()]
+        return np.flatnonzero(np.any([(a != b).reshape(len(self), -1).any(axis=1) for a, b in pairs], axis=0))
+
     def append(self, f: "Basis") -> None:
         """Append the functions of `f` (same system and kind); forgets the coefficients."""
         self.A = np.ascontiguousarray(np.concatenate([self.A, f.A]))

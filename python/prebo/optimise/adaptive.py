@@ -184,14 +184,15 @@ class Adaptive:
         """The gain (Eh) of a whole sweep below which the basis counts as converged."""
         return self.opts.tolerance if self.opts.tolerance is not None else TOLERANCE * abs(energy)
 
-    def advance(self, cursor: Cursor, nb: int, energy: float, now: float) -> Cursor:
-        """The unit of work after the one at `cursor`, which left `nb` functions at `energy` after
-        `now` seconds of the run; at the end of a pass it is recorded and the next one chosen."""
-        phase, visited = cursor.phase, cursor.sweep + 1
+    def advance(self, cursor: Cursor, nb: int, energy: float, now: float, functions: int = 1) -> Cursor:
+        """The unit of work after the one at `cursor`, which visited `functions` functions of a
+        sweep and left `nb` functions at `energy` after `now` seconds of the run; at the end of a
+        pass it is recorded and the next one chosen."""
+        phase, visited = cursor.phase, cursor.sweep + functions
         if phase == "grow" and nb < min(cursor.sweep, self.size):
             return cursor
         if phase in ("sweep", "refine"):
-            self.next[phase] = (cursor.index + 1) % nb
+            self.next[phase] = (cursor.index + functions) % nb
             if visited < min(CHUNK, nb):
                 return Cursor(phase, visited, self.next[phase], cursor.cycle)
         functions = visited if phase in ("sweep", "refine") else nb

@@ -29,6 +29,9 @@ None), from the physics of the particles:
 - refine_group: GROUP in the adaptive schedule, whose refinement passes then move each function
   with the GROUP − 1 it overlaps most (near-duplicate partners hold a lone function in place;
   benchmarks/README, "The H2 campaign" and issue 17's rows), 1 in a fixed one;
+- batch: the number of MPI ranks (parallel.py; 1 in one process), each working on one function
+  of a sweep's batch; kept in the checkpoint, so a run resumed on another number of ranks goes on
+  as it would have;
 - the schedule: adaptive (adaptive.py) when none of prune, sweeps, refine, polish, cycles is
   given, else the fixed schedule with the missing ones at 0, 0, 0, 0 and 1.
 """
@@ -40,6 +43,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..basis import family
+from ..parallel import world
 from ..system import System, reduced_mass
 from .settings import Optimiser
 
@@ -87,6 +91,7 @@ def resolved(opts: Optimiser, system: System) -> Optimiser:
                     for k, d in (("prune", 0), ("sweeps", 0), ("refine", 0), ("polish", 0), ("cycles", 1))}
     evaluations = opts.refine_evaluations or (30 if opts.adaptive else 200)
     group = opts.refine_group or (GROUP if opts.adaptive else 1)
+    batch = opts.batch or world().size
     near = opts.near if opts.near is not None else (NEAR if opts.adaptive and bond is None else 0.0)
     return replace(opts, kind=kind, K_max=K_max, channels=channels, trials=trials, refine_evaluations=evaluations,
-                   refine_group=group, near=near, **schedule)
+                   refine_group=group, batch=batch, near=near, **schedule)

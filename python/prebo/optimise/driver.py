@@ -147,9 +147,9 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                 stopped = "budget"  # the cursor is kept: resumed with a larger budget, the run goes on
                 checkpoint()
                 break
-            stopped, old, phase = None, ex.energy, cursor.phase
+            stopped, old, phase, visited = None, ex.energy, cursor.phase, None
             try:
-                steps[cursor.phase].step(run, cursor)
+                visited = steps[cursor.phase].step(run, cursor)  # a batch of refinements visits several
             except StalledError:
                 if not schedule.stall(len(ex.basis)):
                     raise
@@ -162,7 +162,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                 history.append(Step(len(ex.basis), ex.energy, cursor.phase, wall()))
                 run.report.step(ex, old, cursor, schedule)
                 sampler.learn(ex.basis)  # a function of the basis alone, so a resumed run learns the same
-            cursor = schedule.advance(cursor, len(ex.basis), ex.energy, wall())
+            cursor = schedule.advance(cursor, len(ex.basis), ex.energy, wall(), visited or 1)
             if cursor.phase == "done":
                 stopped = schedule.stopped
             ground = ex.eig.energies[0] if ex.eig is not None else np.inf  # the lowest root: bound or not

@@ -9,6 +9,8 @@ apart from prebo.State, the quantum numbers of a system.)
 """
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from .. import eigen
@@ -30,7 +32,7 @@ class Expansion:
     `replace_basis`) the targeted levels are followed by overlap (Levels.follow; one function
     added, replaced or removed never moves a level up and lowers it, objective.py); `followed`
     holds the (before, after) root indices of the last change that moved a level to another root,
-    until the driver takes it.
+    until the driver takes it; `drafted`: a `draft`, which places changes without solving.
 
     rep: the integrals' Representation (integrals.laboratory); threshold: eigen.solve's relative
     overlap eigenvalue below which directions are dropped; min_norm, max_overlap: the
@@ -40,7 +42,7 @@ class Expansion:
                  objective: Levels = Levels()):
         self.basis, self.rep, self.threshold = basis, rep, threshold
         self.min_norm, self.max_overlap, self.objective = min_norm, max_overlap, objective
-        self.followed = None
+        self.followed, self.drafted = None, False
         if len(basis):
             self.m = rep.matrices(basis)
         else:
@@ -121,7 +123,10 @@ class Expansion:
         refinement cannot resolve (eigen.refine: LinearDependenceError, at an overlap condition
         where double precision runs out) is undone like one that does not gain. `mapping`: function
         j of the changed basis was function mapping[j] before it (-1: new; `prior`), for a change of
-        several functions at once, whose levels are followed (objective.py; None: not followed)."""
+        several functions at once, whose levels are followed (objective.py; None: not followed). A
+        draft places the change and keeps it unsolved (`draft`)."""
+        if self.drafted:  # the expansion the draft is of puts its change (`draft`)
+            return True
         try:
             self.solve(None if mapping is None else self.prior(before[2], before[5], mapping))
         except LinearDependenceError:
@@ -217,14 +222,31 @@ class Expansion:
         return self.solve_and_keep_if_lower(before)
 
     def put_group(self, idx: list[int], fs: list[Basis]) -> bool:
-        """Replace the functions `idx` by `fs` (one-function bases) at once if that lowers the
-        energy beyond the uncertainty; True if it did. Rows are patched one function after the
-        other, each against the basis with the ones before it in place (as `put`)."""
+        """Replace (or, at index len, append) the functions `idx` by `fs` (one-function bases) at
+        once if that lowers the energy beyond the uncertainty; True if it did. Rows are patched one
+        function after the other, each against the basis with the ones before it in place (as
+        `put`). The levels are followed through a change of several functions (one changed never
+        moves a level up and lowers it, objective.py)."""
         before = self.snapshot()
         for i, f in zip(idx, fs):
             rows, diag = self.rep.rows(f, self.basis, i)
             self._place(i, f, {k: v[0] for k, v in rows.items()}, diag[0])
-        return self.solve_and_keep_if_lower(before, moved(len(self.basis), idx))
+        return self.solve_and_keep_if_lower(before, moved(len(self.basis), idx) if len(idx) > 1 else None)
+
+    def draft(self) -> Expansion:
+        """A draft of this expansion for a unit of work whose change the expansion itself puts
+        (`changes`, methods.together): a copy, its basis and matrices its own, whose integrals
+        this process evaluates by itself, without the other MPI ranks, and which places a change
+        without solving (`solve_and_keep_if_lower`: the expansion re-checks it)."""
+        twin = copy.copy(self)
+        twin.basis, twin.m, twin.rep, twin.drafted = self.basis.subset(slice(None)), self.snapshot()[1], \
+            self.rep.alone(), True
+        return twin
+
+    def changes(self, before: Expansion) -> tuple[list[int], list[Basis]] | None:
+        """The functions this `draft` of `before` changed and their one-function bases (None: none)."""
+        idx = [int(i) for i in self.basis.differs(before.basis)]
+        return (idx, [self.basis.subset([i]) for i in idx]) if idx else None
 
     def _place(self, i: int, f: Basis, row: dict | None, d) -> None:
         """Append (i == len) or replace function i by `f`, the matrices patched from its row and

@@ -26,16 +26,18 @@ class Fixed:
         """The cursor of a new run: growth from no function."""
         return self.next(Cursor(), 0)
 
-    def advance(self, cursor: Cursor, nb: int, energy: float, now: float) -> Cursor:
-        """The unit of work after the one at `cursor`, which left `nb` functions (the energy and
-        the seconds do not change a fixed schedule); at the end, "done", `stopped` "schedule"."""
-        cursor = self.next(cursor, nb)
+    def advance(self, cursor: Cursor, nb: int, energy: float, now: float, functions: int = 1) -> Cursor:
+        """The unit of work after the one at `cursor`, which visited `functions` functions of a
+        sweep and left `nb` functions (the energy and the seconds do not change a fixed schedule);
+        at the end, "done", `stopped` "schedule"."""
+        cursor = self.next(cursor, nb, functions)
         if cursor.phase == "done":
             self.stopped = "schedule"
         return cursor
 
-    def next(self, cursor: Cursor, nb: int) -> Cursor:
-        """The unit of work after `cursor` for a basis of `nb` functions (module docstring)."""
+    def next(self, cursor: Cursor, nb: int, functions: int = 1) -> Cursor:
+        """The unit of work after `cursor`, which visited `functions` functions of a sweep, for a
+        basis of `nb` functions (module docstring)."""
         opts = self.opts
         if cursor.phase == "grow":
             if nb < opts.size:
@@ -47,7 +49,7 @@ class Fixed:
             if nb > opts.size:
                 return Cursor("prune", index=1, cycle=cursor.cycle)
             return self.settle(Cursor("sweep", cycle=cursor.cycle))
-        nxt = Cursor(cursor.phase, cursor.sweep, cursor.index + 1, cursor.cycle)
+        nxt = Cursor(cursor.phase, cursor.sweep, cursor.index + functions, cursor.cycle)
         if nxt.index >= nb or cursor.phase == "polish":
             nxt = Cursor(cursor.phase, cursor.sweep + 1, 0, cursor.cycle)
         return self.settle(nxt)

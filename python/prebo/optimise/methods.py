@@ -27,6 +27,9 @@ phase of the cursor names the method (`methods`).
   at every step and its energy never rises.
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed, or with the
   functions it overlaps most (`refine_group`; refine.py), as `Minimiser` says.
+- A sweep's step (`Replace`, `Refine`) can take a batch of functions at once (`together`): each
+  worked on from the same basis, on as many MPI ranks, and put in order, each only if it still
+  gains.
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
 - `MomentumMove` ("momentum"): the basis moved on along its displacement since the last move
   (momentum.py; adaptive schedule).
@@ -41,6 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import StalledError, UnsupportedError
+from ..parallel import world
 from .adaptive import pruned
 from .cursor import Cursor
 from .expansion import SIGMA_PRICE, Expansion
@@ -135,18 +139,25 @@ def stalled(nb: int, opts: Optimiser, condition: float = 0.0, sigma: float = 0.0
 class Replace:
     """Replace function `cursor.index` by the best of `trials` functions — its neighbours in K, then
     itself perturbed or random ones — if that lowers the energy; with a `newcomer` minimiser, the
-    winner is refined first (module docstring)."""
+    winner is refined first (module docstring); with a `batch` > 1, that many functions from
+    `cursor.index` on at once (`together`), the trials of each drawn first, in order."""
 
     trials: int
     newcomer: Minimiser | None = None
+    batch: int = 1
 
-    def step(self, run: Run, cursor: Cursor) -> None:
-        """One unit of work on `run` at `cursor` (class docstring)."""
-        ex, i = run.expansion, cursor.index
-        trials = run.sampler.replacements(ex.basis.subset([i]), self.trials)
+    def step(self, run: Run, cursor: Cursor) -> int:
+        """One unit of work on `run` at `cursor` (class docstring); the number of functions visited."""
+        ex = run.expansion
+        batch = sweep_batch(cursor, self.batch, len(ex.basis))
+        drawn = {i: run.sampler.replacements(ex.basis.subset([i]), self.trials) for i in batch}
+        run.report.trials(sum(map(len, drawn.values())))
+        return together(ex, batch, lambda ex, i: self.replace(ex, i, drawn[i]))
+
+    def replace(self, ex: Expansion, i: int, trials) -> None:
+        """Replace function i by the best of `trials` if that lowers the energy (class docstring)."""
         rest = ex.without(i)
         energies, rows, diag = ex.candidates(trials, exclude=i, eig=rest)
-        run.report.trials(len(trials))
         best = int(np.argmin(energies))
         if self.newcomer and np.isfinite(energies[best]):
             regenerate_function(ex, i, trials.subset([best]), self.newcomer.evaluations, self.newcomer.method, rest)
@@ -213,15 +224,45 @@ class PrunePass:
 
 @dataclass(frozen=True)
 class Refine:
-    """Refine function `cursor.index`, with its partners if `minimiser.group` > 1, all others fixed."""
+    """Refine function `cursor.index`, with its partners if `minimiser.group` > 1, all others fixed;
+    with a `batch` > 1, that many functions from `cursor.index` on at once (`together`)."""
 
     minimiser: Minimiser
+    batch: int = 1
 
-    def step(self, run: Run, cursor: Cursor) -> None:
-        """One unit of work on `run` at `cursor` (class docstring)."""
-        run.report.trials(1)
-        refine_group(run.expansion, cursor.index, self.minimiser.group, self.minimiser.evaluations,
-                     self.minimiser.method)
+    def step(self, run: Run, cursor: Cursor) -> int:
+        """One unit of work on `run` at `cursor` (class docstring); the number of functions visited."""
+        m, batch = self.minimiser, sweep_batch(cursor, self.batch, len(run.expansion.basis))
+        run.report.trials(len(batch))
+        return together(run.expansion, batch, lambda ex, i: refine_group(ex, i, m.group, m.evaluations, m.method))
+
+
+def sweep_batch(cursor: Cursor, batch: int, nb: int) -> range:
+    """The functions of a sweep's unit of work at `cursor`: `batch` from `cursor.index` on, not past
+    the basis's `nb` functions."""
+    return range(cursor.index, min(cursor.index + batch, nb))
+
+
+def together(ex: Expansion, batch: range, unit) -> int:
+    """`unit(ex, i)`, the unit of work of a sweep at function i, for every function of `batch` (a
+    range); the number of functions visited. A batch of more than one function: each unit is done
+    on a draft of `ex` of its own (Expansion.draft), the MPI ranks sharing them (parallel.py; one
+    process does them in turn), and the functions each draft changed are put into `ex` in the order
+    of the batch, each change only if it still lowers the energy (Expansion.put_group re-checks it
+    against the basis the changes before it made). The units of a batch are thus independent, and
+    a batch gives the same bits on any number of ranks."""
+    if len(batch) == 1:
+        unit(ex, batch[0])
+        return 1
+    ranks, mine = world(), []
+    for i in batch[ranks.mine(len(batch))]:
+        draft = ex.draft()
+        unit(draft, i)
+        mine.append((i, draft.changes(ex)))
+    for _, change in ranks.gathered(mine, ("batch", batch.start, len(batch))):
+        if change is not None:
+            ex.put_group(*change)
+    return len(batch)
 
 
 @dataclass(frozen=True)
@@ -253,6 +294,6 @@ def methods(opts: Optimiser) -> dict:
     newcomer = Minimiser(opts.refine_evaluations, opts.refine_method) if opts.adaptive or opts.refine else None
     prune = PruneStep(Grow(opts.trials, newcomer), minimiser)
     return {"grow": Grow(opts.trials, newcomer), "prune": PrunePass(prune) if opts.adaptive else prune,
-            "sweep": Replace(opts.trials, newcomer),
-            "refine": Refine(minimiser), "polish": Polish(opts.polish_iterations)} | (
+            "sweep": Replace(opts.trials, newcomer, opts.batch),
+            "refine": Refine(minimiser, opts.batch), "polish": Polish(opts.polish_iterations)} | (
                 {"momentum": MomentumMove()} if opts.adaptive else {})

@@ -24,9 +24,11 @@ class Schedule(Protocol):
     def first(self) -> Cursor:
         """The cursor of a new run."""
 
-    def advance(self, cursor: Cursor, nb: int, energy: float, now: float) -> Cursor:
-        """The unit of work after the one at `cursor`, which left `nb` functions at `energy` (Eh)
-        after `now` seconds of the run; Cursor("done") when the schedule ends (`stopped` says why)."""
+    def advance(self, cursor: Cursor, nb: int, energy: float, now: float, functions: int = 1) -> Cursor:
+        """The unit of work after the one at `cursor`, which visited `functions` functions of a
+        sweep from `cursor.index` on (a batch of refinements, methods.Refine) and left `nb`
+        functions at `energy` (Eh) after `now` seconds of the run; Cursor("done") when the
+        schedule ends (`stopped` says why)."""
 
     def resume(self, cursor: Cursor, stopped: str | None, nb: int, energy: float,
                now: float) -> tuple[Cursor, str | None]:

@@ -57,6 +57,9 @@ SETTINGS = {
     "refine_method": Setting(Choice(REFINE_METHODS), "refinement minimiser", "[optimiser] refine_method"),
     "refine_group": Setting(Automatic(Integer(1, 8)), "functions a refinement sweep moves together: each with those it "
                             "overlaps most (L-BFGS on exact gradients)", "[optimiser] refine_group"),
+    "batch": Setting(Automatic(Integer(1, MAX_SIZE)), "functions of a replacement or refinement sweep worked on at "
+                     "once from one basis, shared among the MPI ranks, then put in order, each only if it still "
+                     "gains", "[optimiser] batch"),
     "polish": Setting(Automatic(Integer(0)), "joint refinement steps per cycle", "[optimiser] polish"),
     "polish_iterations": Setting(Integer(1), "L-BFGS iterations per joint step", "[optimiser] polish_iterations"),
     "cycles": Setting(Automatic(Integer(1)), "repetitions of the prune-sweep-refine-polish block", "[optimiser] cycles"),
@@ -116,6 +119,9 @@ class Optimiser:
     refinement of one function; refine_method — "gradient" (L-BFGS, exact gradients) or
     "powell"; refine_group — functions a refinement sweep moves together (1: one at a time; k: each
     with the k - 1 it overlaps most, always by L-BFGS; chosen by the schedule when not given);
+    batch — functions of a replacement or refinement sweep worked on at once, each from the same
+    basis, shared among the MPI ranks, then put one after the other, each only if it still lowers
+    the energy (methods.together; default: the number of ranks, 1 in one process);
     polish_iterations — iterations per joint step.
     Linear dependence: min_norm — smallest part of a trial orthogonal to the basis, relative to
     its norm; max_overlap — largest normalised overlap of a trial with a function; threshold —
@@ -136,6 +142,7 @@ class Optimiser:
     refine_evaluations: int | None = None
     refine_method: str = "gradient"
     refine_group: int | None = None
+    batch: int | None = None
     polish: int | None = None
     polish_iterations: int = 20
     cycles: int | None = None
