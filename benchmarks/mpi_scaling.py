@@ -10,10 +10,13 @@ the basis, as `Expansion.candidates` evaluates a growth or replacement step; one
 gradient against the basis, as every energy-and-gradient evaluation of a refinement; REFINED
 refinements of one function (L-BFGS, at most EVALUATIONS energies each, with the eigen-updates
 every rank repeats), one after the other with every rank on each, and in batches of one function
-per rank (methods.together, a run's default `batch`), each rank refining its own. Each timed after
-one warm-up, best of REPEATS (the refinements once, in order); the bytes each rank receives per
-build are reported beside. Rank 0 prints the lines.
+per rank (methods.together, a run's default `batch`), each rank refining its own; and the same
+for REFINED steps of a replacement sweep and of a group refinement with the checkpoint's
+settings (its trials, refined newcomer, and refine_group). Each timed after one warm-up, best of
+REPEATS (the sweeps' steps once, in order); the bytes each rank receives per build are reported
+beside. Rank 0 prints the lines.
 """
+import json
 import sys
 import time
 from pathlib import Path
@@ -23,8 +26,11 @@ import numpy as np
 from prebo.eigen import lapack_threads
 from prebo.integrals import laboratory
 from prebo.optimise.expansion import Expansion
-from prebo.optimise.methods import together
-from prebo.optimise.refine import refine_function
+from prebo.optimise import Optimiser
+from prebo.optimise.defaults import resolved
+from prebo.optimise.methods import Minimiser, Replace, together
+from prebo.optimise.sampler import Sampler
+from prebo.optimise.refine import refine_function, refine_group
 from prebo import Basis
 from prebo.parallel import world
 
@@ -73,6 +79,25 @@ def measure(folder: str) -> None:
         together(ex, range(nb // 3 + i, nb // 3 + i + ranks.size),
                  lambda twin, k: refine_function(twin, k, max_evaluations=EVALUATIONS))
     batched = ranks.agreed(time.perf_counter() - start) / REFINED
+    opts = resolved(Optimiser.from_dict(json.loads((Path(folder) / "basis.json").read_text())["optimiser"]),
+                    basis.system)
+    sampler = Sampler(basis.system, opts, np.random.default_rng(0))
+    sampler.learn(basis)
+    replace = Replace(opts.trials, Minimiser(opts.refine_evaluations, opts.refine_method))
+    sweeps = {}
+    for kind in ("replacement", "group refinement"):
+        for size in (1, ranks.size):
+            ex = Expansion(basis.subset(list(range(nb))), rep, 1e-13)
+            start = time.perf_counter()
+            for i in range(0, REFINED, size):
+                batch = range(nb // 3 + i, nb // 3 + i + size)
+                if kind == "replacement":
+                    drawn = {k: sampler.replacements(ex.basis.subset([k]), opts.trials) for k in batch}
+                    together(ex, batch, lambda twin, k: replace.replace(twin, k, drawn[k]))
+                else:
+                    together(ex, batch, lambda twin, k: refine_group(twin, k, opts.refine_group,
+                                                                    opts.refine_evaluations, opts.refine_method))
+            sweeps[kind, size] = ranks.agreed(time.perf_counter() - start) / REFINED
     rows = best(lambda: rep.rows(trials, basis))
     gradient = best(lambda: rep.row_gradient(f, dA, dv, basis))
     if ranks.root:
@@ -85,6 +110,9 @@ def measure(folder: str) -> None:
         print(f"  one row gradient      {gradient:8.4f} s   {1 / gradient:8.1f} evaluations/s ({1 + P} x {nb} x 4 values)")
         print(f"  refinement of one function ({EVALUATIONS} evaluations)  {refine:8.3f} s   {60 / refine:8.1f} per minute")
         print(f"  the same in batches of {ranks.size}            {batched:8.3f} s   {60 / batched:8.1f} per minute")
+        for (kind, size), t in sweeps.items():
+            what = f"{kind} step ({opts.trials} trials)" if kind == "replacement" else f"{kind} ({opts.refine_group} functions)"
+            print(f"  {what}, batches of {size}   {t:8.3f} s   {60 / t:8.1f} per minute")
 
 
 if __name__ == "__main__":
