@@ -61,9 +61,10 @@ def test_ranks_whose_copies_differ_stop_with_an_error_naming_it():
 
 
 def test_a_two_rank_run_equals_a_one_rank_run_of_its_batch_and_resumes_after_a_kill_on_any_rank_count(tmp_path):
-    """Two ranks refine two functions at once (batch defaults to the rank count): one process
-    with batch = 2 gives the same basis bit for bit, and so does the 2-rank run killed
-    mid-way and resumed on 2 ranks or on 1 (the batch is kept in the checkpoint)."""
+    """Two ranks work on two functions of a sweep at once (batch defaults to the rank count): one
+    process with batch = 2 gives the same basis bit for bit, and so does the 2-rank run whose one
+    rank is killed mid-way (the launcher stops the other), resumed on 2 ranks or on 1 (the batch
+    is kept in the checkpoint)."""
     (tmp_path / "in.toml").write_text(INPUT)
     (tmp_path / "batch.toml").write_text(INPUT + "batch = 2\n")
     finished(prebo_run(1, tmp_path / "batch.toml", "--out", tmp_path / "one"), 300)
@@ -73,8 +74,16 @@ def test_a_two_rank_run_equals_a_one_rank_run_of_its_batch_and_resumes_after_a_k
 
     killed = prebo_run(2, tmp_path / "in.toml", "--out", tmp_path / "killed", start_new_session=True)
     mid_schedule(tmp_path / "killed")
-    os.killpg(killed.pid, signal.SIGKILL)  # every rank
-    killed.communicate()
+    ranks = subprocess.run(["pgrep", "-f", f"^{sys.executable} -m prebo run .*killed"], capture_output=True,
+                           text=True).stdout.split()
+    assert len(ranks) == 2, f"not two ranks running: {ranks}"
+    os.kill(int(ranks[-1]), signal.SIGKILL)  # one rank: the launcher stops the other
+    try:
+        killed.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(killed.pid, signal.SIGKILL)
+        pytest.fail("the other rank still ran 60 s after one was killed")
+    assert killed.returncode != 0
     cut = json.loads((tmp_path / "killed" / "basis.json").read_text())["progress"]
     assert cut["phase"] != "done", "the run ended before it was killed: nothing tested"
     shutil.copytree(tmp_path / "killed", tmp_path / "on-one")
