@@ -149,7 +149,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                 break
             stopped, old, phase, visited = None, ex.energy, cursor.phase, None
             try:
-                visited = steps[cursor.phase].step(run, cursor)  # a batch of refinements visits several
+                visited = steps[cursor.phase].step(run, cursor)  # a sweep's batch visits several functions
             except StalledError:
                 if not schedule.stall(len(ex.basis)):
                     raise

@@ -222,11 +222,11 @@ class Expansion:
         return self.solve_and_keep_if_lower(before)
 
     def put_group(self, idx: list[int], fs: list[Basis]) -> bool:
-        """Replace (or, at index len, append) the functions `idx` by `fs` (one-function bases) at
-        once if that lowers the energy beyond the uncertainty; True if it did. Rows are patched one
-        function after the other, each against the basis with the ones before it in place (as
-        `put`). The levels are followed through a change of several functions (one changed never
-        moves a level up and lowers it, objective.py)."""
+        """Replace the functions `idx` by `fs` (one-function bases) at once if that lowers the
+        energy beyond the uncertainty; True if it did. Rows are patched one function after the
+        other, each against the basis with the ones before it in place (as `put`). The levels are
+        followed through a change of several functions (one changed never moves a level up and
+        lowers it, objective.py)."""
         before = self.snapshot()
         for i, f in zip(idx, fs):
             rows, diag = self.rep.rows(f, self.basis, i)
