@@ -1,8 +1,8 @@
 """MPI ranks sharing a run (parallel.py), on this machine's loopback with `mpiexec -n 2`: integrals
 equal one process's bit for bit, a 2-rank run equals a 1-rank one refining the same batches, a
-killed 2-rank run resumes to the same basis on 2 ranks or 1, and a failing rank stops every rank in
-bounded time. Needs prebo's MPI extra (pip install ".[mpi]"), which the README's test command
-installs."""
+killed 2-rank run resumes to the same basis on 2 ranks or 1, a failing rank stops every rank in
+bounded time, and an error every rank meets is reported once. Needs prebo's MPI extra (pip install
+".[mpi]"), which the README's test command installs."""
 import json
 import os
 import shutil
@@ -50,6 +50,14 @@ def test_a_failing_rank_stops_every_rank_with_an_error():
         p.kill()
         pytest.fail("the ranks still ran 60 s after one failed")
     assert p.returncode != 0 and "a deliberate failure on the last rank" in err
+
+
+def test_a_bad_input_under_two_ranks_is_reported_once_with_exit_status_2(tmp_path):
+    """Every rank meets a bad input: rank 0 reports it and stops both (parallel.stop_all)."""
+    (tmp_path / "bad.toml").write_text('[system]\nparticles = ["p", "zz"]\n')
+    p = prebo_run(2, tmp_path / "bad.toml", "--out", tmp_path / "out")
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 2 and err.count("prebo: error:") == 1 and "unknown particle 'zz'" in err
 
 
 def test_ranks_whose_copies_differ_stop_with_an_error_naming_it():

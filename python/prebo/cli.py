@@ -665,11 +665,9 @@ def command(argv) -> int:
         world()  # under MPI: the ranks' threads set before the core first runs (parallel.py)
         return args.func(args)
     except PreboError as exc:
-        print("prebo: error: " + " ".join(str(exc).split("\n")), file=sys.stderr)  # one line, always
-        return stop_all(2)
+        return stop_all(2, "prebo: error: " + " ".join(str(exc).split("\n")))  # one line, always
     except KeyboardInterrupt:
-        print("prebo: interrupted (the last accepted step is saved)", file=sys.stderr)
-        return stop_all(130)
+        return stop_all(130, "prebo: interrupted (the last accepted step is saved)")
 
 
 if __name__ == "__main__":

@@ -44,7 +44,7 @@ LAUNCHERS = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "PMIX_SIZE")
 #: blocks of a full build per rank (`Ranks.matrices`): more even work, more calls
 BLOCKS_PER_RANK = 4
 #: seconds a failing rank waits before it stops every rank, for the launcher to forward its report
-#: (a rank stopped at once by another's abort can lose the lines it wrote last)
+#: (a rank stopped at once by another's abort can lose the lines it wrote last; `stop_all`)
 FORWARD = 0.5
 
 
@@ -199,14 +199,21 @@ def joined(parts: list[dict], axis: int) -> dict:
     return {name: np.concatenate([part[name] for part in parts], axis=axis) for name in parts[0]}
 
 
-def stop_all(status: int) -> int:
-    """`status`, after a failure reported on this rank; under MPI every rank is stopped first (exit
-    status `status`), since the others would wait for this one in a collective call for ever; the
-    abort waits FORWARD seconds, in which the launcher forwards the report."""
+def stop_all(status: int, report: str | None = None) -> int:
+    """`status`, after a failure on this rank, and its one-line `report` on stderr; under MPI every
+    rank is stopped (exit status `status`), since the others would wait for this one in a
+    collective call for ever. A failure every rank meets (a bad input) is reported once: rank 0
+    reports at once and stops every rank FORWARD seconds later (the launcher forwards the report
+    meanwhile), another rank reports only after twice that, when a rank 0 that failed too has
+    stopped it."""
     try:
         ranks = world()
     except UnsupportedError:  # no MPI to stop with: every rank ends by itself
-        return status
+        ranks = Ranks()
+    if report is not None:
+        if not ranks.root:
+            time.sleep(2 * FORWARD)
+        print(report, file=sys.stderr)
     if ranks.comm is not None:
         sys.stderr.flush()
         time.sleep(FORWARD)
