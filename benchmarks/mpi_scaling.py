@@ -69,35 +69,35 @@ def measure(folder: str) -> None:
     build = best(lambda: rep.matrices(basis))
     ex = Expansion(basis.subset(list(range(nb))), rep, 1e-13)
     step = best(lambda: ex.candidates(trials))
-    start = time.perf_counter()
-    for i in range(REFINED):  # the middle functions, as a refinement sweep meets them
-        refine_function(ex, nb // 3 + i, max_evaluations=EVALUATIONS)
-    refine = ranks.agreed(time.perf_counter() - start) / REFINED
-    ex = Expansion(basis.subset(list(range(nb))), rep, 1e-13)
-    start = time.perf_counter()
-    for i in range(0, REFINED, ranks.size):
-        together(ex, range(nb // 3 + i, nb // 3 + i + ranks.size),
-                 lambda twin, k: refine_function(twin, k, max_evaluations=EVALUATIONS))
-    batched = ranks.agreed(time.perf_counter() - start) / REFINED
     opts = resolved(Optimiser.from_dict(json.loads((Path(folder) / "basis.json").read_text())["optimiser"]),
                     basis.system)
     sampler = Sampler(basis.system, opts, np.random.default_rng(0))
     sampler.learn(basis)
     replace = Replace(opts.trials, Minimiser(opts.refine_evaluations, opts.refine_method))
-    sweeps = {}
-    for kind in ("replacement", "group refinement"):
-        for size in (1, ranks.size):
-            ex = Expansion(basis.subset(list(range(nb))), rep, 1e-13)
-            start = time.perf_counter()
-            for i in range(0, REFINED, size):
-                batch = range(nb // 3 + i, nb // 3 + i + size)
-                if kind == "replacement":
-                    drawn = {k: sampler.replacements(ex.basis.subset([k]), opts.trials) for k in batch}
-                    together(ex, batch, lambda twin, k: replace.replace(twin, k, drawn[k]))
-                else:
-                    together(ex, batch, lambda twin, k: refine_group(twin, k, opts.refine_group,
-                                                                    opts.refine_evaluations, opts.refine_method))
-            sweeps[kind, size] = ranks.agreed(time.perf_counter() - start) / REFINED
+
+    def refinements(ex, batch):
+        together(ex, batch, lambda twin, k: refine_function(twin, k, max_evaluations=EVALUATIONS))
+
+    def replacements(ex, batch):
+        drawn = {k: sampler.replacements(ex.basis.subset([k]), opts.trials) for k in batch}
+        together(ex, batch, lambda twin, k: replace.replace(twin, k, drawn[k]))
+
+    def groups(ex, batch):
+        together(ex, batch, lambda twin, k: refine_group(twin, k, opts.refine_group, opts.refine_evaluations,
+                                                         opts.refine_method))
+
+    def per_function(step, size: int) -> float:
+        """Seconds per function of REFINED sweep steps from nb/3 on, in batches of `size`."""
+        ex = Expansion(basis.subset(list(range(nb))), rep, 1e-13)
+        start = time.perf_counter()
+        for i in range(0, REFINED, size):
+            step(ex, range(nb // 3 + i, nb // 3 + i + size))
+        return ranks.agreed(time.perf_counter() - start) / REFINED
+
+    kinds = {f"refinement of one function ({EVALUATIONS} evaluations)": refinements,
+             f"replacement step ({opts.trials} trials)": replacements,
+             f"group refinement ({opts.refine_group} functions)": groups}
+    sweeps = {(what, size): per_function(step, size) for what, step in kinds.items() for size in sorted({1, ranks.size})}
     rows = best(lambda: rep.rows(trials, basis))
     gradient = best(lambda: rep.row_gradient(f, dA, dv, basis))
     if ranks.root:
@@ -108,10 +108,7 @@ def measure(folder: str) -> None:
         print(f"  {TRIALS} trials' rows        {rows:8.3f} s   {TRIALS / rows:8.1f} trials/s")
         print(f"  {TRIALS} trials' energies     {step:8.3f} s   (rows and objective: a growth or replacement step)")
         print(f"  one row gradient      {gradient:8.4f} s   {1 / gradient:8.1f} evaluations/s ({1 + P} x {nb} x 4 values)")
-        print(f"  refinement of one function ({EVALUATIONS} evaluations)  {refine:8.3f} s   {60 / refine:8.1f} per minute")
-        print(f"  the same in batches of {ranks.size}            {batched:8.3f} s   {60 / batched:8.1f} per minute")
-        for (kind, size), t in sweeps.items():
-            what = f"{kind} step ({opts.trials} trials)" if kind == "replacement" else f"{kind} ({opts.refine_group} functions)"
+        for (what, size), t in sweeps.items():
             print(f"  {what}, batches of {size}   {t:8.3f} s   {60 / t:8.1f} per minute")
 
 

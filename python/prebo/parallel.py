@@ -114,7 +114,7 @@ class Ranks:
     def agreed(self, value, what: str = "value"):
         """Rank 0's `value` on every rank (a collective call: every rank makes it, for the same
         `what`; RanksDivergedError otherwise, as for `gathered`)."""
-        return value if self.comm is None else self.each(value, ("agreed", what))[0]
+        return self.each(value, ("agreed", what))[0]
 
     def gathered(self, mine: list, call: tuple) -> list:
         """The (index, item) pairs of every rank, ordered by index (a collective call; one process:

@@ -239,8 +239,8 @@ class Expansion:
         this process evaluates by itself, without the other MPI ranks, and which places a change
         without solving (`solve_and_keep_if_lower`: the expansion re-checks it)."""
         twin = copy.copy(self)
-        twin.basis, twin.m, twin.rep, twin.drafted = self.basis.subset(slice(None)), self.snapshot()[1], \
-            self.rep.alone(), True
+        twin.basis, twin.m = self.snapshot()[:2]
+        twin.rep, twin.drafted = self.rep.alone(), True
         return twin
 
     def changes(self, before: Expansion) -> tuple[list[int], list[Basis]] | None:
