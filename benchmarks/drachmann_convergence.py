@@ -3,11 +3,14 @@ Drachmann's regularised form (prebo.drachmann; docs/properties-derivations.md §
 
 Hydrogen (finite proton mass) 1s in the n even-tempered s Gaussians 3e-3 · 1.6^k bohr⁻², k < n,
 against μ³/π; ⁴He ground state in the first k functions of
-examples/bases/auto-he-700 (grown in that order), against the 700-function regularised values.
+examples/bases/auto-he-700 (grown in that order), against the 700-function regularised values;
+H2⁺ (p p e) ground state in the first k functions of the floating-ECG (400) and ECG-GVR (180)
+examples, whose ⟨V/r_ij⟩ is the quadrature of eq. (38), with the seconds each row took.
 
     nice -n 19 python benchmarks/drachmann_convergence.py
 """
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -55,6 +58,20 @@ def helium():
         print(f"{k:>4} {E:>16.10f} " + " ".join(f"{c:>26}" for c in cells))
 
 
+def h2plus():
+    print("\nH2⁺ ground state, first k functions of the examples; ⟨δ³(r_ep)⟩ and ⟨δ³(r_pp)⟩ (bohr⁻³)")
+    print(f"{'basis':>12} {'k':>4} {'E (Eh)':>16} {'δ(r_ep) direct':>15} {'regularised':>12} "
+          f"{'δ(r_pp) direct':>15} {'regularised':>12} {'s':>6}")
+    for name, sizes in (("h2plus-fecg", (30, 100, 400)), ("h2plus-gvr", (20, 60, 180))):
+        full = prebo.Basis.load(ROOT / "examples" / "bases" / name / "basis.json")
+        for k in sizes:
+            t = time.perf_counter()
+            E, d, r = contact(full.subset(np.arange(k)))
+            print(f"{name:>12} {k:>4} {E:>16.10f} {d['e-p']:>15.8f} {r['e-p']:>12.8f} {d['p-p']:>15.3e} "
+                  f"{r['p-p']:>12.3e} {time.perf_counter() - t:>6.1f}", flush=True)
+
+
 if __name__ == "__main__":
     hydrogen()
     helium()
+    h2plus()

@@ -52,6 +52,25 @@ def test_hydrogen_1s_and_2s_expectation_values_match_the_closed_forms():
     assert all(e < 0 for e in errors) and errors[0] < errors[2] < errors[4], errors
 
 
+def test_hydrogen_2p_in_global_vector_functions_matches_the_closed_forms():
+    """H (finite proton mass) 2p, N = 1, in the 25 ECG-GVR functions of examples/bases/h2p (energy
+    5.1e-11 relative above −μ/8): ⟨r⟩ = 5/μ, ⟨r²⟩ = 30/μ², ⟨1/r⟩ = μ/4, ⟨1/r²⟩ = μ²/12 (the
+    n, l forms (3n² − l(l + 1))/2μ, n²(5n² + 1 − 3l(l + 1))/2μ², μ/n², μ²/(n³(l + ½)); Bethe &
+    Salpeter, eqs. 3.24–3.26) within 1e-9 (⟨1/r²⟩ 1e-7; measured 1.0e-10, 7.6e-10, 1.2e-10,
+    1.1e-8), and no contact density: direct 7e-18, Drachmann's 1.1e-8 bohr⁻³ (measured), against
+    μ³/(8π) = 0.04 for 2s."""
+    basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2p" / "basis.json")
+    m = basis.system.masses
+    mu = m[0] * m[1] / (m[0] + m[1])
+    p = prebo.properties(basis, regularised=True)
+    exact = {"r": 5 / mu, "r2": 30 / mu**2, "inv_r": mu / 4, "inv_r2": mu**2 / 12}
+    for name, want in exact.items():
+        got = p["expectation"][name]["e-p"]
+        assert abs(got / want - 1) < (1e-7 if name == "inv_r2" else 1e-9), (name, got, want)
+    scale = mu**3 / (8 * np.pi)
+    assert abs(p["expectation"]["delta"]["e-p"]) < 1e-12 * scale and abs(p["delta_regularised"]["e-p"]) < 1e-6 * scale
+
+
 def test_hydrogen_momentum_expectation_values_match_the_closed_forms():
     """H 1s and 2s (roots 0, 1 of 80 even-tempered s Gaussians): ⟨p²⟩ = μ²/n² and
     ⟨p⁴⟩ = μ⁴(8n − 3)/n⁴ (Bethe & Salpeter, eq. 3.26 with 4⟨(E + 1/r)²⟩, scaled by μ) for the
@@ -98,20 +117,20 @@ def test_positronium_ion_distances_match_frolov():
 
 def test_properties_of_a_ladder_level_are_its_evaluated_expectation_values():
     """`prebo.properties(basis, root=k)` is level k of `evaluate` with the reported operators
-    (every one the family evaluates, but Drachmann's terms, which ECG-GVR cannot complete): in the
+    (every one the family evaluates, but Drachmann's terms, slow for ECG-GVR, unless asked): in the
     first 80 functions of the H2⁺ ladder's basis, v = 1 has its energy, and the protons further
     apart than in v = 0 (⟨r_pp⟩, ⟨r_pp²⟩ up, ⟨1/r_pp⟩ down) with no contact density
     (⟨δ³(r_pp)⟩ ≈ 0 beside e-p's)."""
     basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2plus-ladder" / "basis.json").subset(range(80))
     v1 = prebo.properties(basis, root=1)
     derived = [name for name, op in OPERATORS.items() if op.evaluates(basis.family)]
-    reported = [name for name in derived if name != "gradient_inv_r"]
+    reported = [name for name in derived if name not in ("coulomb_inv_r", "gradient_inv_r")]
     r = prebo.evaluate(basis, roots=2, operators=reported)
     v0 = r["levels"][0]
     assert v1["energy"] == r["levels"][1]["energy"] and v1["expectation"] == r["levels"][1]["expectation"]
     assert set(v1["expectation"]) == set(reported) and v1["units"]["delta"] == "bohr⁻³"
     assert v1["not_derived"] == [name for name in OPERATORS if name not in derived]
-    assert "breit_pauli" not in v1 and "delta_regularised" not in v1  # no p⁴, ⟨V/r⟩, orbit–orbit
+    assert "breit_pauli" not in v1 and "delta_regularised" not in v1  # no p⁴ or orbit–orbit; δ not asked for
     pp0, pp1 = ({k: v["p-p"] for k, v in p["expectation"].items() if OPERATORS[k].acts_on == "pairs"} for p in (v0, v1))
     assert pp1["r"] > pp0["r"] and pp1["r2"] > pp0["r2"] and pp1["inv_r"] < pp0["inv_r"]
     assert abs(pp0["delta"]) < 1e-9 * v0["expectation"]["delta"]["e-p"]

@@ -383,7 +383,7 @@ def cmd_energy(args) -> int:
 
 
 def cmd_properties(args) -> int:
-    """`prebo properties BASIS [--root K] [--coordinates lab|ti] [--threshold T] [--json]`: the
+    """`prebo properties BASIS [--root K] [--coordinates lab|ti] [--threshold T] [--regularised] [--json]`: the
     energy of level K of a stored basis, the expectation value of every registered operator per
     class of equivalent pairs (properties.py) and the level's Breit–Pauli correction (relativistic.py)."""
     from rich.console import Console
@@ -393,7 +393,7 @@ def cmd_properties(args) -> int:
 
     basis, stored = load_basis(args.basis)
     try:
-        p = properties(basis, args.root, args.coordinates, args.threshold or stored)
+        p = properties(basis, args.root, args.coordinates, args.threshold or stored, args.regularised or None)
     except PreboError as exc:
         raise type(exc)(f"{args.basis}: {exc}") from exc
     values = [v for per in p["expectation"].values() for v in per.values()]
@@ -519,6 +519,9 @@ def parser() -> argparse.ArgumentParser:
                     help="lab: LFCC with CM elimination (default); ti: translationally invariant (shared c_A only)")
     pr.add_argument("--threshold", type=fraction, metavar="T",
                     help="relative overlap eigenvalue below which directions are dropped (default: as for prebo energy)")
+    pr.add_argument("--regularised", action="store_true",
+                    help="Drachmann's regularised δ also where it is slow (floating ECGs, ECG-GVR: up to 1 ms per element); "
+                         "plain ECGs always have it")
     pr.add_argument("--json", action="store_true", help="print the properties as JSON")
     pr.set_defaults(func=cmd_properties)
     en = sub.add_parser("energy", help="re-evaluate a stored basis")

@@ -6,7 +6,9 @@ eigenstate Ψ of T_TI + V with energy E,
 with Λ the kinetic matrix of T_TI = −∇ᵀΛ∇. The right side holds global operators, so in Gaussians,
 which lack the cusp, it converges faster with the basis than the direct ⟨δ³(r_ij)⟩ ("delta"), the
 density at one point. Its elements are the core's "inv_r", "coulomb_inv_r" and "gradient_inv_r"
-(crates/prebo-core/src/operators/drachmann.rs); plain ECGs have them all.
+(crates/prebo-core/src/operators/drachmann.rs), for every family. ⟨V/r_ij⟩ is in closed form for
+plain ECGs (eq. 19) and a quadrature over the family's damped ⟨1/r⟩ elements for floating ECGs and
+ECG-GVR (eq. 38), up to a millisecond per element: `CLOSED_FORM` says where it is cheap.
 """
 from __future__ import annotations
 
@@ -17,6 +19,9 @@ from .system import reduced_mass
 
 #: the operators of eq. (27): ⟨1/r_ij⟩, ⟨V/r_ij⟩, ⟨∇Ψ|Λ/r_ij|∇Ψ⟩
 TERMS = ("inv_r", "coulomb_inv_r", "gradient_inv_r")
+
+#: the basis families whose ⟨V/r_ij⟩ is in closed form (eq. 19), as cheap as ⟨1/r_ij⟩
+CLOSED_FORM = ("pecg",)
 
 
 def delta_regularised(rep, basis, C: np.ndarray, energies) -> list[dict[str, float]]:

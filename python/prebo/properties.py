@@ -29,8 +29,10 @@ from .results import evaluate, grids
 from .validation import Integer, checked
 
 
-def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float = eigen.THRESHOLD) -> dict:
-    """The properties of level `root` (0: the lowest of the basis's symmetry) of `basis`.
+def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float = eigen.THRESHOLD,
+               regularised: bool | None = None) -> dict:
+    """The properties of level `root` (0: the lowest of the basis's symmetry) of `basis`, with
+    Drachmann's regularised δ if `regularised` (None: where it is cheap, `reported`).
 
     Returns {"root", "energy", "energy_uncertainty" (Eh), "virial", "bound", "expectation":
     {operator: {class: value}}, "units": {operator: unit}, "not_derived": [operators]} (and "n2",
@@ -43,7 +45,7 @@ def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float 
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"properties: basis = {basis!r}: must be a prebo.Basis with at least one function")
     root = checked(Integer(0, len(basis) - 1), root, "properties: root", f"roots of a basis of {len(basis)} functions")
-    names = reported(basis.family)
+    names = reported(basis.family, regularised)
     r = evaluate(basis, coordinates=coordinates, threshold=threshold, operators=names, roots=root + 1)
     level = r["levels"][root] if "levels" in r else r
     keys = ("root", "energy", "energy_uncertainty", "virial", "bound", "n2", "expectation")
@@ -56,15 +58,17 @@ def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float 
 POINTS, REACH = 400, 5.0
 
 
-def reported(family) -> list[str]:
+def reported(family, regularised: bool | None = None) -> list[str]:
     """The operators a level's properties hold for a basis of `family` (`properties`, `prebo run`'s
-    result.json): every one the family evaluates, but Drachmann's terms only where it evaluates them
-    all, since they serve the regularised ⟨δ³(r_ij)⟩ alone (ECG-GVR's ⟨∇Ψ|Λ/r_ij|∇Ψ⟩ would take
-    128 s of H2-500's 139 s, with no ⟨V/r_ij⟩ to make the δ of it)."""
-    names = [name for name, op in OPERATORS.items() if op.evaluates(family)]
-    if not set(drachmann.TERMS) <= set(names):
-        names = [name for name in names if name not in drachmann.TERMS or name == "inv_r"]
-    return names
+    result.json): every one the family evaluates, Drachmann's terms, which serve the regularised
+    ⟨δ³(r_ij)⟩ alone, only if `regularised`; None: where ⟨V/r_ij⟩ is in closed form
+    (`drachmann.CLOSED_FORM`). Elsewhere they cost minutes for a few hundred functions: ⟨V/r_ij⟩ a
+    quadrature of up to a millisecond per element (eq. 38), ECG-GVR's ⟨∇Ψ|Λ/r_ij|∇Ψ⟩ 128 s of H2-500's
+    139 s."""
+    if regularised is None:
+        regularised = family.name in drachmann.CLOSED_FORM
+    return [name for name, op in OPERATORS.items()
+            if op.evaluates(family) and (regularised or name not in drachmann.TERMS or name == "inv_r")]
 
 
 def corrections(basis, level: dict) -> dict:

@@ -7,9 +7,17 @@
 //! which lack the cusp (`prebo.drachmann` assembles it per state).
 //!
 //! - `coulomb_inv_r`: `<φ_I| V/|r_w| |φ_J> = Σ_{k<l} q_k q_l <1/(|r_kl| |r_w|)>` over the Coulomb
-//!   pairs of the context, each by eq. (19), `S 4 arcsin(ρ)/(πρ √(q₁₁q₂₂))` (eq. 13, `2S/q`, for
-//!   a pair parallel to `w`). Plain ECGs only: for floating ECGs and ECG-GVR the product is a
-//!   two-dimensional integral not derived (§4).
+//!   pairs `w'` of the context. Plain ECGs: each by eq. (19), `S 4 arcsin(ρ)/(πρ √(q₁₁q₂₂))`.
+//!   Every other family: a pair parallel to `w` is `<1/r_w²>` scaled (eq. 13); any other pair is
+//!   `1/|r_w| = π^{−1/2}∫α^{−1/2}e^{−α r_w²}dα` over the family's `1/|r_w'|` element of its
+//!   damped functions (eq. 38), `(2/√(πq)) ∫_0^1 (1 − τ²)^{−3/2} <φ_I| e^{−α r_w²}/|r_w'| |φ_J> dτ`,
+//!   `α = τ²/(q(1 − τ²))`. For plain ECGs the integrand is `S (2/√π)/√(q₂₂(1 − ρ²τ²))`, `ρ` the
+//!   correlation of `r_w` and `r_w'` in the Gaussian: `τ = sin φ/ρ` makes it constant, and makes
+//!   every family's integrand smooth where pairs are nearly parallel (a light particle's distances
+//!   to two heavy ones); Gauss–Legendre panels halved until two rules agree to 1e-11 integrate it
+//!   (`adaptive`). It costs up to hundreds of the family's `1/|r_w'|` elements per pair where a floating
+//!   ECG's centres or a global vector's high powers shape the integrand (50 µs to 0.6 ms per
+//!   element for H2⁺).
 //! - `gradient_inv_r`: `<∇φ_I| Λ/|r_w| |∇φ_J>` with the `Λ` of the context's `T_TI` (the CM part
 //!   removed: `1^T w = 0`, so `w^T Λ w = 1/(2μ_ij)` either way), from `1/|y| = π^{−1/2}∫t^{−1/2}e^{−ty²}dt`
 //!   and eq. (30): with `g = exp(−α r_w²)`, `D(α) = <φ_I|g|φ_J>` and `R = −∂D/∂α`,
@@ -22,23 +30,24 @@
 //!   ECG is centred at `(A + M)^{-1} A s`, which its kinetic element needs (`Fecg::damped`).
 //!   Every family.
 use std::f64::consts::PI;
+use std::sync::OnceLock;
 
 use nalgebra::{Const, U1};
 
 use super::profile::Profile;
-use super::ElementFn;
+use super::{inverse, inverse_square, ElementFn};
 use crate::ecg::{Mat, Vector};
 use crate::families::floating::fecg::erf;
-use crate::families::gvr::gvr_element::legendre_rule;
+use crate::families::gvr::gvr_element::{gauss_legendre, legendre_rule};
 use crate::families::{Family, Form, Shape};
 use crate::gradient::{seed, Dual};
 
 pub const COULOMB: &str = "coulomb_inv_r";
 pub const GRADIENT: &str = "gradient_inv_r";
 
-/// `coulomb_inv_r`'s element where it is derived: plain ECGs.
-pub fn coulomb<const D: usize, F: Family<D>>() -> Option<ElementFn<D, F>> {
-    (F::FORM == Form::Plain).then_some(coulomb_inv_r::<D, F> as ElementFn<D, F>)
+/// `coulomb_inv_r`'s element: eq. (19) for plain ECGs, the damped quadrature (eq. 38) otherwise.
+pub fn coulomb<const D: usize, F: Family<D>>() -> ElementFn<D, F> {
+    if F::FORM == Form::Plain { coulomb_inv_r::<D, F> } else { coulomb_by_damping::<D, F> }
 }
 
 /// `<φ_I| V/|r_w| |φ_J>` of plain ECGs (hartree/bohr; `v = [w]`).
@@ -50,18 +59,92 @@ pub fn coulomb_inv_r<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: 
     F::operators(ctx).pairs.iter().map(|(w, charge)| charge * inverse_product(&a, &whiten(w))).sum::<f64>() * s
 }
 
+/// `<φ_I| V/|r_w| |φ_J>` of any family by eq. (38) (hartree/bohr; `v = [w]`; module docs).
+pub fn coulomb_by_damping<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
+    let w = &v[0];
+    let Some(chol) = (F::exponent(bra) + F::exponent(ket)).cholesky() else { return f64::NAN };
+    let whiten = |w: &Vector<D>| chol.l().solve_lower_triangular(w).unwrap_or_else(|| Vector::<D>::repeat(f64::NAN));
+    let (a, ww) = (whiten(w), w * w.transpose());
+    let q = a.norm_squared();
+    let pair = |wp: &Vector<D>| {
+        let ap = whiten(wp);
+        let qp = ap.norm_squared();
+        // 1 − ρ² from the wedge: accurate also where the pairs are nearly parallel
+        let rest2 = (wedge(&a, &ap).powi(2) / (q * qp)).min(1.0);
+        if rest2 <= 1e-28 {
+            return (q / qp).sqrt() * inverse_square::element::<D, F>(bra, ket, ctx, w);
+        }
+        // the integrand of eq. (38) at τ, given 1 − τ² too (accurate where τ → 1)
+        let at = |tau: f64, rest: f64| {
+            let damped = F::damped(ket, &(ww * (tau * tau / (q * rest))));
+            inverse::element::<D, F>(bra, &damped, ctx, wp) / rest.powf(1.5)
+        };
+        let rho2 = 1.0 - rest2;
+        // 1e-11, or the rounding of the damped functions near α → ∞, which goes like the condition
+        // of B + αwwᵀ there, ~1/(1 − ρ²)
+        let tol = 1e-11f64.max(20.0 * f64::EPSILON / rest2);
+        let integral = if rho2 < 1e-6 {
+            adaptive(&|tau| at(tau, (1.0 - tau) * (1.0 + tau)), 0.0, 1.0, tol)
+        } else {
+            // τ = sin φ/ρ, 1 − τ² = (cos φ − ε)(cos φ + ε)/ρ², ε² = 1 − ρ²
+            let (rho, eps) = (rho2.sqrt(), rest2.sqrt());
+            let f = |phi: f64| at(phi.sin() / rho, (phi.cos() - eps) * (phi.cos() + eps) / rho2) * phi.cos() / rho;
+            adaptive(&f, 0.0, rho.asin(), tol)
+        };
+        2.0 / (PI * q).sqrt() * integral
+    };
+    F::operators(ctx).pairs.iter().map(|(wp, charge)| charge * pair(wp)).sum()
+}
+
+/// `|a ∧ b|`.
+fn wedge<const D: usize>(a: &Vector<D>, b: &Vector<D>) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..D {
+        for j in i + 1..D {
+            sum += (a[i] * b[j] - a[j] * b[i]).powi(2);
+        }
+    }
+    sum.sqrt()
+}
+
+/// `∫_a^b f` by Gauss–Legendre rules of 8 and 16 nodes per panel, a panel halved (at most 8
+/// times) while the two differ by more than `tol` of `∫|f|` (its first estimate) times the
+/// panel's share of `[a, b]`; a value that is not finite is returned as it is.
+fn adaptive(f: &impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> f64 {
+    static RULES: OnceLock<[Vec<(f64, f64)>; 2]> = OnceLock::new();
+    let [low, high] = RULES.get_or_init(|| [gauss_legendre(8), gauss_legendre(16)]);
+    // (∫f, ∫|f|) over [a, b] by the rule r
+    let rule = |r: &[(f64, f64)], a: f64, b: f64| {
+        let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+        r.iter().fold((0.0, 0.0), |(sum, size), &(x, wt)| {
+            let y = half * wt * f(mid + half * x);
+            (sum + y, size + y.abs())
+        })
+    };
+    let (whole, size) = rule(high, a, b);
+    let tol = tol * size / (b - a);
+    // depth first, left to right: (a, b, depth, the 16-node value if known)
+    let (mut total, mut stack) = (0.0, vec![(a, b, 8, Some(whole))]);
+    while let Some((a, b, depth, known)) = stack.pop() {
+        let (fine, coarse) = (known.unwrap_or_else(|| rule(high, a, b).0), rule(low, a, b).0);
+        if !fine.is_finite() {
+            return fine;
+        }
+        if depth == 0 || (fine - coarse).abs() <= tol * (b - a) {
+            total += fine;
+        } else {
+            let mid = 0.5 * (a + b);
+            stack.extend([(mid, b, depth - 1, None), (a, mid, depth - 1, None)]);
+        }
+    }
+    total
+}
+
 /// `<1/(|r_w| |r_w'|)>/S = 4 arcsin(ρ)/(πρ √(q₁₁q₂₂))` (eq. 19) of `a = L^{-1}w`, `b = L^{-1}w'`
 /// (`L L^T = A_I + A_J`): `q₁₂ = a·b`, `ρ√(q₁₁q₂₂) = q₁₂` and `arcsin ρ = atan2(q₁₂, |a ∧ b|)`,
 /// exact also for parallel vectors (`|a ∧ b| = 0`, eq. 13) and orthogonal ones (`q₁₂ = 0`).
 fn inverse_product<const D: usize>(a: &Vector<D>, b: &Vector<D>) -> f64 {
-    let q12 = a.dot(b);
-    let mut wedge = 0.0;
-    for i in 0..D {
-        for j in i + 1..D {
-            wedge += (a[i] * b[j] - a[j] * b[i]).powi(2);
-        }
-    }
-    let wedge = wedge.sqrt();
+    let (q12, wedge) = (a.dot(b), wedge(a, b));
     if q12 == 0.0 { 4.0 / (PI * wedge) } else { 4.0 * q12.atan2(wedge) / (PI * q12) }
 }
 
@@ -169,22 +252,22 @@ mod tests {
     }
 
     /// `Σ_kl q_kl <1/(r_kl r_w)>` by the double integral (module docs) with α = tan²θ/q₁₁,
-    /// β = tan²ϑ/q₂₂, and the `inv_r2` element for a pair parallel to `w`.
-    fn coulomb_by_quadrature<const N: usize>(gi: &Gvr<N>, gj: &Gvr<N>, go: &GvrOps<N>, w: &Vector<N>, n: usize) -> f64 {
-        let q11 = variance(&gi.a, &gj.a, w);
+    /// β = tan²ϑ/q₂₂, and the `inv_r2` element for a pair parallel to `w`; any family.
+    fn coulomb_by_quadrature<const N: usize, F: Family<N>>(fi: &F::Function<f64>, fj: &F::Function<f64>, ctx: &F::Context, w: &Vector<N>, n: usize) -> f64 {
+        let (ai, aj) = (F::exponent(fi), F::exponent(fj));
+        let q11 = variance(ai, aj, w);
         let mut total = 0.0;
-        for (wp, charge) in &go.ops.pairs {
+        for (wp, charge) in &F::operators(ctx).pairs {
             if wp == w || *wp == -w {
-                total += charge * inverse_square::element::<N, PlainEcg>(gi, gj, go, w);
+                total += charge * inverse_square::element::<N, F>(fi, fj, ctx, w);
                 continue;
             }
-            let q22 = variance(&gi.a, &gj.a, wp);
+            let q22 = variance(ai, aj, wp);
             let (ww, wpwp) = (w * w.transpose(), wp * wp.transpose());
             let inner = |theta: f64| {
                 quarter(n, |vartheta: f64| {
                     let damping = ww * (theta.tan().powi(2) / q11) + wpwp * (vartheta.tan().powi(2) / q22);
-                    let d = <PlainEcg as Family<N>>::overlap(gi, &gj.damped(&damping), go);
-                    d / (theta.cos() * vartheta.cos()).powi(2)
+                    F::overlap(fi, &F::damped(fj, &damping), ctx) / (theta.cos() * vartheta.cos()).powi(2)
                 })
             };
             total += charge * 4.0 / (PI * (q11 * q22).sqrt()) * quarter(n, inner);
@@ -234,7 +317,7 @@ mod tests {
                     let w = Vector::<N>::from_fn(|k, _| (k == i) as i32 as f64 - (k == j) as i32 as f64);
                     let label = format!("N = {N}, CM {cm}, seeds ({si}, {sj}), pair ({i}, {j})");
                     let got = coulomb_inv_r::<N, PlainEcg>(&gi, &gj, &go, &[w]);
-                    let want = coulomb_by_quadrature(&gi, &gj, &go, &w, 80);
+                    let want = coulomb_by_quadrature::<N, PlainEcg>(&gi, &gj, &go, &w, 80);
                     assert!(close(got, want, 1e-9), "{label}: coulomb_inv_r {got} vs {want}");
                     let got = gradient_inv_r::<N, PlainEcg>(&gi, &gj, &go, &[w]);
                     let (numerical, closed) = (gradient_by_quadrature(&gi, &gj, &go, &w), gradient_closed_form(&gi, &gj, &go, &w));
@@ -243,6 +326,9 @@ mod tests {
                     // ECG-GVR at K = N = 0: the same functions
                     let gvr = gradient_inv_r::<N, EcgGvr>(&gi, &gj, &go, &[w]);
                     assert!(close(gvr, got, 1e-13), "{label}: ECG-GVR {gvr} vs {got}");
+                    // eq. (38) on the same functions against eq. (19)
+                    let (got, want) = (coulomb_by_damping::<N, EcgGvr>(&gi, &gj, &go, &[w]), coulomb_inv_r::<N, PlainEcg>(&gi, &gj, &go, &[w]));
+                    assert!(close(got, want, 1e-12), "{label}: eq. (38) {got} vs eq. (19) {want}");
                 }
             }
         }
@@ -304,6 +390,64 @@ mod tests {
         assert!(close(got, want, 1e-12), "{got} vs {want}");
     }
 
+    /// Eq. (38) where the pairs are nearly parallel: a light particle between two heavy ones held
+    /// close (`A` grows by `tight` along their pair vector), so that its distances to them
+    /// correlate up to ρ² = 1 − 1.2·10⁻⁵; against eq. (19) on plain ECGs and for floating ECGs at
+    /// zero centres. The damped functions near α → ∞ round like the condition of `B + αwwᵀ` there,
+    /// which grows with `tight`: 1e-12 + 1e-15·tight relative (measured 3.4e-13, 8.3e-13 and
+    /// 4.2e-11 at tight = 10, 10³, 10⁵, the charges' sum cancelling about tenfold).
+    #[test]
+    fn nearly_parallel_pairs_match_eq_19() {
+        let ops = laboratory([1836.15267343, 1836.15267343, 1.0], [1.0, 1.0, -1.0], false);
+        let go = GvrOps::new(ops.clone(), 0, 0).unwrap();
+        let heavy = Vector::<3>::new(1.0, -1.0, 0.0);
+        for tight in [10.0, 1e3, 1e5] {
+            let (ai, aj) = [0.3, 1.9].map(|seed| exponent::<3>(seed, None) + heavy * heavy.transpose() * tight).into();
+            let (gi, gj) = (plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1));
+            let (fi, fj) = (Fecg::new(ai, Centres::<3>::zeros(), 1.0, 0).unwrap(), Fecg::new(aj, Centres::<3>::zeros(), 1.0, 1).unwrap());
+            for w in [Vector::<3>::new(1.0, 0.0, -1.0), Vector::<3>::new(0.0, 1.0, -1.0), heavy] {
+                let want = coulomb_inv_r::<3, PlainEcg>(&gi, &gj, &go, &[w]);
+                let tol = 1e-12 + 1e-15 * tight;
+                let got = coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]);
+                assert!(close(got, want, tol), "A + {tight} w wᵀ, w = {w:?}: ECG-GVR {got} vs {want}");
+                let got = coulomb_by_damping::<3, FloatingEcg>(&fi, &fj, &ops, &[w]);
+                assert!(close(got, want, tol), "A + {tight} w wᵀ, w = {w:?}: floating {got} vs {want}");
+            }
+        }
+    }
+
+    /// Eq. (38) for floating ECGs with centres and ECG-GVR with K, N > 0 (three particles, with
+    /// and without CM-separable exponents) against the double integral over their own damped
+    /// overlaps (`coulomb_by_quadrature`).
+    #[test]
+    fn floating_and_global_vector_functions_match_the_double_integral() {
+        let masses = [7294.29954142, 1.0, 1.0];
+        let mu = Vector::<3>::from_row_slice(&masses) / masses.iter().sum::<f64>();
+        let pairs = [Vector::<3>::new(1.0, -1.0, 0.0), Vector::<3>::new(0.0, 1.0, -1.0)];
+        for cm in [false, true] {
+            let ops = laboratory(masses, [2.0, -1.0, -1.0], cm);
+            let cm_of = |c_a: f64| cm.then_some((&mu, c_a));
+            let (ai, aj) = (exponent(0.5, cm_of(0.7)), exponent(1.1, cm_of(1.3)));
+            for spread in [0.3, 1.5] {
+                // centres with a common shift along the CM direction only where A is CM-separable
+                let (fi, fj) = (Fecg::new(ai, fixtures::centres(0.3, spread), 0.7, 0).unwrap(), Fecg::new(aj, fixtures::centres(2.1, spread), 1.3, 1).unwrap());
+                for w in pairs {
+                    let (got, want) = (coulomb_by_damping::<3, FloatingEcg>(&fi, &fj, &ops, &[w]), coulomb_by_quadrature::<3, FloatingEcg>(&fi, &fj, &ops, &w, 40));
+                    assert!(close(got, want, 1e-10), "floating, CM {cm}, spread {spread}, w = {w:?}: {got} vs {want}");
+                }
+            }
+            for (ki, kj, n_ang) in [(1, 0, 0), (2, 1, 1), (1, 3, 2)] {
+                let go = GvrOps::new(ops.clone(), n_ang, 3).unwrap();
+                let gi = Gvr::new(ai, Vector::<3>::new(0.3, 1.0, -0.4), ki, 0.7, &go, 0).unwrap();
+                let gj = Gvr::new(aj, Vector::<3>::new(-0.7, 0.2, 0.9), kj, 1.3, &go, 1).unwrap();
+                for w in pairs {
+                    let (got, want) = (coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]), coulomb_by_quadrature::<3, EcgGvr>(&gi, &gj, &go, &w, 40));
+                    assert!(close(got, want, 1e-10), "K = ({ki}, {kj}), N = {n_ang}, CM {cm}, w = {w:?}: {got} vs {want}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn boys_functions_match_quadrature() {
         for lambda in [0.0, 1e-3, 0.7, 1.0, 3.5, 7.99, 8.0, 12.9, 13.1, 40.0] {
@@ -318,13 +462,10 @@ mod tests {
     }
 
     #[test]
-    fn the_registry_has_them_where_derived() {
-        assert!(coulomb::<3, PlainEcg>().is_some() && coulomb::<3, EcgGvr>().is_none() && coulomb::<3, FloatingEcg>().is_none());
+    fn every_family_has_them() {
         for name in [COULOMB, GRADIENT] {
-            assert!(lookup::<3, PlainEcg>(name).is_ok());
+            assert!(lookup::<3, PlainEcg>(name).is_ok() && lookup::<3, EcgGvr>(name).is_ok() && lookup::<3, FloatingEcg>(name).is_ok());
         }
-        assert!(lookup::<3, EcgGvr>(GRADIENT).is_ok() && lookup::<3, FloatingEcg>(GRADIENT).is_ok());
-        assert!(lookup::<3, EcgGvr>(COULOMB).is_err() && lookup::<3, FloatingEcg>(COULOMB).is_err());
     }
 }
 

@@ -55,7 +55,7 @@ fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<
         (delta::NAME, 1, one_vector!(delta::element::<D, F>)),
         (momentum::P2, 1, one_vector!(momentum::p2::<D, F>)),
         (momentum::P4, 1, quartic),
-        (drachmann::COULOMB, 1, drachmann::coulomb::<D, F>()),
+        (drachmann::COULOMB, 1, Some(drachmann::coulomb::<D, F>())),
         (drachmann::GRADIENT, 1, Some(drachmann::gradient_inv_r::<D, F>)),
         (orbit::NAME, 3, orbit::element_for::<D, F>()),
         (angular::NAME, 1, F::ANGULAR.and_then(|_| one_vector!(angular::element::<D, F>))),
