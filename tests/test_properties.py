@@ -130,7 +130,7 @@ def test_properties_of_a_ladder_level_are_its_evaluated_expectation_values():
     assert v1["energy"] == r["levels"][1]["energy"] and v1["expectation"] == r["levels"][1]["expectation"]
     assert set(v1["expectation"]) == set(reported) and v1["units"]["delta"] == "bohr⁻³"
     assert v1["not_derived"] == [name for name in OPERATORS if name not in derived]
-    assert "breit_pauli" not in v1 and "delta_regularised" not in v1  # no p⁴ or orbit–orbit; δ not asked for
+    assert "breit_pauli" in v1 and "delta_regularised" not in v1  # δ regularised only when asked for
     pp0, pp1 = ({k: v["p-p"] for k, v in p["expectation"].items() if OPERATORS[k].acts_on == "pairs"} for p in (v0, v1))
     assert pp1["r"] > pp0["r"] and pp1["r2"] > pp0["r2"] and pp1["inv_r"] < pp0["inv_r"]
     assert abs(pp0["delta"]) < 1e-9 * v0["expectation"]["delta"]["e-p"]

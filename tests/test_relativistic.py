@@ -8,9 +8,7 @@ import numpy as np
 import pytest
 
 import prebo
-from prebo import relativistic
 from prebo.cli import main
-from prebo.errors import UnsupportedError
 from prebo.relativistic import ALPHA, terms
 
 from conftest import ROOT, hydrogen_s
@@ -115,14 +113,42 @@ def test_a_regularised_contact_density_replaces_the_direct_one():
     assert given["classes"]["spin_spin"]["e-e"] == 3 * direct["classes"]["spin_spin"]["e-e"]
 
 
-def test_a_family_without_p4_is_refused_in_one_line():
-    """ECG-GVR functions have no ⟨p⁴⟩ element: one line naming it; `properties` lists the block as
-    not derived instead of failing."""
-    basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json")
-    with pytest.raises(UnsupportedError, match=r"^Breit–Pauli correction: operator 'p4' is not derived for "
-                                               r"ecg-gvr functions$"):
-        relativistic.breit_pauli(basis, {})
-    assert relativistic.missing(basis.family)[0] == "p4"
+def hydrogen_2p(mu: float) -> dict:
+    """The expectation values of hydrogen's 2p level with reduced mass μ: ⟨p⁴⟩ = μ⁴(8n/(2l + 1) − 3)/n⁴
+    = 7μ⁴/48 (Bethe & Salpeter, eq. 3.26), no contact density, and ⟨p_e·(δ + r̂r̂)/r·p_p⟩ =
+    −∫r(2R′² + l(l + 1)R²/r²)dr = −μ³/8 for ψ = R(r)Y_lm (|∇ψ|² and |r̂·∇ψ|² averaged over angles;
+    R = μ^{3/2} μr e^{−μr/2}/(2√6), docs/relativistic.md)."""
+    return {"p4": {"e": 7 * mu**4 / 48, "p": 7 * mu**4 / 48}, "delta": {"e-p": 0.0},
+            "orbit_orbit": {"e-p": -mu**3 / 8}}
+
+
+def test_hydrogen_2p_closed_forms_give_the_dirac_centroid_at_infinite_mass():
+    """The mass–velocity term of the 2p values at μ = 1 is the (2j + 1)-weighted mean of the Dirac
+    fine structure of 2p½ and 2p3/2, −(α²/2n³)(1/(j + ½) − 3/4n): spin–orbit splits the level about
+    it, and the Darwin and orbit–orbit terms vanish with δ = 0 and 1/M."""
+    dirac = {j: -A2 / 16 * (1 / (j + 0.5) - 3 / 8) for j in (0.5, 1.5)}
+    centroid = (2 * dirac[0.5] + 4 * dirac[1.5]) / 6
+    assert -A2 / 8 * hydrogen_2p(1.0)["p4"]["e"] == pytest.approx(centroid, rel=1e-15)
+
+
+#: measured in the 25 ECG-GVR functions of examples/bases/h2p (N = 1): ⟨p⁴⟩ 1.0e-6, the orbit–orbit
+#: value 1.7e-8 and the sum 1.0e-6 from their closed forms
+H2P_TOL = {"p4": 2e-6, "orbit_orbit": 5e-8, "total": 2e-6}
+
+
+def test_hydrogen_2p_from_ecg_gvr_matches_the_closed_forms():
+    """H 2p (finite proton mass) in ECG-GVR functions: ⟨p_i⁴⟩ of both particles and the orbit–orbit
+    value within H2P_TOL of `hydrogen_2p`, and the Breit–Pauli sum within H2P_TOL["total"] of the
+    closed forms' (the mass–velocity and orbit–orbit terms; no contact density in a p state)."""
+    basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2p" / "basis.json")
+    m = basis.system.masses
+    exact = hydrogen_2p(m[0] * m[1] / (m[0] + m[1]))
+    got = prebo.properties(basis)
+    for name in ("p4", "orbit_orbit"):
+        for c, want in exact[name].items():
+            assert abs(got["expectation"][name][c] / want - 1) < H2P_TOL[name], (name, c, got["expectation"][name][c])
+    want = terms(basis.system, exact)["Eh"]["total"]
+    assert abs(got["breit_pauli"]["Eh"]["total"] / want - 1) < H2P_TOL["total"], got["breit_pauli"]["Eh"]
 
 
 #: relative error allowed per expectation value in 80 even-tempered s Gaussians (conftest.hydrogen_s,
@@ -152,10 +178,10 @@ def test_hydrogen_1s_and_2s_from_plain_ecgs_match_the_closed_forms():
         assert abs(got["Eh"]["total"] / exact["Eh"]["total"] - 1) < TOTAL_TOL, (n, got["Eh"]["total"])
 
 
-def test_prebo_properties_prints_the_terms_and_leaves_them_out_for_ecg_gvr(capsys):
+def test_prebo_properties_prints_the_terms_for_every_family(capsys):
     """`prebo properties`: He's table has the Breit–Pauli block (its JSON the terms per class: the
-    e–e contact, Darwin terms for the electrons only about the spin-0 α particle); the properties of
-    an ECG-GVR basis have no Breit–Pauli block, its family lacking ⟨p⁴⟩."""
+    e–e contact, Darwin terms for the electrons only about the spin-0 α particle); so have the
+    properties of an ECG-GVR basis (H2⁺: the contact of the identical spin-½ protons)."""
     he = str(ROOT / "examples" / "bases" / "he" / "basis.json")
     assert main(["properties", he, "--json"]) == 0
     bp = json.loads(capsys.readouterr().out)["breit_pauli"]
@@ -163,4 +189,5 @@ def test_prebo_properties_prints_the_terms_and_leaves_them_out_for_ecg_gvr(capsy
     assert bp["Eh"]["total"] == pytest.approx(math.fsum(v for k, v in bp["Eh"].items() if k != "total"), rel=1e-15)
     assert main(["properties", he]) == 0 and "Breit–Pauli correction" in capsys.readouterr().out
     gvr = prebo.Basis.load(ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json").subset(range(20))
-    assert "breit_pauli" not in prebo.properties(gvr) and relativistic.missing(gvr.family)[0] == "p4"
+    bp = prebo.properties(gvr)["breit_pauli"]
+    assert set(bp["classes"]["darwin"]) == {"e-p", "p-p"} and set(bp["classes"]["spin_spin"]) == {"p-p"}

@@ -6,7 +6,7 @@
   BASIS --root k` prints and `prebo.properties(basis, root=k)` returns. ⟨δ³(r_ij)⟩ is the direct
   expectation value, which Gaussians, lacking the cusp, reach slowly (hydrogen 1s in 80
   even-tempered Gaussians: 1.8e-4 low, against 2e-11 for ⟨r⟩). With them, the level's
-  Breit–Pauli correction (relativistic.py) where the family evaluates its operators.
+  Breit–Pauli correction (relativistic.py).
 - `densities`: the pictures of several levels — the distribution P(r) = 4πr²ρ̄(r) of every
   inter-particle distance and of every particle's distance from the centre of mass, ρ̄ the
   spherically averaged density (`expectation.densities`), on a grid; `csv` its text, which
@@ -24,7 +24,7 @@ from . import drachmann, eigen
 from .basis import Basis
 from .errors import InputError
 from .expectation import OPERATORS
-from .relativistic import NEEDS, breit_pauli
+from .relativistic import NEEDS, terms
 from .results import evaluate, grids
 from .validation import Integer, checked
 
@@ -74,11 +74,11 @@ def reported(family, regularised: bool | None = None) -> list[str]:
 def corrections(basis, level: dict) -> dict:
     """What the expectation values of a level of `basis` ({"energy", "expectation": {operator:
     {class: value}}}, a level of `results.evaluate`) give beyond themselves, where they hold the
-    operators: "breit_pauli", its Breit–Pauli correction (`relativistic.breit_pauli`), and
+    operators: "breit_pauli", its Breit–Pauli correction (`relativistic.terms`), and
     "delta_regularised", {pair class: Drachmann's ⟨δ³(r_ij)⟩} (`drachmann.regularised`)."""
     out, have = {}, set(level.get("expectation", {}))
     if set(NEEDS) <= have:
-        out["breit_pauli"] = breit_pauli(basis, level["expectation"])
+        out["breit_pauli"] = terms(basis.system, level["expectation"])
     if set(drachmann.TERMS) <= have:
         out["delta_regularised"] = drachmann.regularised(basis.system, level["expectation"], level["energy"])
     return out

@@ -22,8 +22,7 @@ from __future__ import annotations
 
 import math
 
-from .errors import UnsupportedError
-from .expectation import OPERATORS, members
+from .expectation import members
 from .results import HARTREE_CM
 
 #: the fine-structure constant, CODATA 2018 (E. Tiesinga et al., Rev. Mod. Phys. 93, 025010 (2021))
@@ -37,26 +36,11 @@ NEEDS = ("p4", "delta", "orbit_orbit")
 TERMS = ("mass_velocity", "darwin", "orbit_orbit", "spin_spin")
 
 
-def missing(family) -> list[str]:
-    """The operators of NEEDS that the basis family `family` does not evaluate."""
-    return [name for name in NEEDS if name not in OPERATORS or not OPERATORS[name].evaluates(family)]
-
-
 def dirac(particle) -> bool:
     """Whether `particle` is taken for a Dirac point particle: spin ½, with g = 2 and the Darwin
     term (1/8m²)∇²V of the Foldy–Wouthuysen reduction. Spin 0 (Klein–Gordon) has no Darwin term;
     the Darwin-like terms of higher spins depend on the particle's structure and are left out."""
     return particle.spin == 0.5
-
-
-def breit_pauli(basis, expectation: dict, delta: dict | None = None) -> dict:
-    """The Breit–Pauli correction (`terms`) of one level of `basis` from its expectation values;
-    UnsupportedError naming the first operator of NEEDS that the basis family does not evaluate."""
-    lacking = missing(basis.family)
-    if lacking:
-        raise UnsupportedError(f"Breit–Pauli correction: operator {lacking[0]!r} is not derived for "
-                               f"{basis.family.name} functions")
-    return terms(basis.system, expectation, delta)
 
 
 def terms(system, expectation: dict, delta: dict | None = None) -> dict:

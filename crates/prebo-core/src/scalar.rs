@@ -5,7 +5,7 @@
 use std::ops::{Add, Div, Mul, Sub};
 
 use nalgebra::{ComplexField, RealField};
-use num_dual::DualSVec64;
+use num_dual::{DualSVec64, HyperDual64};
 
 /// Arithmetic with itself and with `f64` constants, and the few functions of one value the shared
 /// formulas need. The functions are associated functions (`T::sqrt(x)`), not methods, so they do
@@ -69,28 +69,41 @@ impl Scalar for f64 {
     }
 }
 
-impl<const W: usize> Scalar for DualSVec64<W> {
-    #[inline(always)]
-    fn of(x: f64) -> Self {
-        Self::from(x)
-    }
-    #[inline(always)]
-    fn sqrt(x: Self) -> Self {
-        ComplexField::sqrt(x)
-    }
-    #[inline(always)]
-    fn ln(x: Self) -> Self {
-        ComplexField::ln(x)
-    }
-    #[inline(always)]
-    fn clamp_unit(x: Self) -> Self {
-        RealField::clamp(x, Self::from(-1.0), Self::from(1.0))
-    }
-    #[inline(always)]
-    fn powu(x: Self, k: u32) -> Self {
-        ComplexField::powi(x, k as i32)
-    }
+/// `Scalar` for a num-dual type `$t` (with generics `$g`): its own functions, and `clamp_unit`
+/// given as a closure of one argument.
+macro_rules! dual_scalar {
+    ([$($g:tt)*] $t:ty, |$x:ident| $clamp:expr) => {
+        impl<$($g)*> Scalar for $t {
+            #[inline(always)]
+            fn of(x: f64) -> Self {
+                Self::from(x)
+            }
+            #[inline(always)]
+            fn sqrt(x: Self) -> Self {
+                ComplexField::sqrt(x)
+            }
+            #[inline(always)]
+            fn ln(x: Self) -> Self {
+                ComplexField::ln(x)
+            }
+            #[inline(always)]
+            fn clamp_unit($x: Self) -> Self {
+                $clamp
+            }
+            #[inline(always)]
+            fn powu(x: Self, k: u32) -> Self {
+                ComplexField::powi(x, k as i32)
+            }
+        }
+    };
 }
+
+dual_scalar!([const W: usize] DualSVec64<W>, |x| RealField::clamp(x, Self::from(-1.0), Self::from(1.0)));
+
+// Hyper-dual numbers (one mixed second derivative), for ECG-GVR's `p_g⁴` and orbit–orbit elements
+// (`families::gvr::gvr_momentum`): `clamp_unit` clamps the value only, since the shared formulas
+// are analytic where they clamp (ρ = z/√(xy), `gvr_series::omega`) and the derivatives stand.
+dual_scalar!([] HyperDual64, |x| Self { re: x.re.clamp(-1.0, 1.0), ..x });
 
 #[cfg(test)]
 mod tests {

@@ -25,6 +25,7 @@ use crate::error::{CoreError, Result};
 use crate::gradient::Dual;
 use crate::images::Transform;
 use crate::matrices::Matrices;
+use crate::operators::{orbit, ElementFn};
 
 pub mod floating;
 pub mod gvr;
@@ -179,8 +180,7 @@ pub enum Shape {
 }
 
 /// What a family's function is beside its Gaussian `exp(−tr((r − s)ᵀ A (r − s)))`: the operators
-/// whose elements are written for a bare Gaussian (`operators::orbit`, `operators::drachmann`)
-/// ask this of a family.
+/// whose elements are written for a bare Gaussian (`operators::drachmann`) ask this of a family.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Form {
     /// The Gaussian about the origin (plain ECGs).
@@ -218,9 +218,12 @@ pub trait Family<const D: usize>: Sized + 'static {
     const ORIENTED: bool = true;
     /// What a function is beside its Gaussian (`Form`).
     const FORM: Form;
-    /// The element of the momentum operators `p_g²` and `p_g⁴` (`Momentum`), or `None` where the
-    /// family's `p_g⁴` is not derived (`operators::lookup` then refuses it).
-    const MOMENTUM: Option<Momentum<D, Self>>;
+    /// The element of the momentum operators `p_g²` and `p_g⁴` (`Momentum`).
+    const MOMENTUM: Momentum<D, Self>;
+    /// The element of the orbit–orbit operator `p_g·M(r_w)·p_h` (`operators::orbit`): by default
+    /// that of functions whose gradients are a Gaussian times a linear polynomial (plain and
+    /// floating ECGs), for ECG-GVR its own.
+    const ORBIT: ElementFn<D, Self> = orbit::element::<D, Self>;
     /// The element of `N_TI²` where the functions are not its eigenfunctions (`Angular`), `None`
     /// where they are (`N_TI² φ = N(N + 1) φ`).
     const ANGULAR: Option<Angular<D, Self>> = None;
@@ -277,11 +280,10 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// The Hamiltonian's operators (Λ, the Coulomb pairs, the CM mass) the context holds.
     fn operators(ctx: &Self::Context) -> &Operators<D>;
 
-    /// `<phi_I| p_g² |phi_J>` (`operators::momentum`): `MOMENTUM`'s, or a family without it
-    /// gives its kinetic element with `Λ = g g^T`.
+    /// `<phi_I| p_g² |phi_J>` (`operators::momentum`): `MOMENTUM`'s, where a family has no
+    /// cheaper one (ECG-GVR: its kinetic element with `Λ = g g^T`).
     fn momentum_square(bra: &Self::Function<f64>, ket: &Self::Function<f64>, ctx: &Self::Context, g: &Vector<D>) -> f64 {
-        let element = Self::MOMENTUM.unwrap_or_else(|| panic!("p_g²: no element for {} functions", Self::NAME));
-        element(bra, ket, ctx, g).0
+        (Self::MOMENTUM)(bra, ket, ctx, g).0
     }
 
     /// How the damped overlap of `bra` and `ket` depends on the damping (`Shape`).

@@ -46,7 +46,6 @@ macro_rules! one_vector {
 /// The registered operators: name, arity (vectors per operator) and element function (`None`:
 /// not derived for the family `F`).
 fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<ElementFn<D, F>>)> {
-    let quartic = F::MOMENTUM.and_then(|_| one_vector!(momentum::p4::<D, F>));
     vec![
         (r2::NAME, 1, one_vector!(r2::element::<D, F>)),
         (distance::NAME, 1, one_vector!(distance::element::<D, F>)),
@@ -54,10 +53,10 @@ fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<
         (inverse_square::NAME, 1, one_vector!(inverse_square::element::<D, F>)),
         (delta::NAME, 1, one_vector!(delta::element::<D, F>)),
         (momentum::P2, 1, one_vector!(momentum::p2::<D, F>)),
-        (momentum::P4, 1, quartic),
+        (momentum::P4, 1, one_vector!(momentum::p4::<D, F>)),
         (drachmann::COULOMB, 1, Some(drachmann::coulomb::<D, F>())),
         (drachmann::GRADIENT, 1, Some(drachmann::gradient_inv_r::<D, F>)),
-        (orbit::NAME, 3, orbit::element_for::<D, F>()),
+        (orbit::NAME, 3, Some(F::ORBIT)),
         (angular::NAME, 1, F::ANGULAR.and_then(|_| one_vector!(angular::element::<D, F>))),
     ]
 }
@@ -123,6 +122,14 @@ pub(crate) mod fixtures {
 
     pub fn w() -> Vector<D> {
         Vector::<D>::new(1.0, -1.0, 0.0)
+    }
+
+    /// The nodes and weights of the M-point Gauss–Hermite rule, `∫ e^{−y²} f(y) dy` (Golub–Welsch).
+    pub fn gauss_hermite<const M: usize>() -> [(f64, f64); M] {
+        let off = |i: usize, j: usize| (i.max(j) as f64 / 2.0).sqrt(); // (J)_{k−1,k} = √(k/2)
+        let jacobi = nalgebra::DMatrix::<f64>::from_fn(M, M, |i, j| if i.abs_diff(j) == 1 { off(i, j) } else { 0.0 });
+        let eig = nalgebra::SymmetricEigen::new(jacobi);
+        std::array::from_fn(|k| (eig.eigenvalues[k], std::f64::consts::PI.sqrt() * eig.eigenvectors[(0, k)].powi(2)))
     }
 
     /// `got` within `tol` of `want`, relative.

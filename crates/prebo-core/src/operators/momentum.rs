@@ -4,8 +4,8 @@
 //! centre-of-mass frame, the `p_i` of the mass–velocity term (§5). `g` transforms like `∇`, not
 //! like `r`: in coordinates `x = U_x r` it is `U_x g`. The elements are the family's
 //! (`Family::MOMENTUM`): plain ECGs `6τ S_IJ` and `60τ² S_IJ`, `τ = g^T A_I (A_I + A_J)^{-1} A_J g`
-//! (eqs. 22–23); floating ECGs eq. (25). ECG-GVR has `p_g²` as its kinetic element with
-//! `Λ = g g^T` and no `p_g⁴` (eq. 26 is not derived): `operators::lookup` refuses that for it.
+//! (eqs. 22–23); floating ECGs eq. (25); ECG-GVR the overlap's generating function (eq. 26b,
+//! `gvr_momentum`), its `p_g²` the kinetic element with `Λ = g g^T`.
 use crate::ecg::Vector;
 use crate::families::Family;
 
@@ -17,11 +17,9 @@ pub fn p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Functio
     F::momentum_square(bra, ket, ctx, g)
 }
 
-/// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴) of a family that has it
-/// (`operators::lookup` checks).
+/// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴; `Family::MOMENTUM`).
 pub fn p4<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
-    let element = F::MOMENTUM.unwrap_or_else(|| panic!("p_g⁴: no element for {} functions", F::NAME));
-    element(bra, ket, ctx, g).1
+    (F::MOMENTUM)(bra, ket, ctx, g).1
 }
 
 #[cfg(test)]
@@ -30,19 +28,20 @@ mod tests {
     //! against `∫ Δ_gφ_I Δ_gφ_J` by quadrature, with `Δ_g` the second derivatives of the
     //! functions themselves in dual numbers; the Gaussian ratio 5/3; floating ECGs at `s = 0`
     //! equal to plain ECGs; `Σ_i p_{g_i}²/(2 m_i)` with `g_i = e_i − μ_i 1` equal to the family's
-    //! `T_TI` (plain, floating and ECG-GVR functions); ECG-GVR's `p_g⁴` refused by `lookup`.
-    use nalgebra::{SMatrix, SymmetricEigen};
+    //! `T_TI` (plain, floating and ECG-GVR functions); ECG-GVR's generating-function elements at
+    //! K = N = 0 equal to plain ECGs', and for K, N > 0 against the same quadrature (complex
+    //! `(v_x + i v_y)^N`) and its `p_g²` against its kinetic element.
+    use nalgebra::SMatrix;
     use num_dual::{Dual2_64, DualNum};
 
     use super::*;
     use crate::ecg::{Mat, Operators};
-    use crate::error::CoreError;
     use crate::families::floating::fecg::{Centres, Fecg};
     use crate::families::floating::FloatingEcg;
     use crate::families::gvr::gvr_element::{Gvr, GvrOps};
-    use crate::families::gvr::EcgGvr;
+    use crate::families::gvr::{gvr_momentum, EcgGvr};
     use crate::families::plain::PlainEcg;
-    use crate::operators::fixtures::{centres, close, exponent, plain, D};
+    use crate::operators::fixtures::{centres, close, exponent, gauss_hermite, plain, D};
     use crate::operators::{lookup, names};
 
     /// Kinetic `Λ = g g^T`, no Coulomb pairs.
@@ -83,14 +82,6 @@ mod tests {
         eprintln!("p2 against T(Λ = g gᵀ): largest relative deviation {worst:.1e}");
     }
 
-    /// The nodes and weights of the 4-point Gauss–Hermite rule, `∫ e^{−y²} f(y) dy` (Golub–Welsch).
-    fn gauss_hermite() -> [(f64, f64); 4] {
-        let off = |i: usize, j: usize| (i.max(j) as f64 / 2.0).sqrt(); // (J)_{k−1,k} = √(k/2)
-        let jacobi = SMatrix::<f64, 4, 4>::from_fn(|i, j| if i.abs_diff(j) == 1 { off(i, j) } else { 0.0 });
-        let eig = SymmetricEigen::new(jacobi);
-        std::array::from_fn(|k| (eig.eigenvalues[k], std::f64::consts::PI.sqrt() * eig.eigenvectors[(0, k)].powi(2)))
-    }
-
     /// `φ(r)` and `Δ_gφ(r) = Σ_c ∂²/∂t² φ(r + t g e_c^T)` of `φ = exp(−tr((r − s)^T A (r − s)))`,
     /// the second derivative by dual numbers.
     fn laplacian(a: &Mat<2>, s: &Centres<2>, r: &Centres<2>, g: &Vector<2>) -> (f64, f64) {
@@ -110,31 +101,45 @@ mod tests {
         (along(0).re, (0..3).map(|c| along(c).v2).sum())
     }
 
-    /// `(∫ φ_Iφ_J, −∫ φ_I Δ_gφ_J, ∫ Δ_gφ_I Δ_gφ_J)` of unnormalised functions in two coordinates,
-    /// over the common factor `|A_I + A_J|^{−3/2}`: the 4-point Gauss–Hermite product rule in
-    /// `y = L^T (r − r̄)`, `L L^T = A_I + A_J`, `r̄ = (A_I + A_J)^{-1}(A_I s_I + A_J s_J)`, exact for
-    /// the Gaussian `φ_Iφ_J` times polynomials of degree ≤ 7 in `r`.
-    fn quadrature(ai: &Mat<2>, si: &Centres<2>, aj: &Mat<2>, sj: &Centres<2>, g: &Vector<2>) -> [f64; 3] {
+    /// `(∫ φ_I*φ_J, −∫ φ_I* Δ_gφ_J, ∫ (Δ_gφ_I)* Δ_gφ_J)` in two coordinates, over the common factor
+    /// `|A_I + A_J|^{−3/2}`, of the functions' `[[Re φ, Im φ], [Re Δ_gφ, Im Δ_gφ]]` at r (`values`):
+    /// the M-point Gauss–Hermite product rule in `y = L^T (r − r̄)`, `L L^T = A_I + A_J`,
+    /// `r̄ = (A_I + A_J)^{-1}(A_I s_I + A_J s_J)`, exact for the Gaussian `φ_Iφ_J` times polynomials
+    /// of degree ≤ 2M − 1 in `r`.
+    fn quadrature<const M: usize>(
+        ai: &Mat<2>,
+        si: &Centres<2>,
+        aj: &Mat<2>,
+        sj: &Centres<2>,
+        values: &dyn Fn(&Centres<2>) -> ([[f64; 2]; 2], [[f64; 2]; 2]),
+    ) -> [f64; 3] {
         let b = ai + aj;
         let rbar = b.try_inverse().unwrap() * (ai * si + aj * sj);
         let back = b.cholesky().unwrap().l().transpose().try_inverse().unwrap(); // r = r̄ + L^{-T} y
-        let rule = gauss_hermite();
+        let rule = gauss_hermite::<M>();
+        let dot = |p: [f64; 2], q: [f64; 2]| p[0] * q[0] + p[1] * q[1]; // Re(p* q)
         let mut sums = [0.0; 3];
-        for index in 0..4usize.pow(6) {
+        for index in 0..M.pow(6) {
             let (mut y, mut weight) = (Centres::<2>::zeros(), 1.0);
             for e in 0..6 {
-                let (node, w) = rule[index / 4usize.pow(e as u32) % 4];
+                let (node, w) = rule[index / M.pow(e as u32) % M];
                 y[(e % 2, e / 2)] = node;
                 weight *= w;
             }
             let r = rbar + back * y;
             let weight = weight * y.norm_squared().exp();
-            let ((fi, lap_i), (fj, lap_j)) = (laplacian(ai, si, &r, g), laplacian(aj, sj, &r, g));
-            for (sum, term) in sums.iter_mut().zip([fi * fj, -fi * lap_j, lap_i * lap_j]) {
+            let ([fi, lap_i], [fj, lap_j]) = values(&r);
+            for (sum, term) in sums.iter_mut().zip([dot(fi, fj), -dot(fi, lap_j), dot(lap_i, lap_j)]) {
                 *sum += weight * term;
             }
         }
         sums
+    }
+
+    /// `laplacian` as `quadrature` reads it (real functions).
+    fn real(a: &Mat<2>, s: &Centres<2>, r: &Centres<2>, g: &Vector<2>) -> [[f64; 2]; 2] {
+        let (f, lap) = laplacian(a, s, r, g);
+        [[f, 0.0], [lap, 0.0]]
     }
 
     #[test]
@@ -149,7 +154,7 @@ mod tests {
             let (gi, gj) = (plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1));
             let s = <PlainEcg as Family<2>>::overlap(&gi, &gj, &go);
             let got = [p2::<2, PlainEcg>(&gi, &gj, &go, &g), p4::<2, PlainEcg>(&gi, &gj, &go, &g)];
-            let q = quadrature(&ai, &zero, &aj, &zero, &g);
+            let q = quadrature::<4>(&ai, &zero, &aj, &zero, &|r| (real(&ai, &zero, r, &g), real(&aj, &zero, r, &g)));
             for k in 0..2 {
                 let want = q[k + 1] / q[0] * s;
                 assert!(close(got[k], want, 1e-12), "plain, p{}: {} vs {want}", 2 * k + 2, got[k]);
@@ -161,7 +166,7 @@ mod tests {
                 let (fi, fj) = (Fecg::new(ai, ci, 1.0, 0).unwrap(), Fecg::new(aj, cj, 1.0, 1).unwrap());
                 let s = <FloatingEcg as Family<2>>::overlap(&fi, &fj, &ops);
                 let got = [p2::<2, FloatingEcg>(&fi, &fj, &ops, &g), p4::<2, FloatingEcg>(&fi, &fj, &ops, &g)];
-                let q = quadrature(&ai, &ci, &aj, &cj, &g);
+                let q = quadrature::<4>(&ai, &ci, &aj, &cj, &|r| (real(&ai, &ci, r, &g), real(&aj, &cj, r, &g)));
                 for k in 0..2 {
                     let want = q[k + 1] / q[0] * s;
                     assert!(close(got[k], want, 1e-12), "floating, spread {spread}, p{}: {} vs {want}", 2 * k + 2, got[k]);
@@ -245,17 +250,96 @@ mod tests {
     }
 
     #[test]
-    fn ecg_gvr_functions_are_refused_p4_in_one_line() {
+    fn ecg_gvr_functions_at_k_and_n_zero_are_plain_ecgs() {
+        let mut worst: f64 = 0.0;
+        for g in vectors() {
+            let go = GvrOps::new(squared(&g), 0, 0).unwrap();
+            for (si, sj) in SEEDS {
+                let (gi, gj) = (plain(exponent(si), 1.0, &go, 0), plain(exponent(sj), 1.0, &go, 1));
+                let want = [p2::<D, PlainEcg>(&gi, &gj, &go, &g), p4::<D, PlainEcg>(&gi, &gj, &go, &g)];
+                let (p2_h, p4_h) = gvr_momentum::momentum(&gi, &gj, &go, &g);
+                assert!(close(p2_h, want[0], 1e-13) && close(p4_h, want[1], 1e-13), "{:?} vs {want:?}", (p2_h, p4_h));
+                worst = worst.max((p2_h / want[0] - 1.0).abs()).max((p4_h / want[1] - 1.0).abs());
+            }
+        }
+        eprintln!("ECG-GVR at K = N = 0 against plain ECGs: largest relative deviation {worst:.1e}");
+    }
+
+    #[test]
+    fn ecg_gvr_p2_by_the_generating_function_is_its_kinetic_element() {
+        let mut worst: f64 = 0.0;
+        for g in vectors() {
+            for n in [0, 1, 2] {
+                let go = GvrOps::new(squared(&g), n, 3).unwrap();
+                for ((si, sj), (ki, kj)) in SEEDS.into_iter().zip([(0, 3), (2, 1), (3, 3)]) {
+                    let (ui, uj) = (Vector::<D>::new(0.4, -1.0, 0.6), Vector::<D>::new(-0.9, 0.2, 0.7 + si));
+                    let fi = Gvr::new(exponent(si), ui, ki, 1.0, &go, 0).unwrap();
+                    let fj = Gvr::new(exponent(sj), uj, kj, 1.0, &go, 1).unwrap();
+                    let want = p2::<D, EcgGvr>(&fi, &fj, &go, &g);
+                    let got = gvr_momentum::momentum(&fi, &fj, &go, &g).0;
+                    assert!(close(got, want, 1e-12), "N = {n}, K = ({ki}, {kj}): {got} vs {want}");
+                    worst = worst.max((got / want - 1.0).abs());
+                }
+            }
+        }
+        eprintln!("ECG-GVR p2 (eq. 26b) against its kinetic element: largest relative deviation {worst:.1e}");
+    }
+
+    /// `(φ, Δ_gφ)` of `φ = |v|^{2K} (v_x + i v_y)^N exp(−tr(rᵀAr))`, `v = uᵀr`, each as (real,
+    /// imaginary) parts, the second derivatives along `g e_c^T` by dual numbers.
+    fn gvr_laplacian(a: &Mat<2>, u: &Vector<2>, k: u32, n: u32, r: &Centres<2>, g: &Vector<2>) -> [[f64; 2]; 2] {
+        let along = |c: usize| {
+            let at = |kk: usize, l: usize| Dual2_64::new(r[(kk, l)], if l == c { g[kk] } else { 0.0 }, 0.0);
+            let (mut q, mut v) = (Dual2_64::from_re(0.0), [Dual2_64::from_re(0.0); 3]);
+            for l in 0..3 {
+                for kk in 0..2 {
+                    v[l] += at(kk, l) * u[kk];
+                    for m in 0..2 {
+                        q += at(kk, l) * at(m, l) * a[(kk, m)];
+                    }
+                }
+            }
+            let radial = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).powi(k as i32) * (-q).exp();
+            let (mut re, mut im) = (radial, Dual2_64::from_re(0.0));
+            for _ in 0..n {
+                (re, im) = (re * v[0] - im * v[1], re * v[1] + im * v[0]);
+            }
+            [re, im]
+        };
+        let sides = [0, 1, 2].map(along);
+        [[sides[0][0].re, sides[0][1].re], [0, 1].map(|p| sides.iter().map(|side| side[p].v2).sum())]
+    }
+
+    #[test]
+    fn ecg_gvr_p2_and_p4_match_quadrature_of_the_laplacians() {
+        let g = Vector::<2>::new(0.8, -0.35);
+        let go = |n: u32| GvrOps::new(squared(&g), n, 2).unwrap();
+        let (ui, uj) = (Vector::<2>::new(0.7, -0.4), Vector::<2>::new(0.3, 0.9));
+        let mut worst: f64 = 0.0;
+        // 6 Gauss–Hermite nodes a side are exact to degree 11 ≥ (2K_I + N + 2) + (2K_J + N + 2)
+        for ((si, sj), (ki, kj, n)) in SEEDS.into_iter().zip([(1, 0, 1), (2, 1, 0), (0, 1, 2)]) {
+            let (ai, aj) = (exponent::<2>(si), exponent::<2>(sj));
+            let ctx = go(n);
+            let (fi, fj) = (Gvr::new(ai, ui, ki, 1.0, &ctx, 0).unwrap(), Gvr::new(aj, uj, kj, 1.0, &ctx, 1).unwrap());
+            let s = <EcgGvr as Family<2>>::overlap(&fi, &fj, &ctx);
+            let got = gvr_momentum::momentum(&fi, &fj, &ctx, &g);
+            let zero = Centres::<2>::zeros();
+            let q = quadrature::<6>(&ai, &zero, &aj, &zero, &|r| (gvr_laplacian(&ai, &ui, ki, n, r, &g), gvr_laplacian(&aj, &uj, kj, n, r, &g)));
+            for (k, got) in [got.0, got.1].into_iter().enumerate() {
+                let want = q[k + 1] / q[0] * s;
+                assert!(close(got, want, 1e-11), "K = ({ki}, {kj}), N = {n}, p{}: {got} vs {want}", 2 * k + 2);
+                worst = worst.max((got / want - 1.0).abs());
+            }
+        }
+        eprintln!("ECG-GVR p2, p4 against quadrature: largest relative deviation {worst:.1e}");
+    }
+
+    #[test]
+    fn every_family_evaluates_p2_and_p4() {
         assert!(names().contains(&P2) && names().contains(&P4));
         for name in [P2, P4] {
             assert!(lookup::<D, PlainEcg>(name).is_ok() && lookup::<D, FloatingEcg>(name).is_ok());
-        }
-        assert!(lookup::<D, EcgGvr>(P2).is_ok());
-        match lookup::<D, EcgGvr>(P4) {
-            Err(CoreError::Unsupported(msg)) => {
-                assert!(msg.contains(P4) && msg.contains("ecg-gvr") && !msg.contains('\n'), "{msg}")
-            }
-            other => panic!("{P4}: {:?}", other.map(|_| ())),
+            assert!(lookup::<D, EcgGvr>(name).is_ok());
         }
     }
 }

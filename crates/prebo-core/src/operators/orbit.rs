@@ -10,24 +10,17 @@
 //! eq. 28), `(2S/√(πq)) ∫_0^1 e^{−λτ²} P(τ²) dτ` with `P` a quartic in `u` (eq. 35), so a sum
 //! of five Boys functions (eq. 36); plain ECGs `16 τ S/√(πq)` (eq. 37).
 //!
-//! Derived for the families whose gradients are a Gaussian times a linear polynomial: plain
-//! ECGs and floating ECGs (one formula; a plain ECG has no centres). ECG-GVR is not derived: its
-//! gradient carries the derivatives of `|v|^{2K}(v_x + i v_y)^N`, and eq. (30)'s kinetic-element
-//! route covers the `δ_ab` part only — the `r̂_a r̂_b` part weights the gradients by `r_w` itself,
-//! which no kinetic element of damped functions gives.
+//! This is the element of the families whose gradients are a Gaussian times a linear polynomial,
+//! plain and floating ECGs (one formula; a plain ECG has no centres), and `Family::ORBIT`'s
+//! default. ECG-GVR gradients carry the derivatives of `|v|^{2K}(v_x + i v_y)^N`: their element
+//! is the overlap's generating function's (`gvr_momentum::orbit`, eq. 26c).
 use std::f64::consts::PI;
 
 use super::drachmann::boys;
-use super::ElementFn;
 use crate::ecg::Vector;
-use crate::families::{Family, Form};
+use crate::families::Family;
 
 pub const NAME: &str = "orbit_orbit";
-
-/// The element where it is derived: plain and floating ECGs (module docs).
-pub fn element_for<const D: usize, F: Family<D>>() -> Option<ElementFn<D, F>> {
-    (F::FORM != Form::GlobalVector).then_some(element::<D, F> as ElementFn<D, F>)
-}
 
 /// `<φ_I| p_g · M(r_w) · p_h |φ_J>` for normalised functions, `v = [w, g, h]` (ħ²/bohr³).
 pub fn element<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
@@ -69,32 +62,34 @@ pub fn element<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Fu
 mod tests {
     //! Against an evaluation that uses neither the Gaussian moments nor eq. (35): eq. (34)'s
     //! t-integral by a Gauss–Legendre rule in `τ`, each damped integral
-    //! `∫ ∇_gφ_I·(1 + 2α y yᵀ)·∇_hφ_J e^{−αy²}` by the 3-point Gauss–Hermite product rule about
-    //! the damped Gaussian (exact: that Gaussian times a quartic), the gradients of the functions
-    //! themselves in dual numbers; two particles and three (laboratory frame, CM-separable
-    //! exponents `A 1 = c_A μ`), plain and floating ECGs. Symmetric in I ↔ J and g ↔ h; floating
-    //! ECGs at zero centres equal plain ECGs; ECG-GVR refused by `lookup`.
+    //! `∫ ∇_gφ_I*·(1 + 2α y yᵀ)·∇_hφ_J e^{−αy²}` by a Gauss–Hermite product rule about the damped
+    //! Gaussian (3 nodes, exact for that Gaussian times a quartic; 5 for ECG-GVR's polynomials),
+    //! the gradients of the functions themselves in dual numbers; two particles and three
+    //! (laboratory frame, CM-separable exponents `A 1 = c_A μ`), plain and floating ECGs, and
+    //! ECG-GVR with K, N > 0 for two. Symmetric in I ↔ J and g ↔ h; floating ECGs at zero centres
+    //! and ECG-GVR at K = N = 0 equal plain ECGs.
     use nalgebra::{Const, SMatrix, SVector, U1};
     use num_dual::{Derivative, DualNum, DualSVec64};
 
     use super::*;
     use crate::ecg::{Mat, Operators};
-    use crate::error::CoreError;
     use crate::families::gvr::gvr_element::{even_rule, Gvr, GvrOps};
     use crate::families::floating::fecg::{Centres, Fecg};
     use crate::families::floating::FloatingEcg;
     use crate::families::gvr::EcgGvr;
     use crate::families::plain::PlainEcg;
-    use crate::operators::fixtures::{centres, close, exponent, plain, separable};
-    use crate::operators::lookup;
+    use crate::operators::fixtures::{centres, close, exponent, gauss_hermite, plain, separable};
 
-    /// `φ(r) = exp(−Σ_c (r − s)_c^T A (r − s)_c)` and `∇_g φ` (a 3-vector): the derivatives in `t_c`
-    /// of `φ` at `r` moved by `t_c g` along the Cartesian axes `c`, in dual numbers.
-    fn gradient<const N: usize>(a: &Mat<N>, s: &Centres<N>, r: &Centres<N>, g: &Vector<N>) -> (f64, [f64; 3]) {
-        let d = SMatrix::<DualSVec64<3>, N, 3>::from_fn(|k, c| {
-            DualSVec64::new(r[(k, c)] - s[(k, c)], Derivative::some(SVector::<f64, 3>::ith(c, g[k])))
-        });
-        let mut e = DualSVec64::<3>::from_re(0.0);
+    /// A function's value and `∇_g φ` (a 3-vector) at r, each as (real, imaginary) parts.
+    type Value = ([f64; 2], [[f64; 2]; 3]);
+
+    /// `φ(r) = P(uᵀr) exp(−Σ_c (r − s)_c^T A (r − s)_c)` and `∇_g φ`: the derivatives in `t_c` of
+    /// `φ` at `r` moved by `t_c g` along the Cartesian axes `c`, in dual numbers; `P = 1` without
+    /// `gvr`, else `P(v) = |v|^{2K} (v_x + i v_y)^N` for `gvr = (u, K, N)`.
+    fn gradient<const N: usize>(a: &Mat<N>, s: &Centres<N>, gvr: Option<(&Vector<N>, u32, u32)>, r: &Centres<N>, g: &Vector<N>) -> Value {
+        type T = DualSVec64<3>;
+        let d = SMatrix::<T, N, 3>::from_fn(|k, c| T::new(r[(k, c)] - s[(k, c)], Derivative::some(SVector::<f64, 3>::ith(c, g[k]))));
+        let mut e = T::from_re(0.0);
         for c in 0..3 {
             for k in 0..N {
                 for l in 0..N {
@@ -102,14 +97,26 @@ mod tests {
                 }
             }
         }
-        let phi = (-e).exp();
-        let eps = phi.eps.unwrap_generic(Const::<3>, U1);
-        (phi.re, [eps[0], eps[1], eps[2]])
+        let (mut re, mut im) = ((-e).exp(), T::from_re(0.0));
+        if let Some((u, k, n)) = gvr {
+            let v: [T; 3] = std::array::from_fn(|c| (0..N).fold(T::from_re(0.0), |acc, l| acc + d[(l, c)] * u[l]));
+            re *= (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).powi(k as i32);
+            for _ in 0..n {
+                (re, im) = (re * v[0] - im * v[1], re * v[1] + im * v[0]);
+            }
+        }
+        let (dre, dim) = (re.eps.unwrap_generic(Const::<3>, U1), im.eps.unwrap_generic(Const::<3>, U1));
+        ([re.re, im.re], std::array::from_fn(|c| [dre[c], dim[c]]))
     }
 
-    /// `∫ f(r) φ_I φ_J e^{−α r_w²} dr` (unnormalised functions) by the 3-point Gauss–Hermite product
-    /// rule in `y = L^T (r − r̄_α)`, `L L^T = B + α w w^T`, `f` given `r`, `φ_I φ_J e^{−αy²}` and `y`.
-    fn damped<const N: usize>(
+    /// `Re(p* q)` of complex numbers as (real, imaginary) parts.
+    fn dot(p: [f64; 2], q: [f64; 2]) -> f64 {
+        p[0] * q[0] + p[1] * q[1]
+    }
+
+    /// `∫ f(r) φ_I* φ_J e^{−α r_w²} dr` (unnormalised functions) by the M-point Gauss–Hermite product
+    /// rule in `y = L^T (r − r̄_α)`, `L L^T = B + α w w^T`, `f` given `r`, `φ_I* φ_J e^{−αy²}` and `y`.
+    fn damped<const N: usize, const M: usize>(
         (ai, si, aj, sj): (&Mat<N>, &Centres<N>, &Mat<N>, &Centres<N>),
         w: &Vector<N>,
         alpha: f64,
@@ -119,12 +126,12 @@ mod tests {
         let rbar = b.try_inverse().unwrap() * (ai * si + aj * sj);
         let chol = b.cholesky().unwrap();
         let back = chol.l().transpose().try_inverse().unwrap();
-        let rule = [(0.0, 2.0 / 3.0), (1.5f64.sqrt(), 1.0 / 6.0), (-(1.5f64.sqrt()), 1.0 / 6.0)]; // weights / √π
+        let rule = gauss_hermite::<M>().map(|(node, weight)| (node, weight / std::f64::consts::PI.sqrt()));
         let mut sum = 0.0;
-        for index in 0..3usize.pow(3 * N as u32) {
+        for index in 0..M.pow(3 * N as u32) {
             let (mut y, mut weight) = (Centres::<N>::zeros(), 1.0);
             for e in 0..3 * N {
-                let (node, wt) = rule[index / 3usize.pow(e as u32) % 3];
+                let (node, wt) = rule[index / M.pow(e as u32) % M];
                 y[(e % N, e / N)] = node;
                 weight *= wt;
             }
@@ -135,28 +142,32 @@ mod tests {
         sum * std::f64::consts::PI.powf(1.5 * N as f64) / chol.l().diagonal().product().powi(3)
     }
 
+    /// One side of `quadrature`: a function's exponent, centres and polynomial (`gradient`).
+    type Side<'a, const N: usize> = (&'a Mat<N>, &'a Centres<N>, Option<(&'a Vector<N>, u32, u32)>);
+
     /// `<φ_I| p_g·M(r_w)·p_h |φ_J> / S_IJ` by eq. (34) with `t² = α = τ²/(q(1 − τ²))`:
-    /// `(2/√(πq)) ∫_0^1 (1 − τ²)^{−3/2} E(α) dτ` on `m` positive Gauss–Legendre nodes; with
-    /// `dyad = 0` its `δ_ab/r` part alone, `<∇_gφ_I| 1/r_w |∇_hφ_J> / S_IJ`.
-    fn quadrature<const N: usize>(fi: (&Mat<N>, &Centres<N>), fj: (&Mat<N>, &Centres<N>), v: &[Vector<N>; 3], m: usize, dyad: f64) -> f64 {
+    /// `(2/√(πq)) ∫_0^1 (1 − τ²)^{−3/2} E(α) dτ` on `m` positive Gauss–Legendre nodes, each damped
+    /// integral by the M-point product rule; with `dyad = 0` its `δ_ab/r` part alone,
+    /// `<∇_gφ_I| 1/r_w |∇_hφ_J> / S_IJ`.
+    fn quadrature<const N: usize, const M: usize>(fi: Side<N>, fj: Side<N>, v: &[Vector<N>; 3], m: usize, dyad: f64) -> f64 {
         let [w, g, h] = v;
         let pair = (fi.0, fi.1, fj.0, fj.1);
         let q = w.dot(&((fi.0 + fj.0).try_inverse().unwrap() * w));
         let integrand = |alpha: f64| {
             move |r: &Centres<N>, y: [f64; 3]| {
-                let (di, dj) = (gradient(fi.0, fi.1, r, g).1, gradient(fj.0, fj.1, r, h).1);
-                let (dy_i, dy_j) = ((0..3).map(|c| di[c] * y[c]).sum::<f64>(), (0..3).map(|c| dj[c] * y[c]).sum::<f64>());
-                let dd = (0..3).map(|c| di[c] * dj[c]).sum::<f64>();
+                let (di, dj) = (gradient(fi.0, fi.1, fi.2, r, g).1, gradient(fj.0, fj.1, fj.2, r, h).1);
+                let along = |d: [[f64; 2]; 3]| std::array::from_fn::<f64, 2, _>(|p| (0..3).map(|c| d[c][p] * y[c]).sum());
+                let dd = (0..3).map(|c| dot(di[c], dj[c])).sum::<f64>();
                 let y2 = y.iter().map(|x| x * x).sum::<f64>();
-                (dd + dyad * 2.0 * alpha * dy_i * dy_j) * (-alpha * y2).exp()
+                (dd + dyad * 2.0 * alpha * dot(along(di), along(dj))) * (-alpha * y2).exp()
             }
         };
-        let overlap = damped(pair, w, 0.0, |r, _| gradient(fi.0, fi.1, r, g).0 * gradient(fj.0, fj.1, r, h).0);
+        let overlap = damped::<N, M>(pair, w, 0.0, |r, _| dot(gradient(fi.0, fi.1, fi.2, r, g).0, gradient(fj.0, fj.1, fj.2, r, h).0));
         let t_integral: f64 = even_rule(m)
             .iter()
             .map(|&(tau, wt)| {
                 let alpha = tau * tau / (q * (1.0 - tau * tau));
-                wt * damped(pair, w, alpha, integrand(alpha)) / (1.0 - tau * tau).powf(1.5)
+                wt * damped::<N, M>(pair, w, alpha, integrand(alpha)) / (1.0 - tau * tau).powf(1.5)
             })
             .sum();
         2.0 / (std::f64::consts::PI * q).sqrt() * t_integral / overlap
@@ -189,14 +200,14 @@ mod tests {
                 let zero = Centres::<N>::zeros();
                 let got = element::<N, PlainEcg>(&plain(ai, 0.7, &go, 0), &plain(aj, 1.3, &go, 1), &go, &v);
                 let s = <PlainEcg as Family<N>>::overlap(&plain(ai, 0.7, &go, 0), &plain(aj, 1.3, &go, 1), &go);
-                let want = quadrature((&ai, &zero), (&aj, &zero), &v, 5, 1.0) * s;
+                let want = quadrature::<N, 3>((&ai, &zero, None), (&aj, &zero, None), &v, 5, 1.0) * s;
                 assert!(close(got, want, 1e-12), "N = {N}, plain, vectors {set}: {got} vs {want}");
                 worst = worst.max((got / want - 1.0).abs());
                 for &spread in spreads {
                     let (ci, cj) = (centres::<N>(0.3, spread), centres::<N>(2.1, spread));
                     let (fi, fj) = (Fecg::new(ai, ci, 0.7, 0).unwrap(), Fecg::new(aj, cj, 1.3, 1).unwrap());
                     let got = element::<N, FloatingEcg>(&fi, &fj, &ops, &v);
-                    let want = quadrature((&ai, &ci), (&aj, &cj), &v, 12, 1.0) * <FloatingEcg as Family<N>>::overlap(&fi, &fj, &ops);
+                    let want = quadrature::<N, 3>((&ai, &ci, None), (&aj, &cj, None), &v, 12, 1.0) * <FloatingEcg as Family<N>>::overlap(&fi, &fj, &ops);
                     assert!(close(got, want, 1e-11), "N = {N}, floating, spread {spread}, vectors {set}: {got} vs {want}");
                     worst = worst.max((got / want - 1.0).abs());
                 }
@@ -263,13 +274,51 @@ mod tests {
         eprintln!("orbit-orbit, floating at s = 0 against plain: {:.1e}; plain against eq. (37): {:.1e}", (got / want - 1.0).abs(), (want / closed - 1.0).abs());
     }
 
+    /// ECG-GVR functions (`gvr_momentum::orbit`, eq. 26c) of (K_I, K_J, N) and global vectors
+    /// varied by `x`, in N_C coordinates.
+    fn gvr_pair<const NC: usize>(a: [Mat<NC>; 2], (ki, kj, n): (u32, u32, u32), x: f64) -> (GvrOps<NC>, [Gvr<NC>; 2]) {
+        let go = GvrOps::new(Operators { lambda: Mat::<NC>::identity() * 0.5, pairs: vec![], cm_mass: None }, n, 3).unwrap();
+        let u = |y: f64| Vector::<NC>::from_fn(|k, _| (1.3 * k as f64 + y).sin());
+        (go.clone(), [Gvr::new(a[0], u(x), ki, 1.0, &go, 0).unwrap(), Gvr::new(a[1], u(x + 2.0), kj, 1.0, &go, 1).unwrap()])
+    }
+
     #[test]
-    fn ecg_gvr_functions_are_refused_in_one_line() {
-        assert!(lookup::<3, PlainEcg>(NAME).is_ok_and(|(arity, _)| arity == 3) && lookup::<3, FloatingEcg>(NAME).is_ok());
-        match lookup::<3, EcgGvr>(NAME) {
-            Err(CoreError::Unsupported(msg)) => assert!(msg.contains(NAME) && msg.contains("ecg-gvr") && !msg.contains('\n'), "{msg}"),
-            other => panic!("{NAME}: {:?}", other.map(|_| ())),
+    fn ecg_gvr_functions_match_quadrature() {
+        // two coordinates, exponents and vectors without structure; 5 Gauss–Hermite nodes a side are
+        // exact for the Gaussian times (2K_I + N + 1) + (2K_J + N + 1) + 2 ≤ 9 powers of r, and 4
+        // τ-nodes for the τ-integrand of degree ≤ 2(K_I + K_J + N + 2) in τ
+        let v = [Vector::<2>::new(1.0, -1.0), Vector::<2>::new(0.8, -0.35), Vector::<2>::new(-0.2, 0.9)];
+        let mut worst: f64 = 0.0;
+        for (case, powers) in [(1, 0, 1), (1, 1, 0), (0, 0, 2), (0, 0, 0)].into_iter().enumerate() {
+            let a = [exponent::<2>(0.3 + case as f64), exponent::<2>(1.7 + case as f64)];
+            let (go, [fi, fj]) = gvr_pair(a, powers, 0.4 * case as f64);
+            let got = <EcgGvr as Family<2>>::ORBIT(&fi, &fj, &go, &v);
+            let zero = Centres::<2>::zeros();
+            let (si, sj) = ((&fi.u, fi.k, go.n_ang), (&fj.u, fj.k, go.n_ang));
+            let want = quadrature::<2, 5>((&fi.a, &zero, Some(si)), (&fj.a, &zero, Some(sj)), &v, 4, 1.0)
+                * <EcgGvr as Family<2>>::overlap(&fi, &fj, &go);
+            assert!(close(got, want, 1e-11), "(K_I, K_J, N) = {powers:?}: {got} vs {want}");
+            worst = worst.max((got / want - 1.0).abs());
         }
+        eprintln!("orbit-orbit, ECG-GVR against quadrature: largest relative deviation {worst:.1e}");
+    }
+
+    #[test]
+    fn ecg_gvr_functions_are_symmetric_and_at_k_n_zero_plain_ecgs() {
+        let (go, [gi, gj], _, _, v) = three();
+        let [w, g, h] = v;
+        let (gvr_go, [fi, fj]) = gvr_pair([gi.a, gj.a], (0, 0, 0), 0.0);
+        let (got, want) = (<EcgGvr as Family<3>>::ORBIT(&fi, &fj, &gvr_go, &v), element::<3, PlainEcg>(&gi, &gj, &go, &v));
+        assert!(close(got, want, 1e-13), "K = N = 0: {got} vs {want}");
+        let mut worst = (got / want - 1.0).abs();
+        let (gvr_go, [fi, fj]) = gvr_pair([gi.a, gj.a], (2, 1, 1), 0.7);
+        for v in [[w, g, h], [w, g * 0.3 - h, h * 1.7 + g]] {
+            let x = [(&fi, &fj, v), (&fj, &fi, v), (&fi, &fj, [v[0], v[2], v[1]])]
+                .map(|(bra, ket, v)| <EcgGvr as Family<3>>::ORBIT(bra, ket, &gvr_go, &v));
+            assert!(close(x[1], x[0], 1e-12) && close(x[2], x[0], 1e-12), "{x:?}");
+            worst = worst.max((x[1] / x[0] - 1.0).abs()).max((x[2] / x[0] - 1.0).abs());
+        }
+        eprintln!("orbit-orbit, ECG-GVR at K = N = 0 against plain, and I <-> J, g <-> h: largest relative deviation {worst:.1e}");
     }
 
     #[test]
@@ -303,7 +352,7 @@ mod tests {
             let [w, g, _] = vectors(&mu, 0, 1);
             let ops = Operators { lambda: g * g.transpose(), pairs: vec![], cm_mass: None };
             let got = super::super::drachmann::gradient_inv_r::<N, FloatingEcg>(&fi, &fj, &ops, &[w]);
-            let want = quadrature((&ai, &ci), (&aj, &cj), &[w, g, g], 12, 0.0) * <FloatingEcg as Family<N>>::overlap(&fi, &fj, &ops);
+            let want = quadrature::<N, 3>((&ai, &ci, None), (&aj, &cj, None), &[w, g, g], 12, 0.0) * <FloatingEcg as Family<N>>::overlap(&fi, &fj, &ops);
             assert!(close(got, want, 1e-11), "spread {spread}: {got} vs {want}");
             worst = worst.max((got / want - 1.0).abs());
         }

@@ -29,7 +29,7 @@ impl<const D: usize> Family<D> for FloatingEcg {
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("s"), Field::floats("c_A")];
     /// Eq. (25) of docs/properties-derivations.md (`fecg::momentum`).
     const FORM: Form = Form::Floating;
-    const MOMENTUM: Option<Momentum<D, Self>> = Some(fecg::momentum::<D>);
+    const MOMENTUM: Momentum<D, Self> = fecg::momentum::<D>;
     const ANGULAR: Option<Angular<D, Self>> = Some(fecg::angular::<D>);
     type Function<T: Real> = Fecg<D, T>;
     type Context = Operators<D>;

@@ -8,6 +8,8 @@
 //! - `gvr_kernel`: the same element in `f64` lanes without allocation, and the Coulomb
 //!   τ-quadratures; `gvr_build`: matrices and rows with it, compiled per instruction set;
 //! - `gvr_gradient`: the row gradient by hand-derived reverse mode in the kernel's lanes;
+//! - `gvr_momentum`: `p_g²`, `p_g⁴` and the orbit–orbit operator from the overlap's generating
+//!   function (eqs. 26–26c);
 //! - `gvr_coulomb` (tests only): the closed form of the Coulomb τ-integral.
 use nalgebra::SMatrix;
 
@@ -18,6 +20,7 @@ use crate::families::{columns, matrices_of, Column, Directions, Exponents, Famil
 use crate::gradient::{seed_matrix, Dual};
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
+use crate::operators::ElementFn;
 use crate::path;
 use gvr_element::{element, functions, Gvr, GvrOps, GvrParams};
 
@@ -28,6 +31,7 @@ mod gvr_coulomb;
 pub mod gvr_element;
 pub mod gvr_gradient;
 pub mod gvr_kernel;
+pub mod gvr_momentum;
 pub mod gvr_series;
 
 /// The ECG-GVR family: parameters `A` (`k x n x n`), `u` (`k x n`), `K`, `c_A` (`GvrParams`); N is
@@ -38,9 +42,9 @@ impl<const D: usize> Family<D> for EcgGvr {
     const NAME: &'static str = "ecg-gvr";
     const FIELDS: &'static [Field] =
         &[Field::floats("A"), Field::floats("u"), Field::naturals("K"), Field::floats("c_A")];
-    /// Not derived (docs/properties-derivations.md eq. 26).
     const FORM: Form = Form::GlobalVector;
-    const MOMENTUM: Option<Momentum<D, Self>> = None;
+    const MOMENTUM: Momentum<D, Self> = gvr_momentum::momentum::<D>;
+    const ORBIT: ElementFn<D, Self> = gvr_momentum::orbit::<D>;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = GvrParams<'a>;
@@ -81,7 +85,7 @@ impl<const D: usize> Family<D> for EcgGvr {
         &ctx.ops
     }
 
-    /// The kinetic element with `Λ = g g^T` (`p_g⁴` is not derived: `MOMENTUM` is `None`).
+    /// The kinetic element with `Λ = g g^T`, cheaper than `MOMENTUM`'s hyper-dual numbers.
     fn momentum_square(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &Vector<D>) -> f64 {
         element(bra, ket, &go.with_kinetic(g * g.transpose())).t
     }

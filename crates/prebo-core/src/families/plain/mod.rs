@@ -43,7 +43,7 @@ impl<const D: usize> Family<D> for PlainEcg {
     /// Rows in full-build orientation from the SIMD kernel (`pecg_build::rows`).
     const ORIENTED: bool = true;
     const FORM: Form = Form::Plain;
-    const MOMENTUM: Option<Momentum<D, Self>> = Some(momentum::<D>);
+    const MOMENTUM: Momentum<D, Self> = momentum::<D>;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = Exponents<'a>;
