@@ -19,7 +19,7 @@ import pytest
 from numpy.polynomial.hermite import hermgauss
 
 import prebo
-from prebo.expectation import OPERATORS
+from prebo.expectation import OPERATORS, vector
 from prebo.integrals import laboratory, translationally_invariant
 
 from conftest import ROOT, random_centres, random_pair_A
@@ -164,14 +164,16 @@ def images(basis, sym):
 def test_pair_class_averages_of_a_symmetrised_state(kind, names):
     """With identical particles the reported value is the average over the class of equivalent
     pairs. Check it on Ψ = Y†Y Σ_k c_k φ_k written out as a basis of all images Pφ_k of distinguishable
-    particles (no symmetriser; c_k c_P as coefficients): there every pair's ⟨r_ij²⟩ is an ordinary
-    Hermitian expectation value. Their class averages must equal the engine's, to 1e-10."""
+    particles (no symmetriser; c_k c_P as coefficients): there every pair's ⟨r_ij²⟩, ⟨p_i²p_j²⟩ and
+    orbit–orbit value is an ordinary Hermitian expectation value. Their class averages must equal
+    the engine's, to 1e-10."""
     rng = np.random.default_rng(11)
     masses = {"p": 1836.15267343, "e": 1.0}
     charges = {"p": 1.0, "e": -1.0}
     system = prebo.System([_p(x, masses[x], charges[x]) for x in names], state=prebo.State(N=0, parity=1))
     basis = family_basis(kind, system, rng, nb=3)
-    result = prebo.evaluate(basis, operators=["r2"])
+    names_checked = ("r2", "p2p2", "orbit_orbit")
+    result = prebo.evaluate(basis, operators=list(names_checked))
     c = result["coefficients"]
     labels = [f"{x}{i}" for i, x in enumerate(names)]
     plain = prebo.System([_p(label, masses[x], charges[x]) for label, x in zip(labels, names)],
@@ -185,16 +187,16 @@ def test_pair_class_averages_of_a_symmetrised_state(kind, names):
     S = rep.matrices(big)["S"]
     norm = coefficients @ S @ coefficients
     pairs = list(itertools.combinations(range(len(names)), 2))
-    w = np.zeros((len(pairs), len(names)))
-    for k, (i, j) in enumerate(pairs):
-        w[k, i], w[k, j] = 1.0, -1.0
-    R = rep.operator("r2", big, w)
-    per_pair = {(i, j): coefficients @ R[k] @ coefficients / norm for k, (i, j) in enumerate(pairs)}
-    for label, value in result["expectation"]["r2"].items():
-        a, b = label.split("-")
-        members = [v for (i, j), v in per_pair.items() if sorted((names[i], names[j])) == [a, b]]
-        assert members
-        assert abs(np.mean(members) - value) <= 1e-10 * abs(value), (label, members, value)
+    for name in names_checked:
+        op = OPERATORS[name]
+        v = np.array([[vector(plain, kind, i, j) for kind in op.vectors] for i, j in pairs])
+        R = rep.operator(name, big, v, op.momenta)
+        per_pair = {(i, j): coefficients @ R[k] @ coefficients / norm for k, (i, j) in enumerate(pairs)}
+        for label, value in result["expectation"][name].items():
+            a, b = label.split("-")
+            members = [v for (i, j), v in per_pair.items() if sorted((names[i], names[j])) == [a, b]]
+            assert members
+            assert abs(np.mean(members) - value) <= 1e-10 * abs(value), (name, label, members, value)
 
 
 def test_hydrogen_mean_square_radius():
@@ -205,7 +207,8 @@ def test_hydrogen_mean_square_radius():
     basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h" / "basis.json")
     m_p = max(basis.system.masses)
     mu = m_p / (m_p + 1.0)
-    result = prebo.evaluate(basis, operators=["r2"])
+    names_checked = ("r2", "p2p2", "orbit_orbit")
+    result = prebo.evaluate(basis, operators=list(names_checked))
     (label, value), = result["expectation"]["r2"].items()
     assert label == "e-p"
     dE = result["energy"] + 0.5 * mu

@@ -187,7 +187,7 @@ def cmd_run(args) -> int:
         except NonFiniteError as exc:  # the energies stand without the properties: say so, write them
             r = _result(basis, where, opts.threshold, roots=roots)
             print(f"prebo: warning: result.json without expectation values: {exc}", file=sys.stderr)
-        for level in r.get("levels", [r]):  # each level's Breit–Pauli correction and regularised δ
+        for level in r.get("levels", [r]):  # each level's Breit–Pauli correction and regularised δ, p⁴
             level |= corrections(basis, level)
         if levels is not None:
             r["targets"] = levels
@@ -419,10 +419,14 @@ def cmd_properties(args) -> int:
                 table.add_row(name, *(f"{p['expectation'][name][c]:.10g}" for c in classes), p["units"][name])
             if acts_on == "pairs" and "delta_regularised" in p:  # drachmann.py
                 table.add_row("delta (Drachmann)", *(f"{p['delta_regularised'][c]:.10g}" for c in classes), "bohr⁻³")
+            if acts_on == "particles" and p.get("p4_regularised"):  # drachmann.py, eq. (27')
+                table.add_row("p4 (regularised)", *(f"{p['p4_regularised'][c]:.10g}" if c in p["p4_regularised"]
+                                                    else "" for c in classes), "ħ⁴/bohr⁴")
             Console().print(table)
     if "breit_pauli" in p:  # relativistic.py: each term, per class and summed
         bp = p["breit_pauli"]
-        table = Table("term", "Eh", "cm⁻¹", "per class (Eh)", title=f"Breit–Pauli correction (α = {bp['alpha']})")
+        kind = "regularised δ and p⁴ of the lightest particles" if bp["regularised"] else "direct δ and p⁴"
+        table = Table("term", "Eh", "cm⁻¹", "per class (Eh)", title=f"Breit–Pauli correction (α = {bp['alpha']}; {kind})")
         for term, e in bp["Eh"].items():
             per = ", ".join(f"{c} {v:.6e}" for c, v in bp["classes"].get(term, {}).items())
             table.add_row(term.replace("_", "–"), f"{e:.6e}", f"{bp['cm-1'][term]:.6f}", per)
@@ -520,8 +524,8 @@ def parser() -> argparse.ArgumentParser:
     pr.add_argument("--threshold", type=fraction, metavar="T",
                     help="relative overlap eigenvalue below which directions are dropped (default: as for prebo energy)")
     pr.add_argument("--regularised", action="store_true",
-                    help="Drachmann's regularised δ also where it is slow (floating ECGs, ECG-GVR: up to 1 ms per element); "
-                         "plain ECGs always have it")
+                    help="the regularised δ and p⁴ (and the Breit–Pauli correction from them) also where they are "
+                         "slow (floating ECGs, ECG-GVR: up to 1 ms per element); plain ECGs always have them")
     pr.add_argument("--json", action="store_true", help="print the properties as JSON")
     pr.set_defaults(func=cmd_properties)
     en = sub.add_parser("energy", help="re-evaluate a stored basis")

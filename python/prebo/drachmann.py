@@ -9,6 +9,15 @@ density at one point. Its elements are the core's "inv_r", "coulomb_inv_r" and "
 (crates/prebo-core/src/operators/drachmann.rs), for every family. ⟨V/r_ij⟩ is in closed form for
 plain ECGs (eq. 19) and a quadrature over the family's damped ⟨1/r⟩ elements for floating ECGs and
 ECG-GVR (eq. 38), up to a millisecond per element: `CLOSED_FORM` says where it is cheap.
+
+The same eigenvalue equation regularises ⟨p_i⁴⟩ (eq. 27'): T_TI = Σ_i p_i²/(2m_i) with the momenta
+in the centre-of-mass frame, so ⟨T_TI²⟩ = ⟨(E − V)²⟩ = E² − 2E⟨V⟩ + ⟨V²⟩, ⟨V²⟩ = Σ_{i<j} q_iq_j⟨V/r_ij⟩,
+and for the class a of the lightest particles (n_a of mass m_a)
+
+    n_a ⟨p_a⁴⟩/(4m_a²) = ⟨(E − V)²⟩ − Σ_{i∉a} ⟨p_i⁴⟩/(4m_i²) − Σ_{i≠j} ⟨p_i²p_j²⟩/(4m_im_j):
+
+the cusps that Gaussians lack enter the right side only through heavier particles' ⟨p_i⁴⟩ and the
+products of distinct particles' momenta, weighted by their masses (`p4_regularised`).
 """
 from __future__ import annotations
 
@@ -19,6 +28,9 @@ from .system import reduced_mass
 
 #: the operators of eq. (27): ⟨1/r_ij⟩, ⟨V/r_ij⟩, ⟨∇Ψ|Λ/r_ij|∇Ψ⟩
 TERMS = ("inv_r", "coulomb_inv_r", "gradient_inv_r")
+
+#: the operators of eq. (27'): those of ⟨V⟩ and ⟨V²⟩, ⟨p_i⁴⟩ and ⟨p_i²p_j²⟩
+P4_TERMS = ("inv_r", "coulomb_inv_r", "p4", "p2p2")
 
 #: the basis families whose ⟨V/r_ij⟩ is in closed form (eq. 19), as cheap as ⟨1/r_ij⟩
 CLOSED_FORM = ("pecg",)
@@ -43,3 +55,27 @@ def regularised(system, expectation: dict, energy: float) -> dict[str, float]:
     inv_r, potential, gradient = (expectation[name] for name in TERMS)
     return {label: float(mu[label] / np.pi * (energy * inv_r[label] - potential[label] - gradient[label]))
             for label in inv_r}
+
+
+def p4_regularised(system, expectation: dict, energy: float) -> dict[str, float]:
+    """{particle class "a": the regularised ⟨p_a⁴⟩ (ħ⁴/bohr⁴)} of one eigenstate of `system` with the
+    energy `energy` (Eh) from its expectation values of P4_TERMS (eq. 27', module docstring), for
+    the class of the lightest particles where no other class has their mass (else {}: the identity
+    gives only the sum over the classes of one mass)."""
+    light = min(p.mass for p in system.particles)
+    classes = members(system, pairs=False)
+    lightest = [label for label, ms in classes.items() if system.particles[ms[0][0]].mass == light]
+    if len(lightest) != 1:
+        return {}
+    (a,) = lightest
+    potential = squared = products = 0.0
+    for label, ms in members(system, pairs=True).items():
+        i, j = ms[0]
+        qq, mm = system.particles[i].charge * system.particles[j].charge, system.masses[i] * system.masses[j]
+        potential += len(ms) * qq * expectation["inv_r"][label]
+        squared += len(ms) * qq * expectation["coulomb_inv_r"][label]
+        products += 2 * len(ms) * expectation["p2p2"][label] / (4 * mm)
+    heavy = sum(len(ms) * expectation["p4"][label] / (4 * system.masses[ms[0][0]] ** 2)
+                for label, ms in classes.items() if label != a)
+    kinetic_squared = energy**2 - 2 * energy * potential + squared
+    return {a: float(4 * light**2 / len(classes[a]) * (kinetic_squared - heavy - products))}

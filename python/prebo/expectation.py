@@ -129,6 +129,9 @@ OPERATORS: dict[str, Operator] = {
                    ("p_i",)),
     "p4": Operator("p4", "ħ⁴/bohr⁴", "⟨p_i⁴⟩, the mass–velocity term's −Σ⟨p_i⁴⟩/(8m_i³c²) per particle i",
                    ("p_i",)),
+    "p2p2": Operator("p2p2", "ħ⁴/bohr⁴", "⟨p_i² p_j²⟩, the product of two particles' square momenta in the "
+                                         "centre-of-mass frame (a term of the regularised ⟨p_i⁴⟩, prebo.drachmann)",
+                     ("p_i", "p_j")),
     "coulomb_inv_r": Operator("coulomb_inv_r", "Eh/bohr", "⟨V/r_ij⟩, the Coulomb potential over r_ij "
                                                          "(a term of Drachmann's ⟨δ³(r_ij)⟩, prebo.drachmann)"),
     "gradient_inv_r": Operator("gradient_inv_r", "Eh/bohr", "⟨∇Ψ|Λ/r_ij|∇Ψ⟩, the kinetic energy density over r_ij "

@@ -32,14 +32,14 @@ from .validation import Integer, checked
 def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float = eigen.THRESHOLD,
                regularised: bool | None = None) -> dict:
     """The properties of level `root` (0: the lowest of the basis's symmetry) of `basis`, with
-    Drachmann's regularised δ if `regularised` (None: where it is cheap, `reported`).
+    the regularised δ and p⁴ if `regularised` (None: where they are cheap, `reported`).
 
     Returns {"root", "energy", "energy_uncertainty" (Eh), "virial", "bound", "expectation":
     {operator: {class: value}}, "units": {operator: unit}, "not_derived": [operators]} (and "n2",
     ⟨N²⟩_TI in ħ², for floating ECGs): the `reported` operators of the basis family, per
     class of equivalent pairs "a-b" or particles "a", and those it has no element for; and
-    the level's `corrections` ("breit_pauli", "delta_regularised") where the family evaluates
-    their operators. InputError
+    the level's `corrections` ("breit_pauli", "delta_regularised", "p4_regularised") where it
+    holds their operators. InputError
     for a root that is not a non-negative integer below the basis size; the errors of
     `results.evaluate` otherwise."""
     if not isinstance(basis, Basis) or len(basis) == 0:
@@ -61,7 +61,7 @@ POINTS, REACH = 400, 5.0
 def reported(family, regularised: bool | None = None) -> list[str]:
     """The operators a level's properties hold for a basis of `family` (`properties`, `prebo run`'s
     result.json): every one the family evaluates, Drachmann's terms, which serve the regularised
-    ⟨δ³(r_ij)⟩ alone, only if `regularised`; None: where ⟨V/r_ij⟩ is in closed form
+    ⟨δ³(r_ij)⟩ and ⟨p⁴⟩ alone, only if `regularised`; None: where ⟨V/r_ij⟩ is in closed form
     (`drachmann.CLOSED_FORM`). Elsewhere they cost minutes for a few hundred functions: ⟨V/r_ij⟩ a
     quadrature of up to a millisecond per element (eq. 38), ECG-GVR's ⟨∇Ψ|Λ/r_ij|∇Ψ⟩ 128 s of H2-500's
     139 s."""
@@ -74,13 +74,21 @@ def reported(family, regularised: bool | None = None) -> list[str]:
 def corrections(basis, level: dict) -> dict:
     """What the expectation values of a level of `basis` ({"energy", "expectation": {operator:
     {class: value}}}, a level of `results.evaluate`) give beyond themselves, where they hold the
-    operators: "breit_pauli", its Breit–Pauli correction (`relativistic.terms`), and
-    "delta_regularised", {pair class: Drachmann's ⟨δ³(r_ij)⟩} (`drachmann.regularised`)."""
+    operators: "delta_regularised", {pair class: Drachmann's ⟨δ³(r_ij)⟩} (`drachmann.regularised`),
+    "p4_regularised", {class of the lightest particles: ⟨p⁴⟩ by eq. (27')}
+    (`drachmann.p4_regularised`), and "breit_pauli", the Breit–Pauli correction
+    (`relativistic.terms`) — with both regularised values where there are both ("regularised":
+    true), else with the direct ones (the two err together, docs/relativistic.md)."""
     out, have = {}, set(level.get("expectation", {}))
-    if set(NEEDS) <= have:
-        out["breit_pauli"] = terms(basis.system, level["expectation"])
+    expectation = level.get("expectation", {})
     if set(drachmann.TERMS) <= have:
-        out["delta_regularised"] = drachmann.regularised(basis.system, level["expectation"], level["energy"])
+        out["delta_regularised"] = drachmann.regularised(basis.system, expectation, level["energy"])
+    if set(drachmann.P4_TERMS) <= have:
+        out["p4_regularised"] = drachmann.p4_regularised(basis.system, expectation, level["energy"])
+    if set(NEEDS) <= have:
+        both = "delta_regularised" in out and bool(out.get("p4_regularised"))
+        regularised = {"delta": out["delta_regularised"], "p4": out["p4_regularised"]} if both else {}
+        out["breit_pauli"] = terms(basis.system, expectation, **regularised) | {"regularised": both}
     return out
 
 

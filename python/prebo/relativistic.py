@@ -43,11 +43,12 @@ def dirac(particle) -> bool:
     return particle.spin == 0.5
 
 
-def terms(system, expectation: dict, delta: dict | None = None) -> dict:
+def terms(system, expectation: dict, delta: dict | None = None, p4: dict | None = None) -> dict:
     """The Breit–Pauli terms (module docstring) of one level of `system` from its expectation
     values `expectation` ({operator: {class: value}}, as `results.evaluate` gives them, with every
     operator of NEEDS); `delta`, contact densities per pair class to use instead of the direct
-    ⟨δ³(r_ij)⟩ (e.g. `drachmann.delta_regularised`'s; docs/relativistic.md on pairing it with p⁴).
+    ⟨δ³(r_ij)⟩, and `p4`, ⟨p_i⁴⟩ per particle class to use instead of the direct ones where given
+    (`drachmann.regularised` and `drachmann.p4_regularised`; docs/relativistic.md on pairing them).
 
     Returns {"Eh": {term: E, "total": Σ}, "cm-1": the same × HARTREE_CM, "classes": {term:
     {class: E (Eh)}}, "alpha": ALPHA} for the TERMS: the mass–velocity term per particle class,
@@ -55,10 +56,11 @@ def terms(system, expectation: dict, delta: dict | None = None) -> dict:
     particles), each summed over the class's members."""
     a2 = ALPHA**2
     delta = expectation["delta"] if delta is None else delta
+    p4 = expectation["p4"] | (p4 or {})
     classes = {term: {} for term in TERMS}
     for label, ms in members(system, pairs=False).items():
         m = system.particles[ms[0][0]].mass
-        classes["mass_velocity"][label] = -a2 / 8 * len(ms) * expectation["p4"][label] / m**3
+        classes["mass_velocity"][label] = -a2 / 8 * len(ms) * p4[label] / m**3
     for label, ms in members(system, pairs=True).items():
         a, b = (system.particles[k] for k in ms[0])
         qq, pairs = a.charge * b.charge, len(ms)

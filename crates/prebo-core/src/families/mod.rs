@@ -25,7 +25,7 @@ use crate::error::{CoreError, Result};
 use crate::gradient::Dual;
 use crate::images::Transform;
 use crate::matrices::Matrices;
-use crate::operators::{orbit, ElementFn};
+use crate::operators::{momentum, orbit, ElementFn};
 
 pub mod floating;
 pub mod gvr;
@@ -195,12 +195,14 @@ pub enum Form {
 /// mass fractions.
 pub type Angular<const D: usize, F> = fn(&<F as Family<D>>::Function<f64>, &<F as Family<D>>::Function<f64>, &Vector<D>) -> f64;
 
-/// `(<phi_I| p_g² |phi_J>, <phi_I| p_g⁴ |phi_J>)` of normalised functions of family `F`, for
-/// `p_g = −i Σ_k g_k ∇_k` with a D-vector `g` (`operators::momentum`; docs/properties-derivations.md §5).
+/// `(<phi_I| p_h² |phi_J>, <p_g² phi_I| p_h² phi_J>)` of normalised functions of family `F`, for
+/// `p_g = −i Σ_k g_k ∇_k` with D-vectors `g` and `h` (`operators::momentum`;
+/// docs/properties-derivations.md §5): at `h = g` the elements of `p_g²` and `p_g⁴`.
 pub type Momentum<const D: usize, F> = fn(
     &<F as Family<D>>::Function<f64>,
     &<F as Family<D>>::Function<f64>,
     &<F as Family<D>>::Context,
+    &Vector<D>,
     &Vector<D>,
 ) -> (f64, f64);
 
@@ -218,8 +220,10 @@ pub trait Family<const D: usize>: Sized + 'static {
     const ORIENTED: bool = true;
     /// What a function is beside its Gaussian (`Form`).
     const FORM: Form;
-    /// The element of the momentum operators `p_g²` and `p_g⁴` (`Momentum`).
-    const MOMENTUM: Momentum<D, Self>;
+    /// The element of the momentum operators `p_h²` and `p_g² p_h²` (`Momentum`): by default that
+    /// of a Gaussian about centres (plain and floating ECGs, `operators::momentum::gaussian`), for
+    /// ECG-GVR its own.
+    const MOMENTUM: Momentum<D, Self> = momentum::gaussian::<D, Self>;
     /// The element of the orbit–orbit operator `p_g·M(r_w)·p_h` (`operators::orbit`): by default
     /// that of functions whose gradients are a Gaussian times a linear polynomial (plain and
     /// floating ECGs), for ECG-GVR its own.
@@ -283,7 +287,7 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// `<phi_I| p_g² |phi_J>` (`operators::momentum`): `MOMENTUM`'s, where a family has no
     /// cheaper one (ECG-GVR: its kinetic element with `Λ = g g^T`).
     fn momentum_square(bra: &Self::Function<f64>, ket: &Self::Function<f64>, ctx: &Self::Context, g: &Vector<D>) -> f64 {
-        (Self::MOMENTUM)(bra, ket, ctx, g).0
+        (Self::MOMENTUM)(bra, ket, ctx, g, g).0
     }
 
     /// How the damped overlap of `bra` and `ket` depends on the damping (`Shape`).

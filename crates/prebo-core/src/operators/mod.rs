@@ -5,9 +5,10 @@
 //! primitives (`Family::overlap`, `Family::damped`, `Family::element`; for the operators of one
 //! pair vector beyond r², the damped overlap's profile in `profile`, which needs of a family only
 //! its exponent and the `Shape` of that profile), and one line in `registry` with its arity,
-//! the number of D-vectors it takes (a pair operator one, `w`; the orbit–orbit operator the pair
-//! vector and two momentum vectors). `path::operator` symmetrises it and the binding exposes it
-//! by name (`Engine.operator(name, params, v)`, `arity` vectors per instance).
+//! the number of D-vectors it takes (a pair operator one, `w`; `p_g² p_h²` two momentum vectors;
+//! the orbit–orbit operator the pair vector and two momentum vectors). `path::operator`
+//! symmetrises it and the binding exposes it by name (`Engine.operator(name, params, v)`, `arity`
+//! vectors per instance).
 use crate::ecg::Vector;
 use crate::error::{CoreError, Result};
 use crate::families::plain::PlainEcg;
@@ -54,6 +55,7 @@ fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<
         (delta::NAME, 1, one_vector!(delta::element::<D, F>)),
         (momentum::P2, 1, one_vector!(momentum::p2::<D, F>)),
         (momentum::P4, 1, one_vector!(momentum::p4::<D, F>)),
+        (momentum::P2P2, 2, Some(momentum::p2p2::<D, F>)),
         (drachmann::COULOMB, 1, Some(drachmann::coulomb::<D, F>())),
         (drachmann::GRADIENT, 1, Some(drachmann::gradient_inv_r::<D, F>)),
         (orbit::NAME, 3, Some(F::ORBIT)),

@@ -1,16 +1,17 @@
-//! `p_g² = −Δ_g` and `p_g⁴`, the powers of the momentum `p_g = −i Σ_k g_k ∇_k` of a D-vector `g`,
-//! with `<φ_I| p_g⁴ |φ_J> = <Δ_g φ_I|Δ_g φ_J>` (docs/properties-derivations.md, eq. 20). In the
-//! laboratory frame `g = e_i − μ_i 1` (`μ_i = m_i/m_tot`) gives particle i's momentum in the
-//! centre-of-mass frame, the `p_i` of the mass–velocity term (§5). `g` transforms like `∇`, not
-//! like `r`: in coordinates `x = U_x r` it is `U_x g`. The elements are the family's
-//! (`Family::MOMENTUM`): plain ECGs `6τ S_IJ` and `60τ² S_IJ`, `τ = g^T A_I (A_I + A_J)^{-1} A_J g`
-//! (eqs. 22–23); floating ECGs eq. (25); ECG-GVR the overlap's generating function (eq. 26b,
-//! `gvr_momentum`), its `p_g²` the kinetic element with `Λ = g g^T`.
+//! `p_g² = −Δ_g`, `p_g⁴` and `p_g² p_h²`, products of the momenta `p_g = −i Σ_k g_k ∇_k` of
+//! D-vectors `g`, `h`, with `<φ_I| p_g² p_h² |φ_J> = <Δ_g φ_I|Δ_h φ_J>` (docs/properties-derivations.md,
+//! eq. 20). In the laboratory frame `g = e_i − μ_i 1` (`μ_i = m_i/m_tot`) gives particle i's
+//! momentum in the centre-of-mass frame, the `p_i` of the mass–velocity term (§5). `g` transforms
+//! like `∇`, not like `r`: in coordinates `x = U_x r` it is `U_x g`. The elements are the family's
+//! (`Family::MOMENTUM`): for a Gaussian about centres (plain and floating ECGs) `gaussian`
+//! (eq. 25'), for ECG-GVR the overlap's generating function (eq. 26b, `gvr_momentum`), its `p_g²`
+//! the kinetic element with `Λ = g g^T`.
 use crate::ecg::Vector;
 use crate::families::Family;
 
 pub const P2: &str = "p2";
 pub const P4: &str = "p4";
+pub const P2P2: &str = "p2p2";
 
 /// `<φ_I| p_g² |φ_J>` for normalised functions ((ħ/bohr)²; `Family::momentum_square`).
 pub fn p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
@@ -19,7 +20,46 @@ pub fn p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Functio
 
 /// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴; `Family::MOMENTUM`).
 pub fn p4<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
-    (F::MOMENTUM)(bra, ket, ctx, g).1
+    (F::MOMENTUM)(bra, ket, ctx, g, g).1
+}
+
+/// `<φ_I| (p_g² p_h² + p_h² p_g²)/2 |φ_J>` for normalised functions, `v = [g, h]` ((ħ/bohr)⁴;
+/// symmetric in I ↔ J as in g ↔ h): for two particles' momenta, a term of the regularised
+/// `<p_i⁴>` (docs/properties-derivations.md §6).
+pub fn p2p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
+    let (g, h) = (&v[0], &v[1]);
+    0.5 * ((F::MOMENTUM)(bra, ket, ctx, g, h).1 + (F::MOMENTUM)(bra, ket, ctx, h, g).1)
+}
+
+/// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` of a Gaussian about centres (`Family::MOMENTUM`'s
+/// default): with `Δ_gφ_I = (4|a|² − 6α) φ_I`, `a = (A_I g)ᵀ(r − s_I)`, `α = gᵀA_Ig`, and likewise
+/// `b`, `β` of `h` and `φ_J`, Gaussian moments under `φ_Iφ_J` (means ā, b̄ at r̄; per-component
+/// variances σ_a, σ_b and covariance σ_ab with `C = (A_I + A_J)⁻¹/2`) give
+///
+/// ```text
+///     <Δ_gφ_I|Δ_hφ_J> = S [(4|ā|² + 6(2σ_a − α)) (4|b̄|² + 6(2σ_b − β)) + 96 σ_ab² + 64 σ_ab ā·b̄],   (25')
+/// ```
+///
+/// `<φ_I|Δ_hφ_J> = S (4|b̄|² + 6(2σ_b − β))`; at g = h eqs. (22), (23) and (25).
+pub fn gaussian<const D: usize, F: Family<D>>(
+    bra: &F::Function<f64>,
+    ket: &F::Function<f64>,
+    ctx: &F::Context,
+    g: &Vector<D>,
+    h: &Vector<D>,
+) -> (f64, f64) {
+    let (ai, aj) = (F::exponent(bra), F::exponent(ket));
+    let Some(chol) = (ai + aj).cholesky() else { return (f64::NAN, f64::NAN) };
+    let (si, sj) = (F::centres(bra), F::centres(ket));
+    let rbar = chol.solve(&(ai * si + aj * sj));
+    let (ag, ah) = (ai * g, aj * h);
+    let (a_bar, b_bar) = (ag.transpose() * (rbar - si), ah.transpose() * (rbar - sj));
+    let (bg, bh) = (chol.solve(&ag), chol.solve(&ah));
+    let (s_a, s_b, s_ab) = (0.5 * ag.dot(&bg), 0.5 * ah.dot(&bh), 0.5 * ag.dot(&bh));
+    let k_a = 4.0 * a_bar.norm_squared() + 6.0 * (2.0 * s_a - g.dot(&ag));
+    let k_b = 4.0 * b_bar.norm_squared() + 6.0 * (2.0 * s_b - h.dot(&ah));
+    let s = F::overlap(bra, ket, ctx);
+    (-k_b * s, (k_a * k_b + 96.0 * s_ab * s_ab + 64.0 * s_ab * a_bar.dot(&b_bar)) * s)
 }
 
 #[cfg(test)]
@@ -257,7 +297,7 @@ mod tests {
             for (si, sj) in SEEDS {
                 let (gi, gj) = (plain(exponent(si), 1.0, &go, 0), plain(exponent(sj), 1.0, &go, 1));
                 let want = [p2::<D, PlainEcg>(&gi, &gj, &go, &g), p4::<D, PlainEcg>(&gi, &gj, &go, &g)];
-                let (p2_h, p4_h) = gvr_momentum::momentum(&gi, &gj, &go, &g);
+                let (p2_h, p4_h) = gvr_momentum::momentum(&gi, &gj, &go, &g, &g);
                 assert!(close(p2_h, want[0], 1e-13) && close(p4_h, want[1], 1e-13), "{:?} vs {want:?}", (p2_h, p4_h));
                 worst = worst.max((p2_h / want[0] - 1.0).abs()).max((p4_h / want[1] - 1.0).abs());
             }
@@ -276,7 +316,7 @@ mod tests {
                     let fi = Gvr::new(exponent(si), ui, ki, 1.0, &go, 0).unwrap();
                     let fj = Gvr::new(exponent(sj), uj, kj, 1.0, &go, 1).unwrap();
                     let want = p2::<D, EcgGvr>(&fi, &fj, &go, &g);
-                    let got = gvr_momentum::momentum(&fi, &fj, &go, &g).0;
+                    let got = gvr_momentum::momentum(&fi, &fj, &go, &g, &g).0;
                     assert!(close(got, want, 1e-12), "N = {n}, K = ({ki}, {kj}): {got} vs {want}");
                     worst = worst.max((got / want - 1.0).abs());
                 }
@@ -322,7 +362,7 @@ mod tests {
             let ctx = go(n);
             let (fi, fj) = (Gvr::new(ai, ui, ki, 1.0, &ctx, 0).unwrap(), Gvr::new(aj, uj, kj, 1.0, &ctx, 1).unwrap());
             let s = <EcgGvr as Family<2>>::overlap(&fi, &fj, &ctx);
-            let got = gvr_momentum::momentum(&fi, &fj, &ctx, &g);
+            let got = gvr_momentum::momentum(&fi, &fj, &ctx, &g, &g);
             let zero = Centres::<2>::zeros();
             let q = quadrature::<6>(&ai, &zero, &aj, &zero, &|r| (gvr_laplacian(&ai, &ui, ki, n, r, &g), gvr_laplacian(&aj, &uj, kj, n, r, &g)));
             for (k, got) in [got.0, got.1].into_iter().enumerate() {
@@ -335,11 +375,51 @@ mod tests {
     }
 
     #[test]
-    fn every_family_evaluates_p2_and_p4() {
-        assert!(names().contains(&P2) && names().contains(&P4));
-        for name in [P2, P4] {
+    fn products_of_two_momenta_match_quadrature() {
+        // (<φ_I|p_h²|φ_J>, <p_g²φ_I|p_h²φ_J>) with g ≠ h, every family, against the quadrature of
+        // Δ_gφ_I and Δ_hφ_J (6 nodes a side for ECG-GVR: degree 5 + 5); and p2p2, their symmetrised
+        // mean, symmetric in I ↔ J and g ↔ h
+        let (g, h) = (Vector::<2>::new(0.8, -0.35), Vector::<2>::new(-0.3, 0.6));
+        let (ops, go) = (squared(&g), GvrOps::new(squared(&g), 1, 2).unwrap());
+        let zero = Centres::<2>::zeros();
+        let mut worst: f64 = 0.0;
+        let mut check = |family: &str, got: (f64, f64), s: f64, q: [f64; 3]| {
+            for (got, want) in [(got.0, q[1] / q[0] * s), (got.1, q[2] / q[0] * s)] {
+                assert!(close(got, want, 1e-11), "{family}: {got} vs {want}");
+                worst = worst.max((got / want - 1.0).abs());
+            }
+        };
+        for (si, sj) in SEEDS {
+            let (ai, aj) = (exponent::<2>(si), exponent::<2>(sj));
+            let (gi, gj) = (plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1));
+            let q = quadrature::<4>(&ai, &zero, &aj, &zero, &|r| (real(&ai, &zero, r, &g), real(&aj, &zero, r, &h)));
+            let s = <PlainEcg as Family<2>>::overlap(&gi, &gj, &go);
+            check("plain", <PlainEcg as Family<2>>::MOMENTUM(&gi, &gj, &go, &g, &h), s, q);
+            let (ci, cj) = (centres::<2>(0.3, 1.5), centres::<2>(2.1, 1.5));
+            let (fi, fj) = (Fecg::new(ai, ci, 1.0, 0).unwrap(), Fecg::new(aj, cj, 1.0, 1).unwrap());
+            let q = quadrature::<4>(&ai, &ci, &aj, &cj, &|r| (real(&ai, &ci, r, &g), real(&aj, &cj, r, &h)));
+            let s = <FloatingEcg as Family<2>>::overlap(&fi, &fj, &ops);
+            check("floating", <FloatingEcg as Family<2>>::MOMENTUM(&fi, &fj, &ops, &g, &h), s, q);
+            let (ui, uj) = (Vector::<2>::new(0.7, -0.4), Vector::<2>::new(0.3, 0.9));
+            let (vi, vj) = (Gvr::new(ai, ui, 1, 1.0, &go, 0).unwrap(), Gvr::new(aj, uj, 1, 1.0, &go, 1).unwrap());
+            let q = quadrature::<6>(&ai, &zero, &aj, &zero, &|r| (gvr_laplacian(&ai, &ui, 1, 1, r, &g), gvr_laplacian(&aj, &uj, 1, 1, r, &h)));
+            let s = <EcgGvr as Family<2>>::overlap(&vi, &vj, &go);
+            check("ECG-GVR", <EcgGvr as Family<2>>::MOMENTUM(&vi, &vj, &go, &g, &h), s, q);
+            for (bra, ket) in [(&gi, &gj), (&vi, &vj)] {
+                let x = [(bra, ket, [g, h]), (ket, bra, [g, h]), (bra, ket, [h, g])].map(|(b, k, v)| p2p2::<2, EcgGvr>(b, k, &go, &v));
+                assert!(close(x[1], x[0], 1e-13) && close(x[2], x[0], 1e-13), "{x:?}");
+            }
+        }
+        eprintln!("<p_h²>, <p_g² p_h²> (g ≠ h) against quadrature: largest relative deviation {worst:.1e}");
+    }
+
+    #[test]
+    fn every_family_evaluates_p2_p4_and_p2p2() {
+        assert!(names().contains(&P2) && names().contains(&P4) && names().contains(&P2P2));
+        for name in [P2, P4, P2P2] {
             assert!(lookup::<D, PlainEcg>(name).is_ok() && lookup::<D, FloatingEcg>(name).is_ok());
             assert!(lookup::<D, EcgGvr>(name).is_ok());
         }
+        assert!(lookup::<D, PlainEcg>(P2P2).is_ok_and(|(arity, _)| arity == 2));
     }
 }

@@ -16,10 +16,6 @@
 //! - translation-free angular momentum `N_TI = Σ r_i × p_i - R × P`: `N_TI phi = -2i Σ_i r_i × t_i phi`
 //!   with `t = (A - c_A μ μ^T) s`, so
 //!   `<N_TI²> = 4 [(Σ_i r̄_i × t_{I,i})·(Σ_k r̄_k × t_{J,k}) + 2 Σ_ik C_ik t_{I,i}·t_{J,k}] S`;
-//! - momentum `p_g = −i Σ_k g_k ∇_k` (docs/properties-derivations.md eqs. 21–25): with
-//!   `τ = g^T A_I B^{-1} A_J g`, `ξ̄ = (A_I g)^T (r̄ - s_I)`, `η̄ = (A_J g)^T (r̄ - s_J)` (3-vectors),
-//!   `<p_g²> = (6τ + 4 ξ̄·η̄) S` (the kinetic element with `Λ = g g^T`) and
-//!   `<p_g⁴> = [24τ² + 32τ ξ̄·η̄ + (4|ξ̄|² - 6τ)(4|η̄|² - 6τ)] S`.
 use std::f64::consts::PI;
 
 use nalgebra::SMatrix;
@@ -309,20 +305,6 @@ pub fn angular<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>, mu: &Vector<D>) -> 
     let mean = li[0] * lj[0] + li[1] * lj[1] + li[2] * lj[2];
     let fluct = (ti * tj.transpose()).component_mul(&binv).sum(); // Σ_ik B^{-1}_ik t_I,i·t_J,k = 2 Σ C_ik ...
     4.0 * (mean + fluct) * s
-}
-
-/// `(<phi_I| p_g² |phi_J>, <phi_I| p_g⁴ |phi_J>)` (module docs; `Family::MOMENTUM`).
-pub fn momentum<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>, _: &Operators<D>, g: &Vector<D>) -> (f64, f64) {
-    let Some((s, binv, rbar)) = pair(bra, ket) else { return (f64::NAN, f64::NAN) };
-    let (ag_i, ag_j) = (bra.a * g, ket.a * g);
-    let tau = ag_i.dot(&(binv * ag_j));
-    let xi = ag_i.transpose() * (rbar - bra.s);
-    let eta = ag_j.transpose() * (rbar - ket.s);
-    let xi_eta = xi.dot(&eta);
-    let p2 = 6.0 * tau + 4.0 * xi_eta;
-    let (mean_i, mean_j) = (4.0 * xi.norm_squared() - 6.0 * tau, 4.0 * eta.norm_squared() - 6.0 * tau);
-    let p4 = 24.0 * tau * tau + 32.0 * tau * xi_eta + mean_i * mean_j;
-    (p2 * s, p4 * s)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use nalgebra::SMatrix;
 use crate::cache::Cache;
 use crate::ecg::{re, Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Angular, Column, Directions, Exponents, Family, Field, Form, Momentum, Shape, Symmetry};
+use crate::families::{columns, matrices_of, Angular, Column, Directions, Exponents, Family, Field, Form, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::matrices::Matrices;
 use crate::path;
@@ -27,9 +27,7 @@ pub struct FloatingEcg;
 impl<const D: usize> Family<D> for FloatingEcg {
     const NAME: &'static str = "fecg";
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("s"), Field::floats("c_A")];
-    /// Eq. (25) of docs/properties-derivations.md (`fecg::momentum`).
     const FORM: Form = Form::Floating;
-    const MOMENTUM: Momentum<D, Self> = fecg::momentum::<D>;
     const ANGULAR: Option<Angular<D, Self>> = Some(fecg::angular::<D>);
     type Function<T: Real> = Fecg<D, T>;
     type Context = Operators<D>;

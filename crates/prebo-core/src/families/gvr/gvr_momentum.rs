@@ -72,12 +72,12 @@ fn generating<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, moves:
     Some((ratio, (log_s0 + l0 - bra.log_norm - ket.log_norm).exp()))
 }
 
-/// `(<φ_I| p_g² |φ_J>, <φ_I| p_g⁴ |φ_J>)` for normalised ECG-GVR functions (eq. 26b;
-/// `Family::MOMENTUM`); NaN where `A_I + A_J` does not factorise.
-pub fn momentum<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &Vector<D>) -> (f64, f64) {
-    let (hi, hj) = (bra.a * g, ket.a * g);
-    let (ugi, ugj) = (bra.u.dot(g), ket.u.dot(g));
-    let (ci, cj) = (-6.0 * g.dot(&hi), -6.0 * g.dot(&hj));
+/// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` for normalised ECG-GVR functions (eq. 26b, with
+/// `h` in D_J and c_J; `Family::MOMENTUM`); NaN where `A_I + A_J` does not factorise.
+pub fn momentum<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &Vector<D>, h: &Vector<D>) -> (f64, f64) {
+    let (hi, hj) = (bra.a * g, ket.a * h);
+    let (ugi, ugj) = (bra.u.dot(g), ket.u.dot(h));
+    let (ci, cj) = (-6.0 * g.dot(&hi), -6.0 * h.dot(&hj));
     // D_I along ε₁, D_J along ε₂
     let (e1, e2) = (H::new(0.0, 1.0, 0.0, 0.0), H::new(0.0, 0.0, 1.0, 0.0));
     let moves = Moves {

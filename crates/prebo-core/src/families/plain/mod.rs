@@ -11,7 +11,7 @@ use super::gvr::gvr_element::{self, Gvr, GvrOps};
 use crate::cache::Cache;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Form, Momentum, Parameters, Shape, Symmetry};
+use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Form, Parameters, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::images::Images;
 use crate::isa::best_isa;
@@ -43,7 +43,6 @@ impl<const D: usize> Family<D> for PlainEcg {
     /// Rows in full-build orientation from the SIMD kernel (`pecg_build::rows`).
     const ORIENTED: bool = true;
     const FORM: Form = Form::Plain;
-    const MOMENTUM: Momentum<D, Self> = momentum::<D>;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = Exponents<'a>;
@@ -135,15 +134,6 @@ impl<const D: usize> Family<D> for PlainEcg {
         })?;
         Ok((pecg_gradient::row_gradient(&f, &da, &kets, &go.ops), diag))
     }
-}
-
-/// `(<φ_I| p_g² |φ_J>, <φ_I| p_g⁴ |φ_J>) = (6τ S_IJ, 60τ² S_IJ)`, `τ = g^T A_I (A_I + A_J)^{-1} A_J g`
-/// (docs/properties-derivations.md eqs. 22–23; `Family::MOMENTUM`).
-fn momentum<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &Vector<D>) -> (f64, f64) {
-    let (ag_i, ag_j) = (bra.a * g, ket.a * g);
-    let tau = (bra.a + ket.a).cholesky().map_or(f64::NAN, |c| ag_i.dot(&c.solve(&ag_j)));
-    let s = <PlainEcg as Family<D>>::overlap(bra, ket, go);
-    (6.0 * tau * s, 60.0 * tau * tau * s)
 }
 
 /// Whether the operators commute with the permutation `p`: `Pᵀ Λ P = Λ`, and every Coulomb
