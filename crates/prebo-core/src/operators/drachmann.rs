@@ -50,10 +50,16 @@ pub fn coulomb<const D: usize, F: Family<D>>() -> ElementFn<D, F> {
     if F::FORM == Form::Plain { coulomb_inv_r::<D, F> } else { coulomb_by_damping::<D, F> }
 }
 
+/// `w ↦ L⁻¹w` with `L Lᵀ = A_I + A_J`, so `|L⁻¹w|² = wᵀ(A_I + A_J)⁻¹w`; None where the sum does not
+/// factorise.
+fn whitening<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>) -> Option<impl Fn(&Vector<D>) -> Vector<D>> {
+    let chol = (F::exponent(bra) + F::exponent(ket)).cholesky()?;
+    Some(move |w: &Vector<D>| chol.l().solve_lower_triangular(w).unwrap_or_else(|| Vector::<D>::repeat(f64::NAN)))
+}
+
 /// `<φ_I| V/|r_w| |φ_J>` of plain ECGs (hartree/bohr; `v = [w]`).
 pub fn coulomb_inv_r<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
-    let Some(chol) = (F::exponent(bra) + F::exponent(ket)).cholesky() else { return f64::NAN };
-    let whiten = |w: &Vector<D>| chol.l().solve_lower_triangular(w).unwrap_or_else(|| Vector::<D>::repeat(f64::NAN));
+    let Some(whiten) = whitening::<D, F>(bra, ket) else { return f64::NAN };
     let a = whiten(&v[0]);
     let s = F::overlap(bra, ket, ctx);
     F::operators(ctx).pairs.iter().map(|(w, charge)| charge * inverse_product(&a, &whiten(w))).sum::<f64>() * s
@@ -62,8 +68,7 @@ pub fn coulomb_inv_r<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: 
 /// `<φ_I| V/|r_w| |φ_J>` of any family by eq. (38) (hartree/bohr; `v = [w]`; module docs).
 pub fn coulomb_by_damping<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
     let w = &v[0];
-    let Some(chol) = (F::exponent(bra) + F::exponent(ket)).cholesky() else { return f64::NAN };
-    let whiten = |w: &Vector<D>| chol.l().solve_lower_triangular(w).unwrap_or_else(|| Vector::<D>::repeat(f64::NAN));
+    let Some(whiten) = whitening::<D, F>(bra, ket) else { return f64::NAN };
     let (a, ww) = (whiten(w), w * w.transpose());
     let q = a.norm_squared();
     let pair = |wp: &Vector<D>| {
