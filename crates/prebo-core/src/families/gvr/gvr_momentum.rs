@@ -25,7 +25,7 @@
 //! orbit–orbit element (`orbit`) is read off the same generating function of damped functions.
 use std::f64::consts::PI;
 
-use nalgebra::{Cholesky, SMatrix, SVector};
+use nalgebra::{Cholesky, Const, SMatrix, SVector};
 use num_dual::{DualNum, HyperDual64};
 
 use super::gvr_element::{legendre_rule, Gvr, GvrOps};
@@ -34,7 +34,7 @@ use crate::ecg::Vector;
 
 type H = HyperDual64;
 
-/// The generating function's moves (eq. 26a): `B' = B + b`, `u_I' = u_I + u_i`, `u_J' = u_J + u_j`,
+/// The generating function's moves (eq. 26a; `Generating::at`): `B' = B + b`, `u_I' = u_I + u_i`, `u_J' = u_J + u_j`,
 /// and Ω's arguments moved by `omega` beyond the covariances under B'.
 struct Moves<const D: usize> {
     b: SMatrix<H, D, D>,
@@ -48,28 +48,46 @@ fn dyad<const D: usize>(v: &Vector<D>, w: &Vector<D>, c: H) -> SMatrix<H, D, D> 
     ((v * w.transpose() + w * v.transpose()) * 0.5).map(H::from) * c
 }
 
-/// `G(moves) / (S_0(B) e^L)` and `S_0(B) e^L / (𝒩_I 𝒩_J)`, L = Ω's scale at B (`omega`): the
-/// normalised element of the moved functions is their product. None where B or B' does not
-/// factorise.
-fn generating<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, moves: Moves<D>) -> Option<(H, f64)> {
-    let b = bra.a + ket.a;
-    let chol = b.cholesky()?;
-    let chol_moved = Cholesky::new(b.map(H::from) + moves.b)?;
-    let (ui, uj) = (bra.u.map(H::from) + moves.u_i, ket.u.map(H::from) + moves.u_j);
-    let (bi, bj) = (chol_moved.solve(&ui), chol_moved.solve(&uj));
-    let [dx, dy, dz] = moves.omega;
-    let (x, y, z) = (ui.dot(&bi) * 0.5 + dx, uj.dot(&bj) * 0.5 + dy, ui.dot(&bj) * 0.5 + dz);
-    let (ci, cj) = (chol.solve(&bra.u), chol.solve(&ket.u));
-    let series = Coefficients::new(bra.k, ket.k, go.n_ang);
-    let (l0, ..) = omega(&series.terms(), bra.u.dot(&ci) * 0.5, ket.u.dot(&cj) * 0.5, bra.u.dot(&cj) * 0.5);
-    let (l, om, ..) = omega(&series.terms(), x, y, z);
-    let log_det_0 = chol.l().diagonal().map(f64::ln).sum() * 2.0;
-    let l_moved = chol_moved.l();
-    let log_det = (0..D).fold(H::from(0.0), |acc, k| acc + l_moved[(k, k)].ln() * 2.0);
-    // S_0(B')/S_0(B) = (|B|/|B'|)^{3/2}
-    let ratio = ((log_det - log_det_0) * -1.5 + (l - l0)).exp() * om;
-    let log_s0 = (log_det_0 - D as f64 * PI.ln()) * -1.5;
-    Some((ratio, (log_s0 + l0 - bra.log_norm - ket.log_norm).exp()))
+/// What every move of one pair's generating function shares: the factor of `B = A_I + A_J`, Ω's
+/// series and its scale L at B, and `S_0(B) e^L / (𝒩_I 𝒩_J)`, by which `at`'s ratios become
+/// normalised elements.
+struct Generating<'a, const D: usize> {
+    bra: &'a Gvr<D>,
+    ket: &'a Gvr<D>,
+    chol: Cholesky<f64, Const<D>>,
+    series: Coefficients,
+    log_det: f64,
+    l: f64,
+    scale: f64,
+}
+
+impl<'a, const D: usize> Generating<'a, D> {
+    /// None where `A_I + A_J` does not factorise.
+    fn new(bra: &'a Gvr<D>, ket: &'a Gvr<D>, go: &GvrOps<D>) -> Option<Self> {
+        let chol = (bra.a + ket.a).cholesky()?;
+        let (ci, cj) = (chol.solve(&bra.u), chol.solve(&ket.u));
+        let series = Coefficients::new(bra.k, ket.k, go.n_ang);
+        let (l, ..) = omega(&series.terms(), bra.u.dot(&ci) * 0.5, ket.u.dot(&cj) * 0.5, bra.u.dot(&cj) * 0.5);
+        let log_det = chol.l().diagonal().map(f64::ln).sum() * 2.0;
+        let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
+        let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
+        Some(Self { bra, ket, chol, series, log_det, l, scale })
+    }
+
+    /// `G(moves) / (S_0(B) e^L)`; None where B' does not factorise.
+    fn at(&self, moves: Moves<D>) -> Option<H> {
+        let (bra, ket) = (self.bra, self.ket);
+        let moved = Cholesky::new((bra.a + ket.a).map(H::from) + moves.b)?;
+        let (ui, uj) = (bra.u.map(H::from) + moves.u_i, ket.u.map(H::from) + moves.u_j);
+        let (bi, bj) = (moved.solve(&ui), moved.solve(&uj));
+        let [dx, dy, dz] = moves.omega;
+        let (x, y, z) = (ui.dot(&bi) * 0.5 + dx, uj.dot(&bj) * 0.5 + dy, ui.dot(&bj) * 0.5 + dz);
+        let (l, om, ..) = omega(&self.series.terms(), x, y, z);
+        let l_moved = moved.l();
+        let log_det = (0..D).fold(H::from(0.0), |acc, k| acc + l_moved[(k, k)].ln() * 2.0);
+        // S_0(B')/S_0(B) = (|B|/|B'|)^{3/2}
+        Some(((log_det - self.log_det) * -1.5 + (l - self.l)).exp() * om)
+    }
 }
 
 /// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` for normalised ECG-GVR functions (eq. 26b, with
@@ -86,7 +104,7 @@ pub fn momentum<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &
         u_j: hj.map(H::from) * (e2 * (-4.0 * ugj)),
         omega: [e1 * (2.0 * ugi * ugi), e2 * (2.0 * ugj * ugj), H::from(0.0)],
     };
-    let Some((g_h, scale)) = generating(bra, ket, go, moves) else {
+    let Some((g_h, scale)) = Generating::new(bra, ket, go).and_then(|gen| Some((gen.at(moves)?, gen.scale))) else {
         return (f64::NAN, f64::NAN);
     };
     let laplacian = g_h.eps2 + cj * g_h.re;
@@ -104,14 +122,13 @@ pub fn momentum<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &
 /// and `r_w·∇_hφ_J`. The τ-integrand is a polynomial of degree ≤ K_I + K_J + N + 2 in τ².
 pub fn orbit<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
     let (w, g, h) = (&v[0], &v[1], &v[2]);
-    let Some(chol) = (bra.a + ket.a).cholesky() else { return f64::NAN };
-    let q = w.dot(&chol.solve(w));
+    let Some(gen) = Generating::new(bra, ket, go) else { return f64::NAN };
+    let q = w.dot(&gen.chol.solve(w));
     let (hi, hj) = (bra.a * g, ket.a * h);
     let (ugi, uhj) = (bra.u.dot(g), ket.u.dot(h));
     let (e1, e2, zero) = (H::new(0.0, 1.0, 0.0, 0.0), H::new(0.0, 0.0, 1.0, 0.0), H::from(0.0));
     let lift = |v: &Vector<D>, c: H| v.map(H::from) * c;
     let mut sum = 0.0;
-    let mut scale = f64::NAN;
     for &(tau, weight) in legendre_rule(((bra.k + ket.k + go.n_ang) / 2 + 2) as usize) {
         let (t2, shrink) = (tau * tau / (q * (1.0 - tau * tau)), 1.0 - tau * tau);
         let damping = dyad(w, w, H::from(t2));
@@ -127,11 +144,8 @@ pub fn orbit<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, v: &[Ve
             u_j: lift(w, e2 * uhj),
             omega: [zero; 3],
         };
-        let (Some((one, s)), Some((two, _))) = (generating(bra, ket, go, isotropic), generating(bra, ket, go, radial)) else {
-            return f64::NAN;
-        };
-        scale = s;
+        let (Some(one), Some(two)) = (gen.at(isotropic), gen.at(radial)) else { return f64::NAN };
         sum += weight * (one.eps1 + 2.0 * t2 * two.eps1eps2) / shrink.powf(1.5);
     }
-    scale * 2.0 / (PI * q).sqrt() * sum
+    gen.scale * 2.0 / (PI * q).sqrt() * sum
 }
