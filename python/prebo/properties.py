@@ -79,8 +79,8 @@ def corrections(basis, level: dict) -> dict:
     (`drachmann.p4_regularised`), and "breit_pauli", the Breit–Pauli correction
     (`relativistic.terms`) — with both regularised values where there are both ("regularised":
     true), else with the direct ones (the two err together, docs/relativistic.md)."""
-    out, have = {}, set(level.get("expectation", {}))
-    expectation = level.get("expectation", {})
+    out, expectation = {}, level.get("expectation", {})
+    have = set(expectation)
     if set(drachmann.TERMS) <= have:
         out["delta_regularised"] = drachmann.regularised(basis.system, expectation, level["energy"])
     if set(drachmann.P4_TERMS) <= have:
