@@ -25,7 +25,7 @@ use crate::error::{CoreError, Result};
 use crate::gradient::Dual;
 use crate::images::Transform;
 use crate::matrices::Matrices;
-use crate::operators::{momentum, orbit, ElementFn};
+use crate::operators::{drachmann, momentum, orbit, ElementFn};
 
 pub mod floating;
 pub mod gvr;
@@ -179,18 +179,6 @@ pub enum Shape {
     Exponential,
 }
 
-/// What a family's function is beside its Gaussian `exp(−tr((r − s)ᵀ A (r − s)))`: the operators
-/// whose elements are written for a bare Gaussian (`operators::drachmann`) ask this of a family.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Form {
-    /// The Gaussian about the origin (plain ECGs).
-    Plain,
-    /// The Gaussian about centres `s` (`Family::centres`; floating ECGs).
-    Floating,
-    /// The Gaussian times a polynomial of a global vector (ECG-GVR).
-    GlobalVector,
-}
-
 /// `<phi_I| N_TI² |phi_J>` of normalised functions of family `F` (`operators::angular`), `μ` the
 /// mass fractions.
 pub type Angular<const D: usize, F> = fn(&<F as Family<D>>::Function<f64>, &<F as Family<D>>::Function<f64>, &Vector<D>) -> f64;
@@ -218,8 +206,6 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// Whether `rows(.., position)` evaluates every element in the orientation of a full build
     /// (lower index as bra), so that rows patched into the matrices give the bits of `matrices`.
     const ORIENTED: bool = true;
-    /// What a function is beside its Gaussian (`Form`).
-    const FORM: Form;
     /// The element of the momentum operators `p_h²` and `p_g² p_h²` (`Momentum`): by default that
     /// of a Gaussian about centres (plain and floating ECGs, `operators::momentum::gaussian`), for
     /// ECG-GVR its own.
@@ -228,6 +214,11 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// that of functions whose gradients are a Gaussian times a linear polynomial (plain and
     /// floating ECGs), for ECG-GVR its own.
     const ORBIT: ElementFn<D, Self> = orbit::element::<D, Self>;
+    /// The element of `V/|r_w|` (`operators::drachmann`, operator `coulomb_inv_r`): by default
+    /// eq. (38) over the family's own `1/|r_w'|` element of its damped functions
+    /// (`drachmann::coulomb_by_damping`); plain ECGs have it in closed form (eq. 19), ECG-GVR reads
+    /// the damped elements off one factorisation.
+    const COULOMB: ElementFn<D, Self> = drachmann::coulomb_by_damping::<D, Self>;
     /// The element of `N_TI²` where the functions are not its eigenfunctions (`Angular`), `None`
     /// where they are (`N_TI² φ = N(N + 1) φ`).
     const ANGULAR: Option<Angular<D, Self>> = None;
@@ -276,13 +267,17 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// The Gaussian exponent `A` of `f`, `exp(−r^T (A ⊗ I_3) r)` (the representation's coordinates).
     fn exponent(f: &Self::Function<f64>) -> &Mat<D>;
 
-    /// The centres `s` of the Gaussian of `f` (zero but for `Form::Floating`).
+    /// The centres `s` of the Gaussian of `f` (zero but for floating ECGs).
     fn centres(_f: &Self::Function<f64>) -> Centres<D> {
         Centres::<D>::zeros()
     }
 
     /// The Hamiltonian's operators (Λ, the Coulomb pairs, the CM mass) the context holds.
     fn operators(ctx: &Self::Context) -> &Operators<D>;
+
+    /// `ctx` without the Coulomb pairs: its `element` is `S, T, T_TI` with `V = 0`, at no Coulomb
+    /// cost (the kinetic elements of damped functions, `drachmann::gradient_inv_r`).
+    fn kinetic_only(ctx: &Self::Context) -> Self::Context;
 
     /// `<phi_I| p_g² |phi_J>` (`operators::momentum`): `MOMENTUM`'s, where a family has no
     /// cheaper one (ECG-GVR: its kinetic element with `Λ = g g^T`).

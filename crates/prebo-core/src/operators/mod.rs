@@ -56,7 +56,7 @@ fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<
         (momentum::P2, 1, one_vector!(momentum::p2::<D, F>)),
         (momentum::P4, 1, one_vector!(momentum::p4::<D, F>)),
         (momentum::P2P2, 2, Some(momentum::p2p2::<D, F>)),
-        (drachmann::COULOMB, 1, Some(drachmann::coulomb::<D, F>())),
+        (drachmann::COULOMB, 1, Some(F::COULOMB)),
         (drachmann::GRADIENT, 1, Some(drachmann::gradient_inv_r::<D, F>)),
         (orbit::NAME, 3, Some(F::ORBIT)),
         (angular::NAME, 1, F::ANGULAR.and_then(|_| one_vector!(angular::element::<D, F>))),

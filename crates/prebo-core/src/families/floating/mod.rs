@@ -11,7 +11,7 @@ use nalgebra::SMatrix;
 use crate::cache::Cache;
 use crate::ecg::{re, Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Angular, Column, Directions, Exponents, Family, Field, Form, Shape, Symmetry};
+use crate::families::{columns, matrices_of, Angular, Column, Directions, Exponents, Family, Field, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::matrices::Matrices;
 use crate::path;
@@ -27,7 +27,6 @@ pub struct FloatingEcg;
 impl<const D: usize> Family<D> for FloatingEcg {
     const NAME: &'static str = "fecg";
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("s"), Field::floats("c_A")];
-    const FORM: Form = Form::Floating;
     const ANGULAR: Option<Angular<D, Self>> = Some(fecg::angular::<D>);
     type Function<T: Real> = Fecg<D, T>;
     type Context = Operators<D>;
@@ -73,6 +72,10 @@ impl<const D: usize> Family<D> for FloatingEcg {
 
     fn operators(ctx: &Self::Context) -> &Operators<D> {
         ctx
+    }
+
+    fn kinetic_only(ctx: &Self::Context) -> Self::Context {
+        Operators { pairs: vec![], ..ctx.clone() }
     }
 
     fn shape(_bra: &Fecg<D>, _ket: &Fecg<D>, _ctx: &Operators<D>, _w: &Vector<D>) -> Shape {

@@ -104,6 +104,11 @@ impl<const D: usize> GvrOps<D> {
         Self { ops: Operators { lambda, pairs: vec![], cm_mass: None }, n_ang: self.n_ang, legendre: self.legendre.clone() }
     }
 
+    /// This context without the Coulomb pairs (`Family::kinetic_only`).
+    pub fn without_pairs(&self) -> Self {
+        Self { ops: Operators { pairs: vec![], ..self.ops.clone() }, n_ang: self.n_ang, legendre: self.legendre.clone() }
+    }
+
     fn k_max(&self) -> u32 {
         ((self.legendre.len() - 1) as u32 - self.n_ang) / 2
     }
@@ -195,7 +200,7 @@ pub fn functions<const D: usize>(p: &GvrParams, go: &GvrOps<D>) -> Result<Vec<Gv
 /// `[x, y, z, γ_I, γ_J]`. At a node the integrand is, with `a = x_τ/x`, `b = y_τ/y`,
 /// `ζ = z_τ/√(xy)`, `P(a, b, ζ) = Σ ĉ_k a^{K_I−k} b^{K_J−k} ζ^{N+2k} = a^{K_I} b^{K_J} ζ^N G(ζ²/(ab))`:
 /// integer powers of ratios ≤ 1 and a polynomial in `ζ²/(ab)` ≤ 1.
-fn quadrature<T: Real>(inputs: [T; 5], rule: &[(f64, f64)], series: &Coefficients) -> T {
+pub(crate) fn quadrature<T: Real>(inputs: [T; 5], rule: &[(f64, f64)], series: &Coefficients) -> T {
     let [x, y, z, gam_i, gam_j] = inputs;
     let rt = (x * y).sqrt();
     let mut integral = T::zero();

@@ -10,13 +10,15 @@
 //! - `gvr_gradient`: the row gradient by hand-derived reverse mode in the kernel's lanes;
 //! - `gvr_momentum`: `p_g²`, `p_g⁴` and the orbit–orbit operator from the overlap's generating
 //!   function (eqs. 26–26c);
+//! - `gvr_drachmann`: `V/|r_w|` (eq. 38) from the Coulomb elements of damped functions as
+//!   rank-one updates of one factorisation;
 //! - `gvr_coulomb` (tests only): the closed form of the Coulomb τ-integral.
 use nalgebra::SMatrix;
 
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Form, Momentum, Shape, Symmetry};
+use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Momentum, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
@@ -28,6 +30,7 @@ pub mod gvr_build;
 /// The closed-form Coulomb τ-integral (docs/gvr.md): slower than the quadrature it checks.
 #[cfg(test)]
 mod gvr_coulomb;
+pub mod gvr_drachmann;
 pub mod gvr_element;
 pub mod gvr_gradient;
 pub mod gvr_kernel;
@@ -42,9 +45,9 @@ impl<const D: usize> Family<D> for EcgGvr {
     const NAME: &'static str = "ecg-gvr";
     const FIELDS: &'static [Field] =
         &[Field::floats("A"), Field::floats("u"), Field::naturals("K"), Field::floats("c_A")];
-    const FORM: Form = Form::GlobalVector;
     const MOMENTUM: Momentum<D, Self> = gvr_momentum::momentum::<D>;
     const ORBIT: ElementFn<D, Self> = gvr_momentum::orbit::<D>;
+    const COULOMB: ElementFn<D, Self> = gvr_drachmann::coulomb_inv_r::<D>;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = GvrParams<'a>;
@@ -83,6 +86,10 @@ impl<const D: usize> Family<D> for EcgGvr {
 
     fn operators(ctx: &Self::Context) -> &Operators<D> {
         &ctx.ops
+    }
+
+    fn kinetic_only(ctx: &Self::Context) -> Self::Context {
+        ctx.without_pairs()
     }
 
     /// The kinetic element with `Λ = g g^T`, cheaper than `MOMENTUM`'s hyper-dual numbers.

@@ -11,11 +11,12 @@ use super::gvr::gvr_element::{self, Gvr, GvrOps};
 use crate::cache::Cache;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Form, Parameters, Shape, Symmetry};
+use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Parameters, Shape, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::images::Images;
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
+use crate::operators::{drachmann, ElementFn};
 use crate::path;
 
 pub mod pecg;
@@ -42,7 +43,8 @@ impl<const D: usize> Family<D> for PlainEcg {
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("c_A")];
     /// Rows in full-build orientation from the SIMD kernel (`pecg_build::rows`).
     const ORIENTED: bool = true;
-    const FORM: Form = Form::Plain;
+    /// Eq. (19) in closed form.
+    const COULOMB: ElementFn<D, Self> = drachmann::coulomb_inv_r::<D, Self>;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = Exponents<'a>;
@@ -85,6 +87,10 @@ impl<const D: usize> Family<D> for PlainEcg {
 
     fn operators(ctx: &Self::Context) -> &Operators<D> {
         &ctx.ops
+    }
+
+    fn kinetic_only(ctx: &Self::Context) -> Self::Context {
+        ctx.without_pairs()
     }
 
     fn shape(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, _w: &Vector<D>) -> Shape {
