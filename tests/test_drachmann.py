@@ -10,6 +10,7 @@ import pytest
 import prebo
 from prebo import eigen
 from prebo.cli import main
+from prebo import drachmann
 from prebo.drachmann import delta_regularised
 from prebo.expectation import expectation
 from prebo.integrals import laboratory, translationally_invariant
@@ -76,6 +77,8 @@ def test_floating_and_global_vector_functions_regularise_too(name, size):
     (direct,), (regularised,) = expectation(rep, basis, C, "delta"), delta_regularised(rep, basis, C, E)
     ref = reference["e-p"]
     assert abs(regularised["e-p"] - ref) < abs(direct["e-p"] - ref) / 4, (ref, direct, regularised)
+    # the protons repel and are heavy: their contact density stays the direct one (drachmann.regularisable)
+    assert set(regularised) == {"e-p"}
     rep, C, E = states(basis, 1, translationally_invariant(basis.system))
     (invariant,) = delta_regularised(rep, basis, C, E)
     assert abs(invariant["e-p"] / regularised["e-p"] - 1) < 1e-7, (invariant, regularised)
@@ -99,3 +102,21 @@ def test_properties_report_the_regularised_contact_density_of_each_level(tmp_pat
     fecg.save(tmp_path / "basis.json")
     assert main(["properties", str(tmp_path / "basis.json"), "--regularised", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["delta_regularised"] == got
+
+
+def test_a_heavy_repelling_pair_keeps_the_direct_contact_density():
+    """H₂ in 80 plain ECGs (examples/bases/h2-pecg): Drachmann's form for p-p multiplies its bracket's
+    basis error by μ_pp/π ≈ 292 and gives −6.40 bohr⁻³ (measured) where the direct value is 4.4e-3 and
+    the exact one is positive; so p-p is not regularised and the Breit–Pauli report takes its
+    direct value, while e-p and e-e are regularised."""
+    basis = prebo.Basis.load(ROOT / "examples" / "bases" / "h2-pecg" / "basis.json")
+    p = prebo.properties(basis)
+    assert set(p["delta_regularised"]) == {"e-p", "e-e"} and p["breit_pauli"]["regularised"]
+    direct, m = p["expectation"]["delta"]["p-p"], basis.system.particles[0].mass
+    assert direct > 0
+    # the Darwin term of the one p-p pair of two Dirac protons (q_p² = 1) with the direct value
+    darwin = -np.pi * prebo.relativistic.ALPHA**2 / 2 * (2 / m**2) * direct
+    assert p["breit_pauli"]["classes"]["darwin"]["p-p"] == pytest.approx(darwin, rel=1e-12)
+    # what the form would give for p-p: below zero
+    inv_r, potential, gradient = (p["expectation"][name]["p-p"] for name in drachmann.TERMS)
+    assert m / 2 / np.pi * (p["energy"] * inv_r - potential - gradient) < -1

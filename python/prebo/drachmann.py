@@ -10,6 +10,12 @@ density at one point. Its elements are the core's "inv_r", "coulomb_inv_r" and "
 plain ECGs (eq. 19) and a quadrature over the family's damped ⟨1/r⟩ elements for floating ECGs and
 ECG-GVR (eq. 38), up to a millisecond per element: `CLOSED_FORM` says where it is cheap.
 
+The bracket is multiplied by μ_ij/π, so its basis error is too: for two heavy particles that repel
+(p-p in H₂⁺ and H₂, d-t), whose contact density is tiny, a ~1000-fold amplified error swamps it and
+the regularised value is worse than the direct one, even negative (H₂⁺ in 400 floating ECGs: direct
+1.1e-6, regularised −2.0e-3 bohr⁻³; benchmarks/README.md). Such pairs keep the direct value: a pair
+is regularised where it attracts or holds one of the lightest particles (`regularisable`).
+
 The same eigenvalue equation regularises ⟨p_i⁴⟩ (eq. 27'): T_TI = Σ_i p_i²/(2m_i) with the momenta
 in the centre-of-mass frame, so ⟨T_TI²⟩ = ⟨(E − V)²⟩ = E² − 2E⟨V⟩ + ⟨V²⟩, ⟨V²⟩ = Σ_{i<j} q_iq_j⟨V/r_ij⟩,
 and for the class a of the lightest particles (n_a of mass m_a)
@@ -47,14 +53,27 @@ def delta_regularised(rep, basis, C: np.ndarray, energies) -> list[dict[str, flo
     return [regularised(basis.system, {name: values[name][s] for name in TERMS}, E) for s, E in enumerate(energies)]
 
 
+def regularisable(system) -> list[str]:
+    """The pair classes "a-b" of `system` whose ⟨δ³(r_ij)⟩ is regularised (module docstring): those
+    that attract (q_a q_b < 0) or hold a particle of the lightest mass; not two heavier particles
+    that repel."""
+    light = min(p.mass for p in system.particles)
+    out = []
+    for label, ms in members(system, pairs=True).items():
+        a, b = (system.particles[k] for k in ms[0])
+        if a.charge * b.charge < 0 or min(a.mass, b.mass) == light:
+            out.append(label)
+    return out
+
+
 def regularised(system, expectation: dict, energy: float) -> dict[str, float]:
     """{pair class "a-b": the regularised ⟨δ³(r_ij)⟩ (bohr⁻³)} of one eigenstate of `system` with
     the energy `energy` (Eh) from its expectation values of TERMS ({operator: {class: value}}, as
-    `results.evaluate` gives them)."""
+    `results.evaluate` gives them), for the `regularisable` classes."""
     mu = {label: reduced_mass(*system.masses[list(ms[0])]) for label, ms in members(system, pairs=True).items()}
     inv_r, potential, gradient = (expectation[name] for name in TERMS)
     return {label: float(mu[label] / np.pi * (energy * inv_r[label] - potential[label] - gradient[label]))
-            for label in inv_r}
+            for label in regularisable(system)}
 
 
 def p4_regularised(system, expectation: dict, energy: float) -> dict[str, float]:

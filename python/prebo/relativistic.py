@@ -47,7 +47,7 @@ def terms(system, expectation: dict, delta: dict | None = None, p4: dict | None 
     """The Breit–Pauli terms (module docstring) of one level of `system` from its expectation
     values `expectation` ({operator: {class: value}}, as `results.evaluate` gives them, with every
     operator of NEEDS); `delta`, contact densities per pair class to use instead of the direct
-    ⟨δ³(r_ij)⟩, and `p4`, ⟨p_i⁴⟩ per particle class to use instead of the direct ones where given
+    ⟨δ³(r_ij)⟩ where given, and `p4`, ⟨p_i⁴⟩ per particle class to use instead of the direct ones where given
     (`drachmann.regularised` and `drachmann.p4_regularised`; docs/relativistic.md on pairing them).
 
     Returns {"Eh": {term: E, "total": Σ}, "cm-1": the same × HARTREE_CM, "classes": {term:
@@ -55,7 +55,7 @@ def terms(system, expectation: dict, delta: dict | None = None, p4: dict | None 
     the others per pair class (the spin–spin contact only for classes of identical spin-½
     particles), each summed over the class's members."""
     a2 = ALPHA**2
-    delta = expectation["delta"] if delta is None else delta
+    delta = expectation["delta"] | (delta or {})
     p4 = expectation["p4"] | (p4 or {})
     classes = {term: {} for term in TERMS}
     for label, ms in members(system, pairs=False).items():
