@@ -122,6 +122,10 @@ def test_a_run_for_several_roots_resumes_bit_for_bit(tmp_path):
     assert np.array_equal(resumed.A, whole.A)
     d = json.loads((tmp_path / "whole" / "basis.json").read_text())
     assert d["levels"] == [0, 1] and d["followed"] == [] and d["system"]["state"]["roots"] == [0, 1]
+    # the file's energy is the lowest root's, the objective Σ w_k E_k what the history records
+    levels = [v["energy"] for v in prebo.evaluate(prebo.Basis.load(tmp_path / "whole" / "basis.json"), roots=2)["levels"]]
+    assert d["energy"] == pytest.approx(levels[0], rel=1e-13)
+    assert d["objective"] == pytest.approx(levels[0] + 2 * levels[1], rel=1e-13) == d["history"][-1][1]
 
 
 @pytest.mark.parametrize("particles", [["p", "e", "e"], ["e+", "e", "e"]], ids=["H-", "Ps-"])
@@ -139,3 +143,7 @@ def test_root_1_of_h_minus_and_ps_minus_is_optimised_and_reported_not_bound(tmp_
     assert not r["levels"][1]["bound"] and r["levels"][1]["energy"] > r["threshold"]
     err = capsys.readouterr().err
     assert "level 1 not below the dissociation threshold" in err and len(err.splitlines()) == 1
+    # the head of the text output is root 0's, and says so where other levels were optimised
+    assert main(["energy", str(tmp_path / "run" / "basis.json")]) == 0
+    out = capsys.readouterr().out
+    assert "energy of root 0 (translation-free)" in out and "binding energy of root 0" in out

@@ -159,3 +159,32 @@ def test_prebo_energy_warns_when_not_bound(tmp_path, capsys):
     assert main(["energy", str(ROOT / "examples" / "bases" / "h-" / "basis.json")]) == 0
     out, err = capsys.readouterr()
     assert err == "" and "(bound)" in out
+
+
+# --- break-ups the hydrogen-like search does not count ----------------------------------------
+@pytest.mark.parametrize("particles, unchecked", [
+    (["alpha", "e", "e", "e"], "alpha-e-e + e"),   # He⁻: He + e lies below He⁺ + e + e
+    (["p", "p", "e", "e"], "p-p-e + e"),           # H₂: H₂⁺ + e (above H + H, but not computed)
+    (["alpha", "p", "e", "e"], "alpha-p-e + e"),   # HeH⁺: He + p lies below He⁺ + H
+    (["p", "e", "e"], None),                       # three particles: every fragment is counted
+    (["e+", "e", "e"], None),
+    (["e", "e", "e", "e"], None),                  # no fragment can bind
+])
+def test_a_fragment_of_three_or_more_particles_is_named_where_it_could_bind(particles, unchecked):
+    assert hydrogen_like(prebo.System(particles)).unchecked == unchecked
+    given = prebo.System(particles, threshold=-100.0)
+    assert lowest(given).fragments == "given" and lowest(given).unchecked is None
+
+
+def test_bound_is_qualified_where_a_break_up_was_not_computed(capsys):
+    """H₂ (4 particles): 'bound' below H + H, with H₂⁺ + e named as not computed; H₂⁺ (3): plainly."""
+    h2 = ROOT / "examples" / "bases" / "h2-pecg" / "basis.json"
+    assert main(["energy", str(h2), "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["bound"] is True and r["threshold_unchecked"] == "p-p-e + e"
+    assert main(["energy", str(h2)]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "bound below the thresholds computed" in out and "give [state] threshold" in out
+    assert main(["energy", str(ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json"), "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["bound"] is True and r["threshold_unchecked"] is None

@@ -57,7 +57,9 @@ def _print_result(r: dict) -> None:
     from .optimise.adaptive import RATIO
 
     t = Table(show_header=False, box=None)
-    t.add_row("energy (translation-free)", f"{r['energy']:.12f} Eh")
+    # the head is root 0's (results.evaluate); a basis optimised for other levels says so
+    of = "" if r.get("targets", [0]) == [0] else " of root 0"
+    t.add_row(f"energy{of} (translation-free)", f"{r['energy']:.12f} Eh")
     t.add_row("numerical uncertainty", f"{r['energy_uncertainty']:.1e} Eh")
     if r.get("energy_lab") is not None:
         t.add_row("energy (laboratory frame)", f"{r['energy_lab']:.12f} Eh")
@@ -65,7 +67,7 @@ def _print_result(r: dict) -> None:
     for fragments, energy in r["thresholds"].items():
         t.add_row("given threshold" if fragments == "given" else "dissociation threshold",
                   f"{energy:.12f} Eh" + ("" if fragments == "given" else f" ({fragments})"))
-    t.add_row("binding energy", f"{r['binding_energy']:.3e} Eh ({'bound' if r['bound'] else 'not bound'})")
+    t.add_row(f"binding energy{of}", f"{r['binding_energy']:.3e} Eh ({_bound(r)})")
     t.add_row("basis", f"{r['n_basis']} {r['basis_type']} functions")
     t.add_row("particles", " ".join(p["name"] for p in r["particles"]))
     t.add_row("overlap condition", f"{r['overlap_condition']:.2e} ({r['kept']} kept)")
@@ -89,6 +91,15 @@ def _print_result(r: dict) -> None:
     Console().print(t)
     if "levels" in r:
         _print_levels(r)
+
+
+def _bound(r: dict) -> str:
+    """'bound' or 'not bound' below the threshold, qualified where a break-up was not computed."""
+    if not r["bound"]:
+        return "not bound"
+    unchecked = r.get("threshold_unchecked")
+    return "bound" if unchecked is None else (f"bound below the thresholds computed; break-ups with a fragment of three "
+                                              f"or more particles, e.g. {unchecked}, were not: give \\[state] threshold")
 
 
 def _print_levels(r: dict) -> None:
@@ -404,7 +415,7 @@ def cmd_properties(args) -> int:
         print(json.dumps(p, allow_nan=False))
         return 0
     head = Table(show_header=False, box=None)
-    head.add_row("level", f"root {p['root']} ({'bound' if p['bound'] else 'not bound'})")
+    head.add_row("level", f"root {p['root']} ({_bound(p)})")
     head.add_row("energy (translation-free)", f"{p['energy']:.12f} Eh ± {p['energy_uncertainty']:.1e}")
     head.add_row("virial η_TI", f"{p['virial']:.2e}")
     if "n2" in p:

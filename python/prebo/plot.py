@@ -1,7 +1,8 @@
 """The pictures: convergence plots from run checkpoints (`convergence`) and the distance
 distributions of levels (`densities`).
 
-Convergence: energy against basis size and against wall time (one line per run).
+Convergence: energy against basis size and against wall time (one line per run); for a run for
+excited levels the objective it lowers, Σ w_k E_k of the targeted levels, and the axis says so.
 
 The growth phase gives one point per basis size; refinement sweeps at the final size are
 drawn as a vertical run of points there, and spread out in the wall-time panel (histories
@@ -22,10 +23,11 @@ from .errors import BasisFileError, InputError
 FORMATS = (".png", ".pdf", ".svg")
 
 
-def history(folder: Path) -> list:
+def history(folder: Path) -> tuple[list, list | None]:
     """The optimisation history of the run checkpoint folder/basis.json: rows [basis size,
-    energy (Eh), phase, wall time (s) when recorded]; BasisFileError naming the file (and the
-    row: history.check_history) if there is none or a row is not one."""
+    energy (Eh; the objective Σ w_k E_k of a run for excited levels), phase, wall time (s) when
+    recorded], and the root indices of those levels (None: the lowest alone); BasisFileError naming
+    the file (and the row: history.check_history) if there is none or a row is not one."""
     from .io.basis_json import read
     from .optimise.checkpoint import CHECKPOINT
     from .optimise.history import check_history
@@ -35,7 +37,7 @@ def history(folder: Path) -> list:
     if not (isinstance(d, dict) and "history" in d):
         raise BasisFileError(f"{path}: no optimisation history (not written by `prebo run`)")
     try:
-        return check_history(d["history"])
+        return check_history(d["history"]), d.get("levels")
     except ValueError as exc:
         raise BasisFileError(f"{path}: {exc}") from None
 
@@ -60,13 +62,16 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None, 
     wall time on a log axis (its rows at time zero left out). Returns `png`.
     InputError for a suffix not in FORMATS or a reference not below every energy plotted."""
     plt = pyplot(png)
-    runs = [(Path(folder).name, history(folder)) for folder in folders]
+    read = [history(folder) for folder in folders]
+    runs = [(Path(folder).name, h) for folder, (h, _) in zip(folders, read)]
+    # a run for excited levels records the objective it lowers, Σ w_k E_k, not one level's energy
+    quantity = "E" if all(levels is None for _, levels in read) else "Σ w_k E_k"
     if start is not None:
         runs = [(name, since(h, start, str(folder))) for (name, h), folder in zip(runs, folders)]
     for name, h in runs:
         if reference is not None and min(row[1] for row in h) <= reference:
             raise InputError(f"--reference {reference!r} Eh is not below the energies of run {name} (lowest "
-                             f"{min(row[1] for row in h)!r} Eh): E - E_ref is drawn on a logarithmic axis")
+                             f"{min(row[1] for row in h)!r} Eh): {quantity} - E_ref is drawn on a logarithmic axis")
     timed = all(len(row) > 3 for _, h in runs for row in h)
     panels = [p for p, shown in (("size", start is None), ("time", timed)) if shown]
     fig, axes = plt.subplots(1, len(panels), figsize=(5.75 * len(panels) + 0.65 * (len(panels) == 1), 4.4),
@@ -85,9 +90,9 @@ def convergence(folders: list[Path], png: Path, reference: float | None = None, 
             ax.set_xscale("log")
         if reference is not None:
             ax.set_yscale("log")
-            ax.set_ylabel(f"E − E_ref  (E_ref = {reference} Eh)")
+            ax.set_ylabel(f"{quantity} − E_ref  (E_ref = {reference} Eh)")
         else:
-            ax.set_ylabel("E / Eh (translation-free)")
+            ax.set_ylabel(f"{quantity} / Eh (translation-free)")
         ax.grid(alpha=0.3)
         ax.legend()
     return save(fig, png)

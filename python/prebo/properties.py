@@ -34,7 +34,8 @@ def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float 
     """The properties of level `root` (0: the lowest of the basis's symmetry) of `basis`, with
     the regularised δ and p⁴ if `regularised` (None: where they are cheap, `reported`).
 
-    Returns {"root", "energy", "energy_uncertainty" (Eh), "virial", "bound", "expectation":
+    Returns {"root", "energy", "energy_uncertainty" (Eh), "virial", "bound", "threshold_unchecked"
+    (`results.evaluate`), "expectation":
     {operator: {class: value}}, "units": {operator: unit}, "not_derived": [operators]} (and "n2",
     ⟨N²⟩_TI in ħ², for floating ECGs): the `reported` operators of the basis family, per
     class of equivalent pairs "a-b" or particles "a", and those it has no element for; and
@@ -50,6 +51,7 @@ def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float 
     level = r["levels"][root] if "levels" in r else r
     keys = ("root", "energy", "energy_uncertainty", "virial", "bound", "n2", "expectation")
     return {k: level[k] for k in keys if k in level} | corrections(basis, level) | {
+        "threshold_unchecked": r["threshold_unchecked"],
         "root": root, "units": {k: OPERATORS[k].unit for k in names},
         "not_derived": [k for k, op in OPERATORS.items() if not op.evaluates(basis.family)]}
 

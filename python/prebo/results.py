@@ -7,7 +7,9 @@ module because it uses every earlier stage and none of them uses it.
 result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_uncertainty
 (Eh, below), energy_lab (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential,
 threshold (the lowest dissociation threshold, Eh: `thresholds.lowest`), threshold_fragments (its
-fragments, "p-e + e", or "given"), thresholds ({fragments or "given": Eh} of both candidates),
+fragments, "p-e + e", or "given"), threshold_unchecked (a break-up into a fragment of three or more
+particles that was not computed and may lie lower, "α-e-e + e"; None where none can or the
+threshold was given: `thresholds`), thresholds ({fragments or "given": Eh} of both candidates),
 bound (energy < threshold − energy_uncertainty), binding_energy (threshold − energy, Eh),
 n_basis, basis_type, particles, state, symmetry, coordinates, overlap_condition, kept; with
 `operators`, expectation ({operator: {pair class: value}} of operators registered in
@@ -135,6 +137,7 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         "energy_lab": energy_lab,
         "threshold": low.energy,
         "threshold_fragments": low.fragments,
+        "threshold_unchecked": low.unchecked,
         "thresholds": {t.fragments: t.energy for t in candidates(system)},
         "n_basis": len(basis),
         "basis_type": basis.family.name,

@@ -13,8 +13,10 @@ particles, whose only "fragment" is the system itself. E.g. H⁻: H + e, −μ_p
 H₂: H + H; Ps⁻: Ps + e, −1/4; Ps₂: Ps + Ps, −1/2; Li: Li²⁺ + e + e, −9μ/2.
 
 Caveats. Real thresholds can be lower: fragments of three or more particles are not counted (Li⁺ + e
-lies far below Li²⁺ + e + e), so the user may give a lower one (≤ 0: `[state] threshold`,
-`State(threshold=...)`) and `lowest` takes the lower of the two. prebo builds natural-parity states
+lies far below Li²⁺ + e + e, He + e below He⁺ + e + e for He⁻), so the user may give a lower one (≤ 0:
+`[state] threshold`, `State(threshold=...)`) and `lowest` takes the lower of the two. Where such a
+fragment could bind (it has an attracting pair) and no threshold is given, `hydrogen_like` names one
+(`Threshold.unchecked`, e.g. "α-e-e + e"), and the reports qualify "bound" by it. prebo builds natural-parity states
 (parity (−1)^N), and a ground-state fragment plus a free particle in the partial wave l = N has that
 N and parity whatever the exchange symmetry (the free particle is in no bound orbital), so such a
 channel is always open. Two identical fragments and no free particle (H + H, Ps + Ps) are different:
@@ -32,10 +34,13 @@ from .system import Particle, System, reduced_mass
 @dataclass(frozen=True)
 class Threshold:
     """A dissociation threshold: its `energy` (Eh) and `fragments`, a label of the fragments and free
-    particles ("p-e + e", "p-e + p-e"; "given" for the user's threshold)."""
+    particles ("p-e + e", "p-e + p-e"; "given" for the user's threshold); `unchecked` labels a
+    break-up into a fragment of three or more particles that could lie lower and was not computed
+    (None: every fragment that can bind was counted, or the threshold was given)."""
 
     energy: float
     fragments: str
+    unchecked: str | None = None
 
 
 def pair_energy(a: Particle, b: Particle) -> float:
@@ -66,7 +71,22 @@ def hydrogen_like(system: System) -> Threshold:
     energy, pairs = best(tuple(range(system.n))) if system.n > 2 else (0.0, [])
     paired = {k for pair in pairs for k in pair}
     parts = [f"{ps[i].name}-{ps[j].name}" for i, j in pairs] + [p.name for k, p in enumerate(ps) if k not in paired]
-    return Threshold(energy, " + ".join(parts))
+    return Threshold(energy, " + ".join(parts), uncounted(system))
+
+
+def uncounted(system: System) -> str | None:
+    """A break-up `hydrogen_like` does not count: the system less one particle (the lightest that
+    leaves an attracting pair behind), a fragment of three or more particles that may bind, plus that
+    particle free ("α-e-e + e" for He⁻); None for three particles or fewer, or where no fragment of
+    three or more particles has an attracting pair."""
+    ps = system.particles
+    if system.n < 4:
+        return None
+    for k in sorted(range(system.n), key=lambda k: ps[k].mass):
+        rest = [p for i, p in enumerate(ps) if i != k]
+        if any(a.charge * b.charge < 0 for i, a in enumerate(rest) for b in rest[i + 1:]):
+            return "-".join(p.name for p in rest) + f" + {ps[k].name}"
+    return None
 
 
 def candidates(system: System) -> list[Threshold]:

@@ -40,8 +40,8 @@ CONVENTIONS = {
 }
 #: the keys of a basis file: the basis, then the energy, the settings and a run's state (prebo.optimise.resume)
 KEYS = ("format", "version", "conventions", "system", "symmetry", "basis_type", "functions", "coefficients",
-        "energy", "optimiser", "progress", "rng", "history", "elapsed", "schedule", "stopped", "momentum", "levels",
-        "followed")
+        "energy", "objective", "optimiser", "progress", "rng", "history", "elapsed", "schedule", "stopped", "momentum",
+        "levels", "followed")
 #: every function's arrays beside its family's extras (name -> shape, "n": particles); and a channel
 COMMON = {"A": ("n", "n"), "c_A": ()}
 #: bytes allowed per function (twice a checkpoint's two copies of a function of 8 particles) and
@@ -115,8 +115,9 @@ def arguments(d: dict, where: str) -> dict:
         if coef is not None and not _holds(coef, (len(funcs),), False):
             raise BasisFileError(f"coefficients must be {len(funcs)} numbers, one per function, or null")
         check_settings(d.get("optimiser"))
-        if d.get("energy") is not None:
-            number(d["energy"], "energy")
+        for key in ("energy", "objective"):
+            if d.get(key) is not None:
+                number(d[key], key)
         A = np.array([f["A"] for f in funcs], dtype=float).reshape(len(funcs), n, n)
         c_A = np.array([f["c_A"] for f in funcs], dtype=float)
         channels = [f.get("channel", "unknown") for f in funcs]

@@ -134,12 +134,13 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         ex.basis.coefficients = ex.coefficients if ex.eig is not None else None
         seconds = wall()  # on every rank: the clock is agreed among the ranks
         if out is not None:
-            energy = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
+            objective = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
             ex.basis.save(Path(out) / CHECKPOINT, {
-                "energy": energy, "optimiser": opts.to_dict(), "progress": vars(cursor),
+                "energy": lowest_root(ex), "optimiser": opts.to_dict(), "progress": vars(cursor),
                 "rng": rng.bit_generator.state, "history": history, "elapsed": seconds,
                 "schedule": schedule.to_dict(), "stopped": stopped, "momentum": run.momentum.to_dict()}
-                | ({} if ex.objective.lowest else {"levels": list(ex.objective.roots), "followed": followed}))
+                | ({} if ex.objective.lowest else {"objective": objective, "levels": list(ex.objective.roots),
+                                                   "followed": followed}))
 
     with run.report, eigen.lapack_threads(opts.size):
         while cursor.phase != "done":
@@ -183,6 +184,12 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     if not ex.objective.lowest:
         best.convergence |= {"levels": list(ex.objective.roots), "followed": followed}
     return best
+
+
+def lowest_root(ex: Expansion) -> float | None:
+    """The lowest root's energy (Eh) of the expansion's state, what a basis file's `energy` holds;
+    None before the first function. For a run of the lowest level alone it is the objective."""
+    return float(ex.eig.energies[0]) if ex.eig is not None and ex.eig.kept else None
 
 
 def resume_from(folder: Path, progress: bool = True, budget: float | None = None) -> tuple[Basis, Optimiser]:

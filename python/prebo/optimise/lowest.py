@@ -20,21 +20,23 @@ from .checkpoint import LOWEST, of_this_run
 
 class Lowest:
     """The lowest state of at most `size` functions a run has passed through (module docstring):
-    its `energy` (hartree) and `basis` (with the state's coefficients; None before the first
-    function); `basis` is the run's (its system and kind). With a folder `out`, out/lowest.json
-    holds it whenever the run stands elsewhere, written as a basis file with `extra` (the
-    settings) when the run leaves it; a `resumed` run reads it back (BasisFileError if it is not
-    of this run; a new run never starts in a folder holding one, driver.optimise)."""
+    its `energy` (hartree; the objective, objective.py) and `basis` (with the state's coefficients;
+    None before the first function); `basis` is the run's (its system and kind). With a folder
+    `out`, out/lowest.json holds it whenever the run stands elsewhere, written as a basis file with
+    `extra` (the settings) when the run leaves it — its `energy` the lowest root's, and for a run
+    for excited levels the `objective` too; a `resumed` run reads it back (BasisFileError if it is
+    not of this run; a new run never starts in a folder holding one, driver.optimise)."""
 
     def __init__(self, basis: Basis, size: int, out: Path | None, extra: dict, resumed: bool):
         self.size, self.extra = size, extra
         self.path = None if out is None else Path(out) / LOWEST
-        self.energy, self.basis, self.written = np.inf, None, False
+        self.energy, self.basis, self.written, self.record = np.inf, None, False, {}
         if resumed and self.path is not None and self.path.exists():  # the run stood above it when it stopped
             d = basis_json.read(self.path)
             self.basis = Basis.from_dict(d, str(self.path))
+            key = "objective" if "objective" in d else "energy"
             try:
-                self.energy = number(d.get("energy"), "energy")
+                self.energy = number(d.get(key), key)
             except InputError as exc:
                 raise BasisFileError(f"{self.path}: {exc}") from exc
             if not of_this_run(self.basis, basis):
@@ -49,10 +51,12 @@ class Lowest:
         if 0 < nb <= self.size and expansion.energy <= self.energy:
             self.energy, self.basis = expansion.energy, expansion.basis.subset(slice(None))
             self.basis.coefficients = expansion.coefficients
+            ground = float(expansion.eig.energies[0])
+            self.record = {"energy": ground} | ({} if expansion.objective.lowest else {"objective": self.energy})
             if self.path is not None and self.written:
                 self.path.unlink(missing_ok=True)
             self.written = False
         elif self.path is not None and self.basis is not None and not self.written and (
                 nb > self.size or expansion.energy > self.energy):
-            self.basis.save(self.path, {"energy": self.energy} | self.extra)
+            self.basis.save(self.path, self.record | self.extra)
             self.written = True
