@@ -78,3 +78,16 @@ def test_light_particles_with_a_heavy_cm_gaussian_stay_above_the_exact_energy():
                           {"name": "b", "mass": 1e-3, "charge": -1, "spin": 0}])
     basis = prebo.optimise(light, prebo.Optimiser(size=10, seed=3, budget=10), progress=False)
     assert prebo.evaluate(basis)["energy"] > -0.25e-3
+
+
+@pytest.mark.parametrize("mass, radius", [(1e7, "2.0e-07"), (1e-6, "2.0e+06")])
+def test_a_pair_whose_exponents_c_a_cannot_hold_is_refused_in_one_line(tmp_path, capsys, mass, radius):
+    """Two particles of charges ±1 and mass 1e7 (Bohr radius 2e-7 bohr: exponents ~2.5e13 bohr⁻², 2.5e13
+    times c_A = 1) or 1e-6: the trials' A lose their Cholesky factor in the core (the run stopped at the
+    first such trial, naming it as "basis function 11") or their integrals their digits. Every trial is
+    refused (parallel.refusing), and the error names the Bohr radius and the way out."""
+    f = tmp_path / "pair.toml"
+    f.write_text(f'[system]\nparticles = [{{name = "x", mass = {mass}, charge = 1, spin = 0}}, '
+                 f'{{name = "y", mass = {mass}, charge = -1, spin = 0}}]\n[basis]\nsize = 4\n')
+    err = cli_error(capsys, "run", f, "--out", tmp_path / "out", "--quiet")
+    assert f"Bohr radius, {radius} bohr" in err and "units that bring the Bohr radii near 1" in err

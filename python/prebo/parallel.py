@@ -36,7 +36,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .errors import RanksDivergedError, UnsupportedError
+from .errors import NotPositiveDefiniteError, RanksDivergedError, UnsupportedError
 
 #: environment variables by which MPI launchers (MPICH/Hydra and Slurm's PMI, Open MPI, PMIx) give
 #: the number of ranks
@@ -163,11 +163,12 @@ class Ranks:
         evaluated by the ranks."""
         k, nb = len(trials[0]), len(params[0])
         if self.size == 1 or max(k, nb) < self.size:
-            return engine.rows(trials, params, position)
+            return refusing(engine, trials, params, position)
         if k >= self.size:
-            parts = self.each(engine.rows(take(trials, self.mine(k)), params, position), ("rows", k, nb, position))
+            parts = self.each(refusing(engine, take(trials, self.mine(k)), params, position), ("rows", k, nb, position))
             return joined([rows for rows, _ in parts], axis=0), np.concatenate([diag for _, diag in parts])
-        return self._columns(lambda basis, at: engine.rows(trials, basis, at), params, position, ("row", k, nb, position))
+        return self._columns(lambda basis, at: refusing(engine, trials, basis, at), params, position,
+                             ("row", k, nb, position))
 
     def row_gradient(self, engine, f: tuple, dA, dv, params: tuple) -> tuple[dict, np.ndarray]:
         """`engine.row_gradient(f, dA, dv, params)`, blocks of its columns evaluated by the ranks."""
@@ -192,6 +193,21 @@ class Ranks:
         s = self.mine(nb)
         rows, diag = evaluate(take(params, s), min(max(at - s.start, 0), s.stop - s.start))
         return joined(self.each(rows, call), axis=1), diag
+
+
+def refusing(engine, trials: tuple, params: tuple, position: int | None) -> tuple[dict, np.ndarray]:
+    """`engine.rows(trials, params, position)`, with NaN elements (which `plausible` refuses) for a
+    trial whose A has no Cholesky factor in the core — exponents far from c_A round it away, as for a
+    pair of very heavy particles (optimise/methods.py, `unresolved`) — instead of the run stopping
+    on it: the trials are then evaluated one at a time. On each rank alike, for its own trials."""
+    try:
+        return engine.rows(trials, params, position)
+    except NotPositiveDefiniteError:
+        k, nb = len(trials[0]), len(params[0])
+        if k == 1:
+            return {name: np.full((1, nb), np.nan) for name in ("S", "T", "T_ti", "V")}, np.full((1, 4), np.nan)
+    parts = [refusing(engine, take(trials, slice(i, i + 1)), params, position) for i in range(k)]
+    return joined([rows for rows, _ in parts], axis=0), np.concatenate([diag for _, diag in parts])
 
 
 def joined(parts: list[dict], axis: int) -> dict:

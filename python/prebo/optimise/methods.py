@@ -53,7 +53,7 @@ from .polish import polish
 from .refine import partners, refine_group, refine_newcomer, regenerate_function
 from .report import Reporter
 from .sampler import Sampler
-from .settings import Optimiser
+from .settings import C_A, Optimiser
 
 STALL_STEPS = 100  # growth steps in a row without an accepted trial before the run stops (StalledError)
 
@@ -109,12 +109,32 @@ class Grow:
         run.stalled += 1
         if run.stalled == STALL_STEPS and len(ex.basis) == 0:
             raise UnsupportedError(f"optimiser: every trial of {STALL_STEPS} growth steps was refused with no function "
-                                   f"in the basis: {ex.basis.family.name} functions cannot describe this state (its "
-                                   "symmetriser annihilates them, or their integrals lose their digits); choose "
-                                   f"another [basis] type, or a smaller c_A (now {run.sampler.opts.c_A:g})")
+                                   f"in the basis: {unresolved(run.sampler, ex.basis.family.name)}")
         if run.stalled == STALL_STEPS:
             why = stalled(len(ex.basis), run.sampler.opts, ex.eig.overlap_condition, ex.sigma)
             raise StalledError(f"optimiser: {why}")
+
+
+#: internal exponents this many times c_A or more (or less) leave too few digits beside it in double
+#: precision: a trial's A = (internal part) + c_A μμᵀ loses its Cholesky factor or its integrals
+#: their digits (settings.py, C_A). Two particles of charges ±1 and masses m at c_A = 1 (1/a² = m²/4):
+#: m = 10⁴ grows, m = 3·10⁴ stalls at 4 functions, m = 10⁵ finds no function (measured, session 36)
+DIGITS_APART = 1e9
+
+
+def unresolved(sampler, family: str) -> str:
+    """Why no trial could start the basis: its pairs' exponents ~1/a² (a the tightest Bohr radius,
+    sampler.pair_lengths) lie DIGITS_APART from c_A, which its bounds (settings.C_A) cannot reach
+    (two particles of 10⁷ electron masses: a = 2e-7 bohr, 1/a² = 2.5e13 bohr⁻²), and a pure Coulomb
+    system scales (masses by λ: energies by λ, lengths by 1/λ); else the functions cannot describe
+    the state."""
+    a, c_A = float(np.min(sampler.a)), sampler.opts.c_A
+    if not 1 / DIGITS_APART < 1 / (a * a * c_A) < DIGITS_APART:
+        return (f"its tightest pair's Bohr radius, {a:.1e} bohr, asks for exponents ~{1 / (a * a):.1e} bohr⁻², too far "
+                f"from the centre-of-mass exponent c_A (now {c_A:g}; allowed {C_A.lo:g} to {C_A.hi:g}) for double "
+                "precision to hold both: give the masses and charges in units that bring the Bohr radii near 1")
+    return (f"{family} functions cannot describe this state (its symmetriser annihilates them, or their integrals "
+            f"lose their digits); choose another [basis] type, or a smaller c_A (now {c_A:g})")
 
 
 def stalled(nb: int, opts: Optimiser, condition: float = 0.0, sigma: float = 0.0) -> str:
