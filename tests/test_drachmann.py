@@ -104,7 +104,7 @@ def test_properties_report_the_regularised_contact_density_of_each_level(tmp_pat
     assert json.loads(capsys.readouterr().out)["delta_regularised"] == got
 
 
-def test_a_heavy_repelling_pair_keeps_the_direct_contact_density():
+def test_a_heavy_repelling_pair_keeps_the_direct_contact_density(capsys):
     """H₂ in 80 plain ECGs (examples/bases/h2-pecg): Drachmann's form for p-p multiplies its bracket's
     basis error by μ_pp/π ≈ 292 and gives −6.40 bohr⁻³ (measured) where the direct value is 4.4e-3 and
     the exact one is positive; so p-p is not regularised and the Breit–Pauli report takes its
@@ -120,3 +120,7 @@ def test_a_heavy_repelling_pair_keeps_the_direct_contact_density():
     # what the form would give for p-p: below zero
     inv_r, potential, gradient = (p["expectation"][name]["p-p"] for name in drachmann.TERMS)
     assert m / 2 / np.pi * (p["energy"] * inv_r - potential - gradient) < -1
+    # the table prints the regularised row with the p-p cell empty
+    assert main(["properties", str(ROOT / "examples" / "bases" / "h2-pecg" / "basis.json")]) == 0
+    out = capsys.readouterr().out
+    assert all(f"{p['delta_regularised'][c]:.10g}" in out for c in ("e-p", "e-e"))

@@ -188,3 +188,13 @@ def test_bound_is_qualified_where_a_break_up_was_not_computed(capsys):
     assert main(["energy", str(ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json"), "--json"]) == 0
     r = json.loads(capsys.readouterr().out)
     assert r["bound"] is True and r["threshold_unchecked"] is None
+
+
+def test_prebo_properties_warns_when_the_level_is_not_bound(capsys):
+    """H⁻'s root 1 lies above H + e: its properties are printed, and one warning line says so."""
+    h_minus = ROOT / "examples" / "bases" / "h-" / "basis.json"
+    for extra in ([], ["--json"]):
+        assert main(["properties", str(h_minus), "--root", "1", *extra]) == 0
+        err = capsys.readouterr().err
+        assert err.startswith("prebo: warning: root 1 is not below") and err.count("\n") == 1, err
+    assert main(["properties", str(h_minus)]) == 0 and capsys.readouterr().err == ""

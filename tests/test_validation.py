@@ -414,3 +414,10 @@ def test_prebo_energy_of_an_input_file_says_so(tmp_path, capsys):
     f = tmp_path / "h.toml"
     f.write_text(H_TOML)
     assert "a TOML input, not a basis; optimise it with `prebo run" in cli_error(capsys, "energy", f)
+
+
+def test_a_spin_given_by_an_alias_names_the_particle_it_means():
+    """Particles named by an alias ("muon") are the known particle ("mu"); a state.spin key that uses
+    the alias is refused with the names to use."""
+    with pytest.raises(InputError, match=r"\['muon'\] \(its particles are named \['mu', 'p'\]; 'muon' is 'mu'\)"):
+        prebo.System(["muon", "muon", "p"], spin={"muon": 1})

@@ -64,6 +64,8 @@ def _print_result(r: dict) -> None:
     if r.get("energy_lab") is not None:
         t.add_row("energy (laboratory frame)", f"{r['energy_lab']:.12f} Eh")
     t.add_row("virial η_TI", f"{r['virial']:.2e}")
+    if "n2" in r:  # floating ECGs: not angular-momentum eigenfunctions
+        t.add_row(f"⟨N²⟩_TI{of}", f"{r['n2']:.3e} ħ²")
     for fragments, energy in r["thresholds"].items():
         t.add_row("given threshold" if fragments == "given" else "dissociation threshold",
                   f"{energy:.12f} Eh" + ("" if fragments == "given" else f" ({fragments})"))
@@ -120,10 +122,14 @@ def _print_levels(r: dict) -> None:
         levels.add_row(str(v["root"]), f"{v['energy']:.12f}", f"{v['energy_uncertainty']:.1e}", f"{v['virial']:.1e}",
                        f"{gap:.6f}", "yes" if v["bound"] else "no", "yes" if v["root"] in targets else "")
     Console().print(levels)
-    steps = Table("transition", "ΔE (Eh)", "ΔE (cm⁻¹)", "uncertainty (cm⁻¹)", title="between neighbouring levels")
+    unbound = {v["root"] for v in r["levels"] if not v["bound"]}
+    steps = Table("transition", "ΔE (Eh)", "ΔE (cm⁻¹)", "uncertainty (cm⁻¹)", title="between neighbouring levels",
+                  caption="*: to or from a level not bound in this basis (a discretised continuum state)"
+                  if unbound else None)
     for v in r["levels"][1:]:
         d = gaps[(v["root"] - 1, v["root"])]
-        steps.add_row(f"{d['lower']} → {d['upper']}", f"{d['Eh']:.10f}", f"{d['cm-1']:.6f}",
+        mark = "*" if {d["lower"], d["upper"]} & unbound else ""
+        steps.add_row(f"{d['lower']} → {d['upper']}{mark}", f"{d['Eh']:.10f}", f"{d['cm-1']:.6f}",
                       f"{d['uncertainty'] * HARTREE_CM:.1e}")
     Console().print(steps)
 
@@ -396,10 +402,8 @@ def cmd_energy(args) -> int:
 def cmd_properties(args) -> int:
     """`prebo properties BASIS [--root K] [--coordinates lab|ti] [--threshold T] [--regularised] [--json]`: the
     energy of level K of a stored basis, the expectation value of every registered operator per
-    class of equivalent pairs (properties.py) and the level's Breit–Pauli correction (relativistic.py)."""
-    from rich.console import Console
-    from rich.table import Table
-
+    class of equivalent pairs (properties.py) and the level's Breit–Pauli correction (relativistic.py);
+    a level not bound in the basis gets a warning line on stderr."""
     from .properties import properties
 
     basis, stored = load_basis(args.basis)
@@ -413,7 +417,20 @@ def cmd_properties(args) -> int:
                              "their digits")
     if args.json:
         print(json.dumps(p, allow_nan=False))
-        return 0
+    else:
+        _print_properties(p, basis)
+    if not p["bound"]:
+        sys.stdout.check()
+        print(f"prebo: warning: root {p['root']} is not below the lowest dissociation threshold: not bound in this "
+              "basis (its properties are those of a discretised continuum state)", file=sys.stderr)
+    return 0
+
+
+def _print_properties(p: dict, basis) -> None:
+    """`prebo properties`' tables (cmd_properties)."""
+    from rich.console import Console
+    from rich.table import Table
+
     head = Table(show_header=False, box=None)
     head.add_row("level", f"root {p['root']} ({_bound(p)})")
     head.add_row("energy (translation-free)", f"{p['energy']:.12f} Eh ± {p['energy_uncertainty']:.1e}")
@@ -429,14 +446,16 @@ def cmd_properties(args) -> int:
             for name in names:
                 table.add_row(name, *(f"{p['expectation'][name][c]:.10g}" for c in classes), p["units"][name])
             if acts_on == "pairs" and "delta_regularised" in p:  # drachmann.py
-                table.add_row("delta (Drachmann)", *(f"{p['delta_regularised'][c]:.10g}" for c in classes), "bohr⁻³")
+                table.add_row("delta (Drachmann)", *(f"{p['delta_regularised'][c]:.10g}" if c in p["delta_regularised"]
+                                                     else "" for c in classes), "bohr⁻³")
             if acts_on == "particles" and p.get("p4_regularised"):  # drachmann.py, eq. (27')
                 table.add_row("p4 (regularised)", *(f"{p['p4_regularised'][c]:.10g}" if c in p["p4_regularised"]
                                                     else "" for c in classes), "ħ⁴/bohr⁴")
             Console().print(table)
     if "breit_pauli" in p:  # relativistic.py: each term, per class and summed
         bp = p["breit_pauli"]
-        kind = "regularised δ and p⁴ of the lightest particles" if bp["regularised"] else "direct δ and p⁴"
+        kind = ("regularised δ and p⁴ where Drachmann's forms serve (drachmann.py)" if bp["regularised"]
+                else "direct δ and p⁴")
         table = Table("term", "Eh", "cm⁻¹", "per class (Eh)", title=f"Breit–Pauli correction (α = {bp['alpha']}; {kind})")
         for term, e in bp["Eh"].items():
             per = ", ".join(f"{c} {v:.6e}" for c, v in bp["classes"].get(term, {}).items())
@@ -445,7 +464,6 @@ def cmd_properties(args) -> int:
     if p["not_derived"]:
         Console().print(f"not derived for {basis.family.name} functions: {', '.join(p['not_derived'])}"
                         + ("" if "breit_pauli" in p else " (so neither is the Breit–Pauli correction)"))
-    return 0
 
 
 class Parser(argparse.ArgumentParser):

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import InputError, SpinError
 from ..validation import MAX_PARTICLES, MAX_SIZE, Integer, Real, Sign, checked, half_integer, strict_keywords
-from .particles import Particle, particle
+from .particles import ALIASES, Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
 
 #: N: bound few-body states have far smaller ones (H₂'s last rotational level has N = 31); the
@@ -139,7 +139,9 @@ class System:
             by_name.setdefault(p.name, []).append(i)
         unknown = set(self.state.spin) - set(by_name)
         if unknown:
-            raise InputError(f"state.spin names particles not in the system: {sorted(unknown)}")
+            aliases = [f"{k!r} is {ALIASES[k]!r}" for k in sorted(unknown) if k in ALIASES]
+            raise InputError(f"state.spin names particles not in the system: {sorted(unknown)} (its particles are "
+                             f"named {list(by_name)}" + "".join(f"; {a}" for a in aliases) + ")")
         groups = []
         for name, idx in by_name.items():
             first = self.particles[idx[0]]
