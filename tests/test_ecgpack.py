@@ -208,6 +208,8 @@ def _edit(tmp_path, old, new, src=HE):
     ("      7  0.5631628846634819E+00", "      8  0.5631628846634819E+00", 640, ["index 8", "expected 7"]),
     ("      7  0.5631628846634819E+00", "      7  0.0000000000000000E+00", 640, ["function 7", "positive definite"]),
     (" BASIS_SIZE    490", " BASIS_SIZE    491", 1123, ["490 basis lines", "BASIS_SIZE"]),
+    (" WHICH_EIGENVALUE      1", " WHICH_EIGENVALUE      0", 8, ["WHICH_EIGENVALUE", "1..BASIS_SIZE (490)"]),
+    (" WHICH_EIGENVALUE      1", " WHICH_EIGENVALUE    491", 8, ["WHICH_EIGENVALUE", "491"]),
 ])
 def test_malformed_files_name_the_line(tmp_path, old, new, line, words):
     p = _edit(tmp_path, old, new)
@@ -217,6 +219,21 @@ def test_malformed_files_name_the_line(tmp_path, old, new, line, words):
     assert msg.startswith(f"{p}:{line}:"), msg
     for w in words:
         assert w in msg, msg
+
+
+def test_which_eigenvalue_is_the_level_the_state_targets(tmp_path):
+    """WHICH_EIGENVALUE k: the basis was optimised for root k − 1, which the imported state targets
+    (its evaluation reports the levels up to it); the export writes it back, with CURRENT_ENERGY that
+    level's energy."""
+    basis = ecgpack.read_inout(_edit(tmp_path, " WHICH_EIGENVALUE      1", " WHICH_EIGENVALUE      2"))
+    assert basis.system.state.levels == ((1,), (1.0,))
+    r = prebo.evaluate(basis)
+    assert r["targets"] == [1] and len(r["levels"]) == 2
+    out = tmp_path / "out.inout.txt"
+    ecgpack.write_inout(basis, out)
+    back = ecgpack.parse_inout(out)
+    assert back.root == 1 and back.energy == pytest.approx(r["levels"][1]["energy"], rel=1e-15)
+    assert ecgpack.parse_inout(HE).root == 0
 
 
 def test_complex_basis_lines_are_recognised(tmp_path):

@@ -85,6 +85,21 @@ def test_resume_without_checkpoint_is_a_clear_error(tmp_path):
     assert r.returncode == 2 and "no checkpoint" in r.stderr and "Traceback" not in r.stderr
 
 
+def test_a_checkpoint_holding_more_functions_than_its_size_allows_is_refused(tmp_path, capsys):
+    """An edited checkpoint (size 6 → 3, six functions, still growing) resumed grew past its size;
+    now it is a one-line error naming the file."""
+    from prebo.cli import main
+    prebo.optimise(prebo.System(["p", "e"]), Optimiser(size=6, seed=1, refine=1, polish=1), out=tmp_path / "run",
+                   progress=False)
+    f = tmp_path / "run" / "basis.json"
+    d = json.loads(f.read_text())
+    d["optimiser"]["size"], d["progress"] = 3, {"phase": "grow", "sweep": 0, "index": 0, "cycle": 0}
+    f.write_text(json.dumps(d))
+    assert main(["run", "--resume", str(tmp_path / "run"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"{f}: 6 functions, more than the run's size = 3" in err and err.count("\n") == 1, err
+
+
 def test_fixed_schedule():
     opts = resolved(Optimiser(size=2, sweeps=1, refine=2, polish=2), prebo.System(["p", "e"]))
     schedule = Fixed(opts)

@@ -30,6 +30,8 @@ Cartesian coordinates, A = U_xᵀ blockdiag(𝒜, c_A) U_x with a c_A of our cho
 (``read_inout(..., c_A=1.0)``); the translation-free energy does not depend on it.
 Only the header keywords, the basis section and its size are read; the status line,
 commands and energy history are skipped. Fortran ``D`` exponents are accepted.
+WHICH_EIGENVALUE k (1-based) is the root the basis was optimised for: the imported state
+targets root k − 1 (`[state] root`), and an export writes the lowest targeted root back.
 
 Symmetry
 --------
@@ -117,7 +119,8 @@ def _particle_spec(mass: float, charge: float) -> dict | str | None:
 @dataclass
 class InoutFile:
     """A parsed ``*.inout.txt``: BASIS_TYPE, MASSES (m_e), CHARGES (e), the SYMMETRY string,
-    CURRENT_ENERGY (Eh; None if absent), each function's vech(L) and every header line."""
+    CURRENT_ENERGY (Eh; None if absent), each function's vech(L), every header line, and the root
+    the basis was optimised for (WHICH_EIGENVALUE − 1; 0 if absent), which its state targets."""
 
     path: Path
     basis_type: str
@@ -127,6 +130,7 @@ class InoutFile:
     energy: float | None
     L: np.ndarray  # (K, n(n+1)/2) vech(L), column by column
     header: dict = field(default_factory=dict)  # keyword -> (line number, rest of the line)
+    root: int = 0
 
     @property
     def n_particles(self) -> int:
@@ -245,6 +249,14 @@ def parse_inout(path) -> InoutFile:
         if len(xs) != 1:
             _fail(path, ln, f"CURRENT_ENERGY must be one number, got {' '.join(vals)!r}")
         energy = xs[0]
+    root = 0
+    if "WHICH_EIGENVALUE" in header:
+        ln, vals, _ = header["WHICH_EIGENVALUE"]
+        which = _count(vals)
+        if which is None or not 1 <= which <= max(size, 1):
+            _fail(path, ln, f"WHICH_EIGENVALUE must be one integer in 1..BASIS_SIZE ({size}), got "
+                            f"{_clip(' '.join(vals))!r}")
+        root = which - 1
     ln, vals, raw = header["SYMMETRY"]
     symmetry = raw.split(None, 1)[1].strip() if len(raw.split(None, 1)) > 1 else ""
     try:
@@ -277,7 +289,8 @@ def parse_inout(path) -> InoutFile:
         _fail(path, len(lines), f"{len(L)} basis lines after the last ===== (line {start}), "
                                 f"BASIS_SIZE says {size} (line {header['BASIS_SIZE'][0]})")
     return InoutFile(path, btype, arrays["MASSES"], arrays["CHARGES"], symmetry, energy,
-                     np.array(L, dtype=float).reshape(size, m), {k: (v[0], " ".join(v[1])) for k, v in header.items()})
+                     np.array(L, dtype=float).reshape(size, m), {k: (v[0], " ".join(v[1])) for k, v in header.items()},
+                     root)
 
 
 def _system(f: InoutFile) -> System:
@@ -327,7 +340,7 @@ def _system(f: InoutFile) -> System:
                           f"({', '.join('+'.join(str(i + 1) for i in g) for g in raw_groups) or 'none'}): "
                           "prebo cannot label it")
     spin = {names[idx[0]]: float(implied[k]) for k, idx in enumerate(raw_groups)}
-    state = State(N=0, parity=1, spin=spin)
+    state = State(N=0, parity=1, spin=spin, root=f.root)
     try:
         return System(specs, state, symmetriser=sym)
     except PreboError as exc:
@@ -414,8 +427,9 @@ def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFi
 
     Parameters: `basis`, plain ECGs (UnsupportedError for another family); `path`, the
     file, written atomically (`write_atomic`); `energy` (Eh) for CURRENT_ENERGY, default the
-    translation-free energy `prebo.evaluate` computes; `source`, the `InoutFile` the basis
-    was read from (`parse_inout(path).to_basis()`), if any.
+    translation-free energy `prebo.evaluate` computes of the level WHICH_EIGENVALUE names, the
+    lowest the state targets (`[state] root`; ecgpack optimises one); `source`, the `InoutFile`
+    the basis was read from (`parse_inout(path).to_basis()`), if any.
 
     Each function's internal exponent 𝒜 (bohr⁻²) is taken in prebo's ``hpc:0`` set
     (relative to the first particle; SeparabilityError if a function couples the CM to
@@ -450,10 +464,12 @@ def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFi
             raise UnsupportedError(f"function {k}: internal exponent is not positive definite") from None
         vech.append(L[rows, cols])
     young = young_string(system.symmetriser, system.groups, n)
+    root = basis.system.state.levels[0][0]
     if energy is None:
         from ..results import evaluate
 
-        energy = evaluate(basis)["energy"] if len(basis) else 0.0
+        r = evaluate(basis) if len(basis) > root else {"energy": 0.0}  # the levels up to the targeted one
+        energy = r["levels"][root]["energy"] if root else r["energy"]
     K = len(basis)
     out = [
         f" BASIS_TYPE {SUPPORTED_TYPE}",
@@ -463,7 +479,7 @@ def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFi
         f" SYMMETRY {young}",
         f" BASIS_SIZE {K:6d}",
         " CURRENT_ENERGY" + _fmt(energy),
-        " WHICH_EIGENVALUE      1",
+        f" WHICH_EIGENVALUE {root + 1:6d}",
         " ==============================",
         f" {K:6d}" + _fmt(energy) + "      0      0      0",
         " ==============================",

@@ -15,6 +15,7 @@ from ..errors import BasisFileError, PreboError
 from ..io import basis_json
 from ..system import System
 from ..validation import number
+from .adaptive import pruned
 from .checkpoint import CHECKPOINT
 from .convergence import STOPPED
 from .cursor import Cursor
@@ -45,6 +46,10 @@ def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> t
     nb = len(basis)
     if (cursor.phase != "grow" and nb == 0) or (cursor.phase in ("sweep", "refine") and cursor.index >= nb):
         raise BasisFileError(f"{where}: progress {vars(cursor)} does not fit a basis of {nb} functions")
+    beyond = max(opts.prune or 0, pruned(opts.size))  # a pruning pass grows past the size, then removes
+    if nb > opts.size + beyond:
+        raise BasisFileError(f"{where}: {nb} functions, more than the run's size = {opts.size} (and {beyond} more "
+                             "while pruning) allows")
     return basis, cursor, history, elapsed, schedule, stopped
 
 
