@@ -11,7 +11,7 @@ took (`prebo.properties`, direct ⟨δ³⟩; docs/relativistic.md).
     nice -n 19 python benchmarks/breit_pauli_literature.py [--regularised]
 
 --regularised: H2 with the regularised δ and p⁴ (docs/relativistic.md), the ⟨V/r_ij⟩ quadrature of
-ECG-GVR functions included (about twenty minutes), instead of the direct ones.
+ECG-GVR functions included (about five minutes), instead of the direct ones.
 """
 import argparse
 import time
