@@ -98,6 +98,7 @@ def test_bad_roots_are_refused_in_one_line(tmp_path, capsys, state, message):
     assert main(["run", str(path), "--out", str(tmp_path / "run"), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert message in err and len(err.splitlines()) == 1, err
+    assert err.startswith(f"prebo: error: {path}: "), err
 
 
 def test_the_state_keeps_its_levels_through_a_basis_file_and_the_api():

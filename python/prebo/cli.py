@@ -162,7 +162,7 @@ def cmd_run(args) -> int:
     refuses a DIR that holds an earlier run's outputs unless `--force` (`claim`). Returns the exit
     status 0."""
     from .io.files import write_json_atomic
-    from .errors import InputError, StalledError
+    from .errors import InputError, StalledError, UnsupportedError
     from .io import toml
     from .io.lock import owned
     from .optimise import optimise, resume_from
@@ -192,8 +192,10 @@ def cmd_run(args) -> int:
                     claim(out, args.force)
                 opts = job.optimiser if args.budget is None else replace(job.optimiser, budget=args.budget)
                 basis = optimise(job.system, opts, out=out, progress=not args.quiet)
-        except StalledError as exc:  # the settings to change are in the input (or the checkpoint)
-            raise StalledError(f"{source}: {exc}") from exc
+        # the settings to change are in the input (or the checkpoint): a state, size or settings that
+        # do not fit together, or no trial that could start or grow the basis
+        except (StalledError, InputError, UnsupportedError) as exc:
+            raise type(exc)(f"{source}: {exc}") from exc
         title = title or basis.system.label()
         where = out / LOWEST if (out / LOWEST).exists() else out / CHECKPOINT  # the file of the state returned
         levels = basis.convergence.get("levels")  # where the targeted levels stand, if followed
