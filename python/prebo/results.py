@@ -8,7 +8,7 @@ result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_
 (Eh, below), energy_lab (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential,
 threshold (the lowest dissociation threshold, Eh: `thresholds.lowest`), threshold_fragments (its
 fragments, "p-e + e", or "given"), threshold_unchecked (a break-up into a fragment of three or more
-particles that was not computed and may lie lower, "α-e-e + e"; None where none can or the
+particles that was not computed and may lie lower, "alpha-e-e + e"; None where none can or the
 threshold was given: `thresholds`), thresholds ({fragments or "given": Eh} of both candidates),
 bound (energy < threshold − energy_uncertainty), binding_energy (threshold − energy, Eh),
 n_basis, basis_type, particles, state, symmetry, coordinates, overlap_condition, kept; with

@@ -16,8 +16,8 @@ Caveats. Real thresholds can be lower: fragments of three or more particles are 
 lies far below Li²⁺ + e + e, He + e below He⁺ + e + e for He⁻), so the user may give a lower one (≤ 0:
 `[state] threshold`, `State(threshold=...)`) and `lowest` takes the lower of the two. Where such a
 fragment could bind (it has an attracting pair) and no threshold is given, `hydrogen_like` names one
-(`Threshold.unchecked`, e.g. "α-e-e + e"), and the reports qualify "bound" by it. prebo builds natural-parity states
-(parity (−1)^N), and a ground-state fragment plus a free particle in the partial wave l = N has that
+(`Threshold.unchecked`, e.g. "alpha-e-e + e"), and the reports qualify "bound" by it. prebo builds
+natural-parity states (parity (−1)^N), and a ground-state fragment plus a free particle in the partial wave l = N has that
 N and parity whatever the exchange symmetry (the free particle is in no bound orbital), so such a
 channel is always open. Two identical fragments and no free particle (H + H, Ps + Ps) are different:
 exchange symmetry can forbid their relative partial wave l = N (H + H for ortho-H₂ with N = 0, whose
@@ -71,13 +71,13 @@ def hydrogen_like(system: System) -> Threshold:
     energy, pairs = best(tuple(range(system.n))) if system.n > 2 else (0.0, [])
     paired = {k for pair in pairs for k in pair}
     parts = [f"{ps[i].name}-{ps[j].name}" for i, j in pairs] + [p.name for k, p in enumerate(ps) if k not in paired]
-    return Threshold(energy, " + ".join(parts), uncounted(system))
+    return Threshold(energy, " + ".join(parts), unchecked(system))
 
 
-def uncounted(system: System) -> str | None:
+def unchecked(system: System) -> str | None:
     """A break-up `hydrogen_like` does not count: the system less one particle (the lightest that
     leaves an attracting pair behind), a fragment of three or more particles that may bind, plus that
-    particle free ("α-e-e + e" for He⁻); None for three particles or fewer, or where no fragment of
+    particle free ("alpha-e-e + e" for He⁻); None for three particles or fewer, or where no fragment of
     three or more particles has an attracting pair."""
     ps = system.particles
     if system.n < 4:
