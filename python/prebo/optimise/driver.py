@@ -136,7 +136,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         if out is not None:
             objective = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
             ex.basis.save(Path(out) / CHECKPOINT, {
-                "energy": lowest_root(ex), "optimiser": opts.to_dict(), "progress": vars(cursor),
+                "energy": ex.lowest_root, "optimiser": opts.to_dict(), "progress": vars(cursor),
                 "rng": rng.bit_generator.state, "history": history, "elapsed": seconds,
                 "schedule": schedule.to_dict(), "stopped": stopped, "momentum": run.momentum.to_dict()}
                 | ({} if ex.objective.lowest else {"objective": objective, "levels": list(ex.objective.roots),
@@ -184,12 +184,6 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     if not ex.objective.lowest:
         best.convergence |= {"levels": list(ex.objective.roots), "followed": followed}
     return best
-
-
-def lowest_root(ex: Expansion) -> float | None:
-    """The lowest root's energy (Eh) of the expansion's state, what a basis file's `energy` holds;
-    None before the first function. For a run of the lowest level alone it is the objective."""
-    return float(ex.eig.energies[0]) if ex.eig is not None and ex.eig.kept else None
 
 
 def resume_from(folder: Path, progress: bool = True, budget: float | None = None) -> tuple[Basis, Optimiser]:

@@ -81,6 +81,12 @@ class Expansion:
         return out, eig.energies[list(objective.roots)]
 
     @property
+    def lowest_root(self) -> float | None:
+        """The lowest root's energy (Eh), what a basis file's `energy` holds; None before the first
+        function. For a run of the lowest level alone it is the objective's `energy`."""
+        return float(self.eig.energies[0]) if self.eig is not None and self.eig.kept else None
+
+    @property
     def coefficients(self) -> np.ndarray:
         """The state's coefficients c, S-normalised (the objective's eigenvector)."""
         return self.objective.vector(self.eig)

@@ -51,8 +51,8 @@ class Lowest:
         if 0 < nb <= self.size and expansion.energy <= self.energy:
             self.energy, self.basis = expansion.energy, expansion.basis.subset(slice(None))
             self.basis.coefficients = expansion.coefficients
-            ground = float(expansion.eig.energies[0])
-            self.record = {"energy": ground} | ({} if expansion.objective.lowest else {"objective": self.energy})
+            self.record = {"energy": expansion.lowest_root} | ({} if expansion.objective.lowest
+                                                               else {"objective": self.energy})
             if self.path is not None and self.written:
                 self.path.unlink(missing_ok=True)
             self.written = False

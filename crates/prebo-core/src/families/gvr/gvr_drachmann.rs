@@ -15,7 +15,7 @@ use std::f64::consts::PI;
 use super::gvr_element::{quadrature, Gvr, GvrOps};
 use super::gvr_series::Coefficients;
 use super::EcgGvr;
-use crate::ecg::Vector;
+use crate::ecg::{log_det_cholesky, Vector};
 use crate::operators::drachmann::by_damping;
 
 /// `Σ_k q_k <φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` for normalised ECG-GVR functions (hartree/bohr;
@@ -26,8 +26,7 @@ pub fn coulomb_inv_r<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>,
     let (gi, gj, b) = (chol.solve(&bra.u), chol.solve(&ket.u), chol.solve(w));
     let (x, y, z) = (bra.u.dot(&gi) * 0.5, ket.u.dot(&gj) * 0.5, bra.u.dot(&gj) * 0.5);
     let (q, bi, bj) = (w.dot(&b), bra.u.dot(&b), ket.u.dot(&b));
-    let log_det = chol.l().diagonal().map(f64::ln).sum() * 2.0;
-    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5 - bra.log_norm - ket.log_norm;
+    let log_s0 = (log_det_cholesky(&chol) - D as f64 * PI.ln()) * -1.5 - bra.log_norm - ket.log_norm;
     let n = go.n_ang;
     let (pi, pj) = (bra.k as f64 + 0.5 * n as f64, ket.k as f64 + 0.5 * n as f64);
     let (series, rule) = (Coefficients::new(bra.k, ket.k, n), go.rule(bra.k + ket.k + n));
