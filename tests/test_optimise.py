@@ -202,27 +202,36 @@ def test_a_batch_keeps_each_change_only_if_it_still_gains_after_the_ones_before(
     """methods.Refine with a batch of three: each function's refinement is done on a copy of the
     same basis and the changes are put in order, re-checked against the basis the ones before
     changed (methods.together). Functions 0 and 3 are first moved away from where they belong.
-    Here function 1's unit refines function 0 less far than function
-    0's own (it gains against the basis it started from, not after function 0's refinement): it is
-    refused; function 2's refines function 3, and is kept; the matrices are those of a full build."""
+    Unit 1 puts function 0 where ten energies of its refinement take it from there: that gains
+    against the basis it started from, less than unit 0's refinement of function 0, so after
+    unit 0 it is refused; unit 2's refinement of function 3 is kept; the matrices are those of a
+    full build. The basis comes from a fixed schedule, which does not follow the clock."""
     from prebo.integrals import laboratory
     from prebo.optimise import Expansion, Minimiser, Refine
     from prebo.optimise import methods as m
     from prebo.optimise.refine import accept, FunctionEnergy, minimise
     from prebo.optimise.report import Reporter
     system = prebo.System(["p", "e", "e"], spin={"e": 0})
-    basis = prebo.optimise(system, Optimiser(size=8, trials=5, seed=4), progress=False)
+    basis = prebo.optimise(system, Optimiser(size=8, trials=5, seed=0, sweeps=0), progress=False)
     basis.A[[0, 3]] *= 2.0  # functions 0 and 3 moved far from where they belong
     rep = laboratory(system)
 
-    def unit(ex, i, *args):  # the function refined by unit i, and with how many energies
-        j, evaluations = {0: (0, 200), 1: (0, 2), 2: (3, 200)}[i]
-        obj = FunctionEnergy(ex, j)
-        minimise(obj, evaluations, "gradient")
-        accept(ex, j, obj)
-
     def fresh():
         return Expansion(basis.subset(slice(None)), rep, 1e-13)
+
+    def refined(ex, j, evaluations):
+        obj = FunctionEnergy(ex, j)
+        minimise(obj, evaluations, "gradient")
+        return obj
+
+    f_1 = refined(fresh(), 0, 10).best_f  # where unit 1 puts function 0
+
+    def unit(ex, i, *args):  # unit i of the batch
+        if i == 1:
+            obj = FunctionEnergy(ex, 0, f=f_1)
+        else:
+            obj = refined(ex, {0: 0, 2: 3}[i], 200)
+        accept(ex, obj.i, obj)
 
     def energy(*units):  # the units done one after the other
         ex = fresh()
