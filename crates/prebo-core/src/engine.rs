@@ -195,10 +195,10 @@ fn row_gradient_d<const D: usize, F: Family<D>>(
 }
 
 fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
-    let (arity, element) = operators::lookup::<D, F>(name)?;
+    let (arity, elements) = operators::lookup::<D, F>(name)?;
     let basis = F::params(basis)?;
     let (ops, sym) = e.rep.operators::<D>();
-    path::operator::<D, F>(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis, element, arity, w)
+    path::operator::<D, F>(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis, |bra, ket, ctx, v| elements.of(bra, ket, ctx, v), arity, w)
 }
 
 fn density_d<const D: usize, F: Family<D>>(e: &Engine, basis: &[Column], w: &[f64], c: &[f64], radii: &[f64]) -> Result<Vec<f64>> {

@@ -130,31 +130,45 @@ pub fn row_gradient<const D: usize, F: Family<D>>(
     })
 }
 
-/// The symmetrised matrix of one extra operator (`operators`, its element `<phi_I| O(v) |phi_J>`
-/// of `arity` vectors) for each instance `v` (`p x arity x n`, flat): `p` row-major `nb x nb`
-/// blocks, upper triangle evaluated, mirrored.
+/// The symmetrised matrix of one extra operator (`operators`, its elements `<phi_I| O(v) |phi_J>`
+/// of every instance `v` at once, `arity` vectors each) for each instance (`p x arity x n`, flat):
+/// `p` row-major `nb x nb` blocks, upper triangle evaluated, mirrored.
 pub fn operator<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     sym: &Symmetry<D>,
     basis: &F::Params<'_>,
-    element: impl Fn(&F::Function<f64>, &F::Function<f64>, &F::Context, &[Vector<D>]) -> f64 + Sync,
+    elements: impl Fn(&F::Function<f64>, &F::Function<f64>, &F::Context, &[Vec<Vector<D>>]) -> Vec<f64> + Sync,
     arity: usize,
     v: &[f64],
 ) -> Result<Vec<f64>> {
     let per = arity * D;
     check(v.len(), v.len() / per * per, "operator vectors")?;
     let b = images::<D, F>(ctx, sym, basis)?;
-    let mut out = Vec::with_capacity(v.len() / per * b.len() * b.len());
-    for vk in v.chunks_exact(per) {
-        let vk: Vec<Vector<D>> = vk.chunks_exact(D).map(Vector::<D>::from_row_slice).collect();
-        out.extend(symmetric_scalar(&b, |x, y| element(x, y, ctx, &vk)));
+    let instances: Vec<Vec<Vector<D>>> = v.chunks_exact(per).map(|vk| vk.chunks_exact(D).map(Vector::<D>::from_row_slice).collect()).collect();
+    let (nb, p) = (b.len(), instances.len());
+    let upper = assemble::upper(nb, |i, j| {
+        b.images[j].iter().zip(&b.coef).fold(vec![0.0; p], |mut acc, (ket, c)| {
+            for (a, x) in acc.iter_mut().zip(elements(&b.functions[i], ket, ctx, &instances)) {
+                *a += c * x;
+            }
+            acc
+        })
+    });
+    let mut out = vec![0.0; p * nb * nb];
+    for (i, row) in upper.iter().enumerate() {
+        for (k, values) in row.iter().enumerate() {
+            for (m, x) in out.chunks_exact_mut(nb * nb).zip(values) {
+                m[i * nb + i + k] = *x;
+                m[(i + k) * nb + i] = *x;
+            }
+        }
     }
     Ok(out)
 }
 
 /// `Σ_IJ c_I c_J Σ_P c_P <phi_I| O_k |P phi_J>` of an operator with `len` components `O_k`
 /// (`element` returns them all), for each state `c` (the columns of `c`, `nb x ns` row-major):
-/// `ns x len`, row-major. Rows `I` in parallel, `J >= I` mirrored as in `symmetric_scalar`,
+/// `ns x len`, row-major. Rows `I` in parallel, `J >= I` mirrored as in `operator`,
 /// summed in row order (the same bits for any number of threads).
 pub fn contracted<G: Sync>(
     b: &Images<G>,
@@ -194,24 +208,4 @@ pub fn contracted<G: Sync>(
         }
     }
     Ok(out)
-}
-
-/// A symmetrised scalar operator matrix (row-major `nb x nb`): `Σ_P c_P el(phi_i, P phi_j)`
-/// for `j >= i`, mirrored (operators that commute with the symmetry operations).
-pub fn symmetric_scalar<G: Sync>(b: &Images<G>, el: impl Fn(&G, &G) -> f64 + Sync) -> Vec<f64> {
-    let nb = b.len();
-    let upper = assemble::upper(nb, |i, j| {
-        b.images[j]
-            .iter()
-            .zip(&b.coef)
-            .fold(0.0, |acc, (ket, c)| acc + c * el(&b.functions[i], ket))
-    });
-    let mut m = vec![0.0; nb * nb];
-    for (i, row) in upper.iter().enumerate() {
-        for (k, x) in row.iter().enumerate() {
-            m[i * nb + i + k] = *x;
-            m[(i + k) * nb + i] = *x;
-        }
-    }
-    m
 }

@@ -25,7 +25,8 @@ use crate::error::{CoreError, Result};
 use crate::gradient::Dual;
 use crate::images::Transform;
 use crate::matrices::Matrices;
-use crate::operators::{drachmann, momentum, orbit, ElementFn};
+use crate::operators::drachmann::{self, InverseProducts};
+use crate::operators::{momentum, orbit, ElementFn};
 
 pub mod floating;
 pub mod gvr;
@@ -214,11 +215,15 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// that of functions whose gradients are a Gaussian times a linear polynomial (plain and
     /// floating ECGs), for ECG-GVR its own.
     const ORBIT: ElementFn<D, Self> = orbit::element::<D, Self>;
-    /// The element of `V/|r_w|` (`operators::drachmann`, operator `coulomb_inv_r`): by default
-    /// eq. (38) over the family's own `1/|r_w'|` element of its damped functions
-    /// (`drachmann::coulomb_by_damping`); plain ECGs have it in closed form (eq. 19), ECG-GVR reads
-    /// the damped elements off one factorisation.
-    const COULOMB: ElementFn<D, Self> = drachmann::coulomb_by_damping::<D, Self>;
+    /// The elements `1/(|r_w| |r_w'|)` of `V/|r_w|` per Coulomb pair `w'` (`operators::drachmann`,
+    /// operator `coulomb_inv_r`): by default eq. (38) over the family's own `1/|r_w'|` element of
+    /// its damped functions (`drachmann::products_by_damping`); plain ECGs have them in closed form
+    /// (eq. 19), ECG-GVR reads the damped elements off one factorisation.
+    const COULOMB: InverseProducts<D, Self> = drachmann::products_by_damping::<D, Self>;
+    /// The element of `<∇φ_I| Λ/|r_w| |∇φ_J>` (`operators::drachmann`, operator `gradient_inv_r`):
+    /// by default eq. (30) over the family's kinetic elements of its damped functions
+    /// (`drachmann::gradient_inv_r`); ECG-GVR reads each node off one factorisation.
+    const GRADIENT: ElementFn<D, Self> = drachmann::gradient_inv_r::<D, Self>;
     /// The element of `N_TI²` where the functions are not its eigenfunctions (`Angular`), `None`
     /// where they are (`N_TI² φ = N(N + 1) φ`).
     const ANGULAR: Option<Angular<D, Self>> = None;

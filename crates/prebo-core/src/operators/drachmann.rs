@@ -18,6 +18,9 @@
 //!   (`adaptive`; `by_damping`). It costs up to hundreds of the family's `1/|r_w'|` elements per pair
 //!   where a floating ECG's centres or a global vector's high powers shape the integrand; ECG-GVR
 //!   reads them off one factorisation of `A_I + A_J` (`Family::COULOMB`, `gvr::gvr_drachmann`).
+//!   `<1/(|r_kl| |r_w|)>` is symmetric in the two vectors, so the operator takes all its instances
+//!   at once (`coulomb_all`) and an instance that is a Coulomb pair reuses the products the
+//!   instances before it had with it: every pair asked for costs half the quadratures.
 //! - `gradient_inv_r`: `<∇φ_I| Λ/|r_w| |∇φ_J>` with the `Λ` of the context's `T_TI` (the CM part
 //!   removed: `1^T w = 0`, so `w^T Λ w = 1/(2μ_ij)` either way), from `1/|y| = π^{−1/2}∫t^{−1/2}e^{−ty²}dt`
 //!   and eq. (30): with `g = exp(−α r_w²)`, `D(α) = <φ_I|g|φ_J>` and `R = −∂D/∂α`,
@@ -53,32 +56,98 @@ fn whitening<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Func
     Some(move |w: &Vector<D>| chol.l().solve_lower_triangular(w).unwrap_or_else(|| Vector::<D>::repeat(f64::NAN)))
 }
 
-/// `<φ_I| V/|r_w| |φ_J>` of plain ECGs (hartree/bohr; `v = [w]`).
+/// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` for each Coulomb pair `(w'_k, q_k)` of the context (bohr⁻²),
+/// `known[k]` taken as it is where given: the element is symmetric in `w` and `w'`, so a caller
+/// that has it the other way round passes it (`coulomb_all`). A family's `Family::COULOMB`.
+pub type InverseProducts<const D: usize, F> =
+    fn(&<F as Family<D>>::Function<f64>, &<F as Family<D>>::Function<f64>, &<F as Family<D>>::Context, &Vector<D>, &[Option<f64>]) -> Vec<f64>;
+
+/// `<φ_I| V/|r_w| |φ_J> = Σ_k q_k <φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` (hartree/bohr; `v = [w]`) from the
+/// family's `Family::COULOMB`.
 pub fn coulomb_inv_r<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
-    let Some(whiten) = whitening::<D, F>(bra, ket) else { return f64::NAN };
-    let a = whiten(&v[0]);
+    let pairs = &F::operators(ctx).pairs;
+    potential(pairs, &F::COULOMB(bra, ket, ctx, &v[0], &vec![None; pairs.len()]))
+}
+
+/// `Σ_k q_k x_k` over the Coulomb pairs `(w'_k, q_k)`.
+fn potential<const D: usize>(pairs: &[(Vector<D>, f64)], x: &[f64]) -> f64 {
+    pairs.iter().zip(x).map(|((_, charge), x)| charge * x).sum()
+}
+
+/// `coulomb_inv_r` of every instance `[w]` at once (an `operators::Elements::All`).
+/// `<1/(|r_w| |r_w'|)>` is symmetric, so an instance that is a Coulomb pair (in the laboratory
+/// frame every one: both are `e_i − e_j`) takes each product with another pair from a table, and
+/// the table computes it once, integrated over the damping of the lighter pair of the two
+/// (`wᵀΛw = 1/(2μ_w)` the larger; of equal ones the first), whose integrand is the smoother
+/// (benchmarks/README.md: damping the protons' pair of H2 costs 2.3 times an electron's). That
+/// halves the quadratures of eq. (38) where every pair is asked for (⟨V²⟩ of the regularised
+/// ⟨p⁴⟩), and each product is the same bits whichever instances share the call (MPI ranks split
+/// them). Any other instance is `coulomb_inv_r`.
+pub fn coulomb_all<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, instances: &[Vec<Vector<D>>]) -> Vec<f64> {
+    let ops = F::operators(ctx);
+    let (pairs, n) = (&ops.pairs, ops.pairs.len());
+    let light: Vec<f64> = pairs.iter().map(|(w, _)| w.dot(&(ops.lambda * w))).collect();
+    // whether the product of pairs k and l is integrated over the damping of k
+    let damps = |k: usize, l: usize| light[k] > light[l] || (light[k] == light[l] && k <= l);
+    // the products damping pair k with the pairs `need` it damps that `table` lacks
+    let fill = |table: &mut [Option<f64>], k: usize, need: &dyn Fn(usize) -> bool| {
+        let skip: Vec<Option<f64>> = (0..n).map(|l| if need(l) && damps(k, l) && table[k * n + l].is_none() { None } else { Some(0.0) }).collect();
+        if skip.iter().all(Option::is_some) {
+            return;
+        }
+        let x = F::COULOMB(bra, ket, ctx, &pairs[k].0, &skip);
+        for l in (0..n).filter(|&l| skip[l].is_none()) {
+            table[k * n + l] = Some(x[l]);
+            table[l * n + k] = Some(x[l]);
+        }
+    };
+    // <1/(|r_w'_k| |r_w'_l|)> at k n + l, where computed
+    let mut table: Vec<Option<f64>> = vec![None; n * n];
+    let mut out = Vec::with_capacity(instances.len());
+    for v in instances {
+        let w = &v[0];
+        out.push(match pairs.iter().position(|(wp, _)| wp == w || *wp == -w) {
+            None => potential(pairs, &F::COULOMB(bra, ket, ctx, w, &vec![None; n])),
+            Some(c) => {
+                fill(&mut table, c, &|_| true);
+                for k in (0..n).filter(|&k| k != c) {
+                    fill(&mut table, k, &|l| l == c);
+                }
+                potential(pairs, &(0..n).map(|l| table[c * n + l].unwrap_or(f64::NAN)).collect::<Vec<_>>())
+            }
+        });
+    }
+    out
+}
+
+/// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` of plain ECGs by eq. (19) (`InverseProducts`).
+pub fn inverse_products<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, w: &Vector<D>, known: &[Option<f64>]) -> Vec<f64> {
+    let pairs = &F::operators(ctx).pairs;
+    let Some(whiten) = whitening::<D, F>(bra, ket) else { return vec![f64::NAN; pairs.len()] };
+    let a = whiten(w);
     let s = F::overlap(bra, ket, ctx);
-    F::operators(ctx).pairs.iter().map(|(w, charge)| charge * inverse_product(&a, &whiten(w))).sum::<f64>() * s
+    pairs.iter().zip(known).map(|((wp, _), x)| x.unwrap_or_else(|| inverse_product(&a, &whiten(wp)) * s)).collect()
 }
 
-/// `<φ_I| V/|r_w| |φ_J>` of any family by eq. (38) over the family's own `1/|r_w'|` element of its
-/// damped functions (hartree/bohr; `v = [w]`; module docs; `Family::COULOMB`'s default).
-pub fn coulomb_by_damping<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
-    let (w, pairs) = (&v[0], &F::operators(ctx).pairs);
-    let ww = w * w.transpose();
-    by_damping::<D, F>(bra, ket, ctx, w, |alpha, k| inverse::element::<D, F>(bra, &F::damped(ket, &(ww * alpha)), ctx, &pairs[k].0))
+/// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` of any family by eq. (38) over the family's own `1/|r_w'|`
+/// element of its damped functions (`InverseProducts`; module docs; `Family::COULOMB`'s default).
+pub fn products_by_damping<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, w: &Vector<D>, known: &[Option<f64>]) -> Vec<f64> {
+    let (ww, pairs) = (w * w.transpose(), &F::operators(ctx).pairs);
+    by_damping::<D, F>(bra, ket, ctx, w, known, |alpha, k| inverse::element::<D, F>(bra, &F::damped(ket, &(ww * alpha)), ctx, &pairs[k].0))
 }
 
-/// `Σ_k q_k <φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` over the context's Coulomb pairs `(w'_k, q_k)` by eq. (38)
-/// (module docs), given `damped(α, k) = <φ_I| e^{−α r_w²}/|r_w'_k| |φ_J>`.
+/// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` for the context's Coulomb pairs `w'_k` by eq. (38) (module
+/// docs), given `damped(α, k) = <φ_I| e^{−α r_w²}/|r_w'_k| |φ_J>`; `known[k]` where given.
 pub fn by_damping<const D: usize, F: Family<D>>(
     bra: &F::Function<f64>,
     ket: &F::Function<f64>,
     ctx: &F::Context,
     w: &Vector<D>,
+    known: &[Option<f64>],
     damped: impl Fn(f64, usize) -> f64,
-) -> f64 {
-    let Some(whiten) = whitening::<D, F>(bra, ket) else { return f64::NAN };
+) -> Vec<f64> {
+    let pairs = &F::operators(ctx).pairs;
+    let Some(whiten) = whitening::<D, F>(bra, ket) else { return vec![f64::NAN; pairs.len()] };
     let a = whiten(w);
     let q = a.norm_squared();
     let pair = |k: usize, wp: &Vector<D>| {
@@ -105,7 +174,7 @@ pub fn by_damping<const D: usize, F: Family<D>>(
         };
         2.0 / (PI * q).sqrt() * integral
     };
-    F::operators(ctx).pairs.iter().enumerate().map(|(k, (wp, charge))| charge * pair(k, wp)).sum()
+    pairs.iter().zip(known).enumerate().map(|(k, ((wp, _), x))| x.unwrap_or_else(|| pair(k, wp))).collect()
 }
 
 /// `|a ∧ b|`.
@@ -160,22 +229,38 @@ fn inverse_product<const D: usize>(a: &Vector<D>, b: &Vector<D>) -> f64 {
     if q12 == 0.0 { 4.0 / (PI * wedge) } else { 4.0 * q12.atan2(wedge) / (PI * q12) }
 }
 
-/// `<∇φ_I| Λ/|r_w| |∇φ_J>` (hartree/bohr; `v = [w]`; module docs).
+/// `<∇φ_I| Λ/|r_w| |∇φ_J>` (hartree/bohr; `v = [w]`; module docs) from the family's kinetic
+/// elements of its damped functions (`Family::GRADIENT`'s default).
 pub fn gradient_inv_r<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
     let w = &v[0];
-    let p = Profile::<D, F>::of(bra, ket, ctx, w);
-    let (q, ww) = (p.q, w * w.transpose());
-    let wlw = w.dot(&(F::operators(ctx).lambda * w));
+    let ww = w * w.transpose();
     let kinetic = F::kinetic_only(ctx);
-    // <∇φ_I| g Λ |∇φ_J> / (1 − u)^{3/2} at u (eq. 30)
-    let h = |u: f64| {
-        let alpha = u / (q * (1.0 - u));
+    kinetic_by_damping::<D, F>(bra, ket, ctx, w, |alpha| {
         let damping: Mat<D> = ww * alpha;
         let t = 0.5 * (F::element(&F::damped(bra, &damping), ket, &kinetic).t_ti + F::element(bra, &F::damped(ket, &damping), &kinetic).t_ti);
         let a: Dual<1> = seed(alpha, std::iter::once(1.0));
         let d = F::overlap(&F::cast::<Dual<1>>(bra), &F::damped(ket, &ww.map(|x| a * x)), ctx);
-        let r = -d.eps.unwrap_generic(Const::<1>, U1)[0];
-        (t + 0.5 * wlw * (4.0 * alpha * alpha * r - 6.0 * alpha * d.re)) / (1.0 - u).powf(1.5)
+        [t, d.re, -d.eps.unwrap_generic(Const::<1>, U1)[0]]
+    })
+}
+
+/// `<∇φ_I| Λ/|r_w| |∇φ_J>` by eq. (30) over the profile's rule (module docs), given at the damping
+/// `α` the kinetic part `½[T_TI(gφ_I, φ_J) + T_TI(φ_I, gφ_J)]`, `D(α)` and `R = −∂D/∂α` (`node`).
+pub fn kinetic_by_damping<const D: usize, F: Family<D>>(
+    bra: &F::Function<f64>,
+    ket: &F::Function<f64>,
+    ctx: &F::Context,
+    w: &Vector<D>,
+    node: impl Fn(f64) -> [f64; 3],
+) -> f64 {
+    let p = Profile::<D, F>::of(bra, ket, ctx, w);
+    let q = p.q;
+    let wlw = w.dot(&(F::operators(ctx).lambda * w));
+    // <∇φ_I| g Λ |∇φ_J> / (1 − u)^{3/2} at u (eq. 30)
+    let h = |u: f64| {
+        let alpha = u / (q * (1.0 - u));
+        let [t, d, r] = node(alpha);
+        (t + 0.5 * wlw * (4.0 * alpha * alpha * r - 6.0 * alpha * d)) / (1.0 - u).powf(1.5)
     };
     let integral: f64 = match &p.shape {
         // degree M + 1 in u = τ²: exact with ⌊(M + 1)/2⌋ + 1 positive nodes (eq. 18)
@@ -252,6 +337,13 @@ mod tests {
         }
         let lambda = Mat::<N>::from_diagonal(&Vector::<N>::from_fn(|i, _| 0.5 / masses[i]));
         Operators { lambda, pairs, cm_mass: cm.then(|| masses.iter().sum()) }
+    }
+
+    /// `<φ_I| V/|r_w| |φ_J>` by the generic eq. (38) (`products_by_damping`), whatever the
+    /// family's own `Family::COULOMB`.
+    fn coulomb_by_damping<const N: usize, F: Family<N>>(fi: &F::Function<f64>, fj: &F::Function<f64>, ctx: &F::Context, v: &[Vector<N>]) -> f64 {
+        let pairs = &F::operators(ctx).pairs;
+        potential(pairs, &products_by_damping::<N, F>(fi, fj, ctx, &v[0], &vec![None; pairs.len()]))
     }
 
     /// `∫_0^{π/2} f` by an n-point Gauss–Legendre rule.
@@ -341,7 +433,7 @@ mod tests {
                     assert!(close(gvr, got, 1e-13), "{label}: ECG-GVR {gvr} vs {got}");
                     // eq. (38) on the same functions against eq. (19), generic and ECG-GVR's own
                     let want = coulomb_inv_r::<N, PlainEcg>(&gi, &gj, &go, &[w]);
-                    for got in [coulomb_by_damping::<N, EcgGvr>(&gi, &gj, &go, &[w]), <EcgGvr as Family<N>>::COULOMB(&gi, &gj, &go, &[w])] {
+                    for got in [coulomb_by_damping::<N, EcgGvr>(&gi, &gj, &go, &[w]), coulomb_inv_r::<N, EcgGvr>(&gi, &gj, &go, &[w])] {
                         assert!(close(got, want, 1e-12), "{label}: eq. (38) {got} vs eq. (19) {want}");
                     }
                 }
@@ -425,7 +517,7 @@ mod tests {
                 let tol = 1e-12 + 1e-15 * tight;
                 let got = coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]);
                 assert!(close(got, want, tol), "A + {tight} w wᵀ, w = {w:?}: ECG-GVR {got} vs {want}");
-                let got = <EcgGvr as Family<3>>::COULOMB(&gi, &gj, &go, &[w]);
+                let got = coulomb_inv_r::<3, EcgGvr>(&gi, &gj, &go, &[w]);
                 assert!(close(got, want, tol), "A + {tight} w wᵀ, w = {w:?}: ECG-GVR's own {got} vs {want}");
                 let got = coulomb_by_damping::<3, FloatingEcg>(&fi, &fj, &ops, &[w]);
                 assert!(close(got, want, tol), "A + {tight} w wᵀ, w = {w:?}: floating {got} vs {want}");
@@ -459,7 +551,7 @@ mod tests {
                 let gj = Gvr::new(aj, Vector::<3>::new(-0.7, 0.2, 0.9), kj, 1.3, &go, 1).unwrap();
                 for w in pairs {
                     let want = coulomb_by_quadrature::<3, EcgGvr>(&gi, &gj, &go, &w, 40);
-                    for got in [coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]), <EcgGvr as Family<3>>::COULOMB(&gi, &gj, &go, &[w])] {
+                    for got in [coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]), coulomb_inv_r::<3, EcgGvr>(&gi, &gj, &go, &[w])] {
                         assert!(close(got, want, 1e-10), "K = ({ki}, {kj}), N = {n_ang}, CM {cm}, w = {w:?}: {got} vs {want}");
                     }
                 }
@@ -467,29 +559,65 @@ mod tests {
         }
     }
 
-    /// ECG-GVR's own eq. (38) (`Family::COULOMB`, rank-one updates of one factorisation) against
-    /// the generic one (`coulomb_by_damping`, each damped function factorised anew) where a
-    /// molecule's would differ if either rounded badly: K up to 15 along the heavy pair, held
-    /// close (1 − ρ² down to ~1e-5), N = 0 and 1, every pair vector; to the generic path's own
-    /// rounding there (`nearly_parallel_pairs_match_eq_19`): measured up to 1.2e-12 at tight ≤ 10³,
-    /// 6.4e-11 at 10⁵.
+    /// ECG-GVR's own eqs. (38) and (30) (`Family::COULOMB`: rank-one updates of one factorisation;
+    /// `Family::GRADIENT`: one element per node for both damped functions) against the generic ones
+    /// (`coulomb_by_damping`, `gradient_inv_r`: each damped function its own element) where a
+    /// molecule's would differ if either rounded badly:
+    /// K up to 15 along the heavy pair, held close (1 − ρ² down to ~1e-5), N = 0 and 1, with and
+    /// without the CM elimination, every pair vector; to the generic path's own rounding there
+    /// (`nearly_parallel_pairs_match_eq_19`): measured up to 1.2e-12 at tight ≤ 10³, 6.4e-11 at 10⁵
+    /// (Coulomb), 7e-14 at 10, 2.2e-12 at 10³ and 5.1e-10 at 10⁵ (gradient).
     #[test]
     fn global_vector_functions_match_the_generic_path() {
-        let ops = laboratory([1836.15267343, 1836.15267343, 1.0], [1.0, 1.0, -1.0], true);
+        let masses = [1836.15267343, 1836.15267343, 1.0];
         let heavy = Vector::<3>::new(1.0, -1.0, 0.0);
-        let mu = Vector::<3>::new(1836.15267343, 1836.15267343, 1.0) / 3673.30534686;
-        for n_ang in [0, 1] {
-            let go = GvrOps::new(ops.clone(), n_ang, 15).unwrap();
-            for (ki, kj, tight) in [(3, 5, 10.0), (15, 12, 1e3), (9, 0, 1e5)] {
-                let [ai, aj] = [0.3, 1.9].map(|seed| exponent::<3>(seed, Some((&mu, 1.0))) + heavy * heavy.transpose() * tight);
-                let gi = Gvr::new(ai, heavy + Vector::<3>::new(0.0, 0.0, 0.1), ki, 1.0, &go, 0).unwrap();
-                let gj = Gvr::new(aj, heavy * 0.8, kj, 1.0, &go, 1).unwrap();
-                for w in [Vector::<3>::new(1.0, 0.0, -1.0), Vector::<3>::new(0.0, 1.0, -1.0), heavy] {
-                    let (got, want) = (<EcgGvr as Family<3>>::COULOMB(&gi, &gj, &go, &[w]), coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]));
-                    assert!(close(got, want, 1e-12 + 1e-15 * tight), "K = ({ki}, {kj}), N = {n_ang}, A + {tight} w wᵀ, w = {w:?}: {got} vs {want}");
+        let mu = Vector::<3>::from_row_slice(&masses) / masses.iter().sum::<f64>();
+        for cm in [true, false] {
+            let ops = laboratory(masses, [1.0, 1.0, -1.0], cm);
+            for n_ang in [0, 1] {
+                let go = GvrOps::new(ops.clone(), n_ang, 15).unwrap();
+                for (ki, kj, tight) in [(3, 5, 10.0), (15, 12, 1e3), (9, 0, 1e5)] {
+                    let [ai, aj] = [0.3, 1.9].map(|seed| exponent::<3>(seed, cm.then_some((&mu, 1.0))) + heavy * heavy.transpose() * tight);
+                    let gi = Gvr::new(ai, heavy + Vector::<3>::new(0.0, 0.0, 0.1), ki, 1.0, &go, 0).unwrap();
+                    let gj = Gvr::new(aj, heavy * 0.8, kj, 1.0, &go, 1).unwrap();
+                    for w in [Vector::<3>::new(1.0, 0.0, -1.0), Vector::<3>::new(0.0, 1.0, -1.0), heavy] {
+                        let (got, want) = (coulomb_inv_r::<3, EcgGvr>(&gi, &gj, &go, &[w]), coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]));
+                        assert!(close(got, want, 1e-12 + 1e-15 * tight), "Coulomb: K = ({ki}, {kj}), N = {n_ang}, CM {cm}, A + {tight} w wᵀ, w = {w:?}: {got} vs {want}");
+                        let (got, want) = (<EcgGvr as Family<3>>::GRADIENT(&gi, &gj, &go, &[w]), gradient_inv_r::<3, EcgGvr>(&gi, &gj, &go, &[w]));
+                        assert!(close(got, want, 1e-12 + 1e-14 * tight), "gradient: K = ({ki}, {kj}), N = {n_ang}, CM {cm}, A + {tight} w wᵀ, w = {w:?}: {got} vs {want}");
+                    }
                 }
             }
         }
+    }
+
+    /// Every instance at once (`coulomb_all`, each product of two pairs computed once) against each
+    /// alone (`coulomb_inv_r`), for floating ECGs with centres and ECG-GVR, three particles in the
+    /// laboratory frame: the instances every Coulomb pair, one of them twice and reversed, and a
+    /// vector that is none; and the same bits for an instance in any company (MPI ranks split the
+    /// instances).
+    #[test]
+    fn all_instances_at_once_match_each_alone() {
+        let masses = [1836.15267343, 1.0, 1.0];
+        let ops = laboratory(masses, [1.0, -1.0, -1.0], true);
+        let mu = Vector::<3>::from_row_slice(&masses) / masses.iter().sum::<f64>();
+        let (ai, aj) = (exponent(0.5, Some((&mu, 0.7))), exponent(1.1, Some((&mu, 1.3))));
+        let mut instances: Vec<Vec<Vector<3>>> = ops.pairs.iter().map(|(w, _)| vec![*w]).collect();
+        instances.extend([vec![-ops.pairs[1].0], vec![Vector::<3>::new(0.5, 0.5, -1.0)]]);
+        let check = |all: &dyn Fn(&[Vec<Vector<3>>]) -> Vec<f64>, each: &dyn Fn(&[Vector<3>]) -> f64, label: &str| {
+            let together = all(&instances);
+            for (k, (got, v)) in together.iter().zip(&instances).enumerate() {
+                let want = each(v);
+                assert!(close(*got, want, 1e-10), "{label}, w = {:?}: {got} vs {want}", v[0]);
+                assert_eq!(all(&instances[k..k + 1])[0].to_bits(), got.to_bits(), "{label}, w = {:?} alone", v[0]);
+            }
+        };
+        let (fi, fj) = (Fecg::new(ai, fixtures::centres(0.3, 1.5), 0.7, 0).unwrap(), Fecg::new(aj, fixtures::centres(2.1, 1.5), 1.3, 1).unwrap());
+        check(&|v| coulomb_all::<3, FloatingEcg>(&fi, &fj, &ops, v), &|v| coulomb_inv_r::<3, FloatingEcg>(&fi, &fj, &ops, v), "floating");
+        let go = GvrOps::new(ops.clone(), 1, 3).unwrap();
+        let gi = Gvr::new(ai, Vector::<3>::new(0.3, 1.0, -0.4), 2, 0.7, &go, 0).unwrap();
+        let gj = Gvr::new(aj, Vector::<3>::new(-0.7, 0.2, 0.9), 3, 1.3, &go, 1).unwrap();
+        check(&|v| coulomb_all::<3, EcgGvr>(&gi, &gj, &go, v), &|v| coulomb_inv_r::<3, EcgGvr>(&gi, &gj, &go, v), "global vector");
     }
 
     #[test]
@@ -512,6 +640,3 @@ mod tests {
         }
     }
 }
-
-
-

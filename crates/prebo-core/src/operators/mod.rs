@@ -36,17 +36,40 @@ pub type ElementFn<const D: usize, F> = fn(
     &[Vector<D>],
 ) -> f64;
 
-/// An operator's element of one vector, as an `ElementFn` of arity 1.
+/// An operator's elements of all its instances at once (`instances`, each `arity` vectors), one
+/// value per instance, for an operator whose instances share work (`drachmann::coulomb_all`).
+pub type BatchFn<const D: usize, F> =
+    fn(&<F as Family<D>>::Function<f64>, &<F as Family<D>>::Function<f64>, &<F as Family<D>>::Context, &[Vec<Vector<D>>]) -> Vec<f64>;
+
+/// How a registered operator evaluates its instances for one pair of functions: each alone by
+/// its `ElementFn`, or all at once by a `BatchFn`.
+pub enum Elements<const D: usize, F: Family<D>> {
+    Each(ElementFn<D, F>),
+    All(BatchFn<D, F>),
+}
+
+impl<const D: usize, F: Family<D>> Elements<D, F> {
+    /// `<phi_I| O(v) |phi_J>` for every instance `v` of `instances`.
+    pub fn of(&self, bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, instances: &[Vec<Vector<D>>]) -> Vec<f64> {
+        match self {
+            Elements::Each(element) => instances.iter().map(|v| element(bra, ket, ctx, v)).collect(),
+            Elements::All(elements) => elements(bra, ket, ctx, instances),
+        }
+    }
+}
+
+/// An operator's element of one vector, as `Elements::Each` of arity 1.
 macro_rules! one_vector {
     ($element:path) => {{
         let element: ElementFn<D, F> = |bra, ket, ctx, v| $element(bra, ket, ctx, &v[0]);
-        Some(element)
+        Some(Elements::Each(element))
     }};
 }
 
-/// The registered operators: name, arity (vectors per operator) and element function (`None`:
-/// not derived for the family `F`).
-fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<ElementFn<D, F>>)> {
+/// The registered operators: name, arity (vectors per instance) and elements (`None`: not
+/// derived for the family `F`).
+fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<Elements<D, F>>)> {
+    use Elements::{All, Each};
     vec![
         (r2::NAME, 1, one_vector!(r2::element::<D, F>)),
         (distance::NAME, 1, one_vector!(distance::element::<D, F>)),
@@ -55,10 +78,10 @@ fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<
         (delta::NAME, 1, one_vector!(delta::element::<D, F>)),
         (momentum::P2, 1, one_vector!(momentum::p2::<D, F>)),
         (momentum::P4, 1, one_vector!(momentum::p4::<D, F>)),
-        (momentum::P2P2, 2, Some(momentum::p2p2::<D, F>)),
-        (drachmann::COULOMB, 1, Some(F::COULOMB)),
-        (drachmann::GRADIENT, 1, Some(drachmann::gradient_inv_r::<D, F>)),
-        (orbit::NAME, 3, Some(F::ORBIT)),
+        (momentum::P2P2, 2, Some(Each(momentum::p2p2::<D, F>))),
+        (drachmann::COULOMB, 1, Some(All(drachmann::coulomb_all::<D, F>))),
+        (drachmann::GRADIENT, 1, Some(Each(F::GRADIENT))),
+        (orbit::NAME, 3, Some(Each(F::ORBIT))),
         (angular::NAME, 1, F::ANGULAR.and_then(|_| one_vector!(angular::element::<D, F>))),
     ]
 }
@@ -73,8 +96,8 @@ pub fn derived<F: Family<1>>() -> Vec<&'static str> {
     registry::<1, F>().into_iter().filter(|(.., element)| element.is_some()).map(|(name, ..)| name).collect()
 }
 
-/// The arity and element function of the operator `name` for the family `F`.
-pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<(usize, ElementFn<D, F>)> {
+/// The arity and elements of the operator `name` for the family `F`.
+pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<(usize, Elements<D, F>)> {
     let (_, arity, element) = registry::<D, F>()
         .into_iter()
         .find(|(n, ..)| *n == name)

@@ -48,6 +48,7 @@
 //! positive nodes of the Gauss–Legendre rule on [−1, 1] with twice as many nodes (exact to degree
 //! 4⌊(K_I+K_J+N)/2⌋+3; for an even integrand ∫_0^1 = ½∫_{−1}^1).
 use std::f64::consts::PI;
+use std::ops::{Mul, Sub};
 
 use nalgebra::{Cholesky, SMatrix, SVector};
 
@@ -134,7 +135,7 @@ impl<const D: usize, T: Real> Gvr<D, T> {
         let log_det_2a = log_det_cholesky(&chol) + (D as f64) * 2f64.ln();
         let n = go.n_ang as f64;
         let g = series_at_one(k, go.n_ang);
-        let log_s0 = (log_det_2a - D as f64 * PI.ln()) * -1.5;
+        let log_s0 = log_s0::<T, D>(log_det_2a);
         let log_norm = (log_s0 + x.ln() * (2.0 * k as f64 + n) + g.ln()) * 0.5;
         Ok(Self { a, u, k, c_a, c_u: u.sum(), log_norm })
     }
@@ -260,6 +261,12 @@ pub(crate) fn series_coefficients<const D: usize>(go: &GvrOps<D>, ki: u32, kj: u
     Coefficients::new(ki, kj, go.n_ang).c
 }
 
+/// `ln S_0 = −(3/2) ln(|B|/π^D)` (module docs) from `ln|B|`.
+#[inline]
+pub(crate) fn log_s0<T: Sub<f64, Output = T> + Mul<f64, Output = T>, const D: usize>(log_det: T) -> T {
+    (log_det - D as f64 * PI.ln()) * -1.5
+}
+
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised ECG-GVR functions.
 pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
     let ops = &go.ops;
@@ -274,7 +281,7 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     let x = bra.u.dot(&gi) * 0.5;
     let y = ket.u.dot(&gj) * 0.5;
     let z = bra.u.dot(&gj) * 0.5;
-    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
+    let log_s0 = log_s0::<_, D>(log_det);
     let series = Coefficients::new(bra.k, ket.k, n);
     let (l, om, ox, oy, oz) = omega(&series.terms(), x, y, z);
     let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
@@ -286,20 +293,8 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
     let zl = mul(&ket.a, &lam_ui); // A_J Λ u_I
     let zr = mul(&bra.a, &lam_uj); // A_I Λ u_J
     let w = mul(&bra.a, &mul(&ops.lambda, &ket.a)); // A_I Λ A_J
-    let tr_wc = binv.component_mul(&w.transpose()).sum() * 0.5;
     let (hi, hj) = (gi * re::<T>(0.5), gj * re::<T>(0.5)); // C u
-    let (w_hi, w_hj) = (mul(&w, &hi), mul(&w, &hj));
-    // (written as `a * 4.0 * b` to keep the rounding of the f64 kernel's `4.0 * a * b`)
-    let t = bra.u.dot(&lam_uj) * oz
-        - zl.dot(&hi) * 4.0 * ox
-        - zl.dot(&hj) * 2.0 * oz
-        - zr.dot(&hj) * 4.0 * oy
-        - zr.dot(&hi) * 2.0 * oz
-        + tr_wc * 12.0 * om
-        + hi.dot(&w_hi) * 8.0 * ox
-        + (hi.dot(&w_hj) + hj.dot(&w_hi)) * 4.0 * oz
-        + hj.dot(&w_hj) * 8.0 * oy;
-    let t = scale * t;
+    let t = scale * kinetic(bra.u.dot(&lam_uj), [&zl, &zr, &hi, &hj], &w, &binv, (om, ox, oy, oz));
     let t_ti = match ops.cm_mass {
         Some(m) => t - scale * cm_kinetic(bra.c_a, ket.c_a, bra.c_u, ket.c_u, m, (om, ox, oy, oz)),
         None => t,
@@ -321,6 +316,21 @@ pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &G
         v += re::<T>(*q * 2.0) / (c * PI).sqrt() * integral;
     }
     Element { s, t, t_ti, v: scale * v }
+}
+
+/// `T/(S_0 e^L)` of the module docs from `λ = u_IᵀΛu_J`, `[A_JΛu_I, A_IΛu_J, ũ_I, ũ_J]`, `W`, `B⁻¹`
+/// and `(Ω, Ω_x, Ω_y, Ω_z)/e^L` (`omega`).
+#[inline]
+pub(crate) fn kinetic<T: Real, const D: usize>(lam: T, v: [&SVector<T, D>; 4], w: &SMatrix<T, D, D>, binv: &SMatrix<T, D, D>, omegas: (T, T, T, T)) -> T {
+    let ([zl, zr, hi, hj], (om, ox, oy, oz)) = (v, omegas);
+    let tr_wc = binv.component_mul(&w.transpose()).sum() * 0.5;
+    let (w_hi, w_hj) = (mul(w, hi), mul(w, hj));
+    // (written as `a * 4.0 * b` to keep the rounding of the f64 kernel's `4.0 * a * b`)
+    lam * oz - zl.dot(hi) * 4.0 * ox - zl.dot(hj) * 2.0 * oz - zr.dot(hj) * 4.0 * oy - zr.dot(hi) * 2.0 * oz
+        + tr_wc * 12.0 * om
+        + hi.dot(&w_hi) * 8.0 * ox
+        + (hi.dot(&w_hj) + hj.dot(&w_hi)) * 4.0 * oz
+        + hj.dot(&w_hj) * 8.0 * oy
 }
 
 /// The profile of the damped overlap `<φ_I| exp(−α r_w²) |φ_J> = (1 − u)^{3/2} G(u)`,
@@ -363,7 +373,7 @@ pub fn profile<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &V
     }
     let nf = n as f64;
     let l = x.ln() * (bra.k as f64 + 0.5 * nf) + y.ln() * (ket.k as f64 + 0.5 * nf);
-    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
+    let log_s0 = log_s0::<_, D>(log_det);
     let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
     acc.iter().map(|g| scale * g).collect()
 }

@@ -38,7 +38,7 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
-use super::gvr_element::{functions, series_coefficients, Gvr, GvrOps, GvrParams};
+use super::gvr_element::{functions, log_s0, series_coefficients, Gvr, GvrOps, GvrParams};
 use super::gvr_kernel::{derivative_series, dot, integral_partials, inverse_log_det, mat_vec, padded_rule, Ket, Prepared, Side, MAX_LANES, MAX_PAIRS};
 use super::gvr_series::{horner, omega, Coefficients};
 use crate::cache::Cache;
@@ -199,7 +199,7 @@ fn images<const D: usize, const W: usize, T: Lane>(
     let x = dot(&ui, &gi) * 0.5;
     let y = dot(uj, &gj) * 0.5;
     let z = dot(&ui, &gj) * 0.5;
-    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
+    let log_s0 = log_s0::<_, D>(log_det);
     let (l, om, ox, oy, oz) = omega(&ser.coef.terms(), x, y, z);
     let scale = (log_s0 + l - bra.log_norm - ket.log_norm).map(f64::exp);
     let hess = ser.hessian(x, y, z);

@@ -27,7 +27,7 @@
 #![allow(clippy::needless_range_loop)]
 use std::f64::consts::PI;
 
-use super::gvr_element::{functions, Gvr, GvrOps, GvrParams};
+use super::gvr_element::{functions, log_s0, Gvr, GvrOps, GvrParams};
 use super::gvr_series::{cm_kinetic, omega, Coefficients, Terms};
 use crate::ecg::{Element, Operators, MAX_DIM};
 use crate::error::Result;
@@ -452,7 +452,7 @@ fn elements<const D: usize, const W: usize, T: Lane>(
     let x = dot(&bra_u, &gi) * 0.5;
     let y = dot(&ket.u, &gj) * 0.5;
     let z = dot(&bra_u, &gj) * 0.5;
-    let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
+    let log_s0 = log_s0::<_, D>(log_det);
     let s = table.series(bra.k, kets[0].k);
     let (l, om, ox, oy, oz) = omega(&s.terms(), x, y, z);
     let scale = (log_s0 + l - bra.log_norm - ket.log_norm).map(f64::exp);

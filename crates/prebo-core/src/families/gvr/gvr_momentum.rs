@@ -28,7 +28,7 @@ use std::f64::consts::PI;
 use nalgebra::{Cholesky, Const, SMatrix, SVector};
 use num_dual::{DualNum, HyperDual64};
 
-use super::gvr_element::{legendre_rule, Gvr, GvrOps};
+use super::gvr_element::{legendre_rule, log_s0, Gvr, GvrOps};
 use super::gvr_series::{omega, Coefficients};
 use crate::ecg::{log_det_cholesky, Vector};
 
@@ -69,7 +69,7 @@ impl<'a, const D: usize> Generating<'a, D> {
         let series = Coefficients::new(bra.k, ket.k, go.n_ang);
         let (l, ..) = omega(&series.terms(), bra.u.dot(&ci) * 0.5, ket.u.dot(&cj) * 0.5, bra.u.dot(&cj) * 0.5);
         let log_det = log_det_cholesky(&chol);
-        let log_s0 = (log_det - D as f64 * PI.ln()) * -1.5;
+        let log_s0 = log_s0::<_, D>(log_det);
         let scale = (log_s0 + l - bra.log_norm - ket.log_norm).exp();
         Some(Self { bra, ket, chol, series, log_det, l, scale })
     }

@@ -22,6 +22,7 @@ use crate::families::{columns, matrices_of, Column, Directions, Exponents, Famil
 use crate::gradient::{seed_matrix, Dual};
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
+use crate::operators::drachmann::InverseProducts;
 use crate::operators::ElementFn;
 use crate::path;
 use gvr_element::{element, functions, Gvr, GvrOps, GvrParams};
@@ -47,7 +48,8 @@ impl<const D: usize> Family<D> for EcgGvr {
         &[Field::floats("A"), Field::floats("u"), Field::naturals("K"), Field::floats("c_A")];
     const MOMENTUM: Momentum<D, Self> = gvr_momentum::momentum::<D>;
     const ORBIT: ElementFn<D, Self> = gvr_momentum::orbit::<D>;
-    const COULOMB: ElementFn<D, Self> = gvr_drachmann::coulomb_inv_r::<D>;
+    const COULOMB: InverseProducts<D, Self> = gvr_drachmann::inverse_products::<D>;
+    const GRADIENT: ElementFn<D, Self> = gvr_drachmann::gradient_inv_r::<D>;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = GvrParams<'a>;

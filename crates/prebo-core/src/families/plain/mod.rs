@@ -16,7 +16,7 @@ use crate::gradient::{seed_matrix, Dual};
 use crate::images::Images;
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
-use crate::operators::{drachmann, ElementFn};
+use crate::operators::drachmann::{self, InverseProducts};
 use crate::path;
 
 pub mod pecg;
@@ -44,7 +44,7 @@ impl<const D: usize> Family<D> for PlainEcg {
     /// Rows in full-build orientation from the SIMD kernel (`pecg_build::rows`).
     const ORIENTED: bool = true;
     /// Eq. (19) in closed form.
-    const COULOMB: ElementFn<D, Self> = drachmann::coulomb_inv_r::<D, Self>;
+    const COULOMB: InverseProducts<D, Self> = drachmann::inverse_products::<D, Self>;
     type Function<T: Real> = Gvr<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = Exponents<'a>;
