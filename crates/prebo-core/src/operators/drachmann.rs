@@ -56,9 +56,9 @@ fn whitening<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Func
     Some(move |w: &Vector<D>| chol.l().solve_lower_triangular(w).unwrap_or_else(|| Vector::<D>::repeat(f64::NAN)))
 }
 
-/// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` for each Coulomb pair `(w'_k, q_k)` of the context (bohr⁻²),
-/// `known[k]` taken as it is where given: the element is symmetric in `w` and `w'`, so a caller
-/// that has it the other way round passes it (`coulomb_all`). A family's `Family::COULOMB`.
+/// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` for each Coulomb pair `(w'_k, q_k)` of the context (bohr⁻²);
+/// where `known[k]` is given it is returned instead, not computed (`coulomb_all` passes what it
+/// has, or needs not). A family's `Family::COULOMB`.
 pub type InverseProducts<const D: usize, F> =
     fn(&<F as Family<D>>::Function<f64>, &<F as Family<D>>::Function<f64>, &<F as Family<D>>::Context, &Vector<D>, &[Option<f64>]) -> Vec<f64>;
 
@@ -107,7 +107,7 @@ pub fn coulomb_all<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F
     for v in instances {
         let w = &v[0];
         out.push(match pairs.iter().position(|(wp, _)| wp == w || *wp == -w) {
-            None => potential(pairs, &F::COULOMB(bra, ket, ctx, w, &vec![None; n])),
+            None => coulomb_inv_r::<D, F>(bra, ket, ctx, v),
             Some(c) => {
                 fill(&mut table, c, &|_| true);
                 for k in (0..n).filter(|&k| k != c) {
