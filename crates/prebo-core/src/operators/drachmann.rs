@@ -19,8 +19,8 @@
 //!   where a floating ECG's centres or a global vector's high powers shape the integrand; ECG-GVR
 //!   reads them off one factorisation of `A_I + A_J` (`Family::COULOMB`, `gvr::gvr_drachmann`).
 //!   `<1/(|r_kl| |r_w|)>` is symmetric in the two vectors, so the operator takes all its instances
-//!   at once (`coulomb_all`) and an instance that is a Coulomb pair reuses the products the
-//!   instances before it had with it: every pair asked for costs half the quadratures.
+//!   at once (`coulomb_all`) and computes each product of two Coulomb pairs once, over the damping
+//!   of the lighter pair: every pair asked for costs half the quadratures.
 //! - `gradient_inv_r`: `<∇φ_I| Λ/|r_w| |∇φ_J>` with the `Λ` of the context's `T_TI` (the CM part
 //!   removed: `1^T w = 0`, so `w^T Λ w = 1/(2μ_ij)` either way), from `1/|y| = π^{−1/2}∫t^{−1/2}e^{−ty²}dt`
 //!   and eq. (30): with `g = exp(−α r_w²)`, `D(α) = <φ_I|g|φ_J>` and `R = −∂D/∂α`,
