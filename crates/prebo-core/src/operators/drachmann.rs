@@ -79,7 +79,7 @@ fn potential<const D: usize>(pairs: &[(Vector<D>, f64)], x: &[f64]) -> f64 {
 /// frame every one: both are `e_i − e_j`) takes each product with another pair from a table, and
 /// the table computes it once, integrated over the damping of the lighter pair of the two
 /// (`wᵀΛw = 1/(2μ_w)` the larger; of equal ones the first), whose integrand is the smoother
-/// (benchmarks/README.md: damping the protons' pair of H2 costs 2.3 times an electron's). That
+/// (benchmarks/README.md: damping the protons' pair of H2 costs 2–3 times damping any other). That
 /// halves the quadratures of eq. (38) where every pair is asked for (⟨V²⟩ of the regularised
 /// ⟨p⁴⟩), and each product is the same bits whichever instances share the call (MPI ranks split
 /// them). Any other instance is `coulomb_inv_r`.
