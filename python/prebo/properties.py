@@ -65,7 +65,7 @@ def reported(family, regularised: bool | None = None) -> list[str]:
     result.json): every one the family evaluates, Drachmann's terms, which serve the regularised
     ⟨δ³(r_ij)⟩ and ⟨p⁴⟩ alone, only if `regularised`; None: where ⟨V/r_ij⟩ is in closed form
     (`drachmann.CLOSED_FORM`). Elsewhere ⟨V/r_ij⟩ is a quadrature of up to a millisecond per element
-    (eq. 38): H2-500's properties take 103 s with them, 40 s without (benchmarks/README.md)."""
+    (eq. 38): H2-500's properties take 55 s with them, 26 s without (benchmarks/README.md)."""
     if regularised is None:
         regularised = family.name in drachmann.CLOSED_FORM
     return [name for name, op in OPERATORS.items()

@@ -5,7 +5,7 @@
 use std::ops::{Add, Div, Mul, Sub};
 
 use nalgebra::{ComplexField, RealField};
-use num_dual::{DualSVec64, HyperDual64};
+use num_dual::{Dual64, DualSVec64, HyperDual64};
 
 /// Arithmetic with itself and with `f64` constants, and the few functions of one value the shared
 /// formulas need. The functions are associated functions (`T::sqrt(x)`), not methods, so they do
@@ -104,6 +104,9 @@ dual_scalar!([const W: usize] DualSVec64<W>, |x| RealField::clamp(x, Self::from(
 // (`families::gvr::gvr_momentum`): `clamp_unit` clamps the value only, since the shared formulas
 // are analytic where they clamp (ρ = z/√(xy), `gvr_series::omega`) and the derivatives stand.
 dual_scalar!([] HyperDual64, |x| Self { re: x.re.clamp(-1.0, 1.0), ..x });
+// Dual numbers where those elements need one derivative only (the isotropic part of orbit–orbit),
+// clamped as the hyper-dual ones.
+dual_scalar!([] Dual64, |x| Self { re: x.re.clamp(-1.0, 1.0), ..x });
 
 #[cfg(test)]
 mod tests {

@@ -31,7 +31,17 @@ use crate::operators::drachmann::{by_damping, kinetic_by_damping};
 /// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` for normalised ECG-GVR functions and each Coulomb pair `w'_k`
 /// (bohr⁻², `drachmann::InverseProducts`); NaN where `A_I + A_J` does not factorise.
 pub fn inverse_products<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &Vector<D>, known: &[Option<f64>]) -> Vec<f64> {
-    let Some(chol) = (bra.a + ket.a).cholesky() else { return vec![f64::NAN; go.ops.pairs.len()] };
+    match damped_inverse(bra, ket, go, w) {
+        Some(damped) => by_damping::<D, EcgGvr>(bra, ket, go, w, known, damped),
+        None => vec![f64::NAN; go.ops.pairs.len()],
+    }
+}
+
+/// `(α, k) ↦ <φ_I| e^{−α r_w²}/|r_w'_k| |φ_J>` for normalised ECG-GVR functions and the Coulomb
+/// pairs `w'_k`, each read off the factorisation of `A_I + A_J` (module docs); None where it does
+/// not factorise.
+pub(crate) fn damped_inverse<'a, const D: usize>(bra: &'a Gvr<D>, ket: &'a Gvr<D>, go: &'a GvrOps<D>, w: &Vector<D>) -> Option<impl Fn(f64, usize) -> f64 + 'a> {
+    let chol = (bra.a + ket.a).cholesky()?;
     let (gi, gj, b) = (chol.solve(&bra.u), chol.solve(&ket.u), chol.solve(w));
     let (x, y, z) = (bra.u.dot(&gi) * 0.5, ket.u.dot(&gj) * 0.5, bra.u.dot(&gj) * 0.5);
     let (q, bi, bj) = (w.dot(&b), bra.u.dot(&b), ket.u.dot(&b));
@@ -41,7 +51,7 @@ pub fn inverse_products<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<
     let (series, rule) = (Coefficients::new(bra.k, ket.k, n), go.rule(bra.k + ket.k + n));
     // per Coulomb pair w': c' = w'ᵀB⁻¹w', (B⁻¹u_I)·w', (B⁻¹u_J)·w', bᵀw'
     let pairs: Vec<[f64; 4]> = go.ops.pairs.iter().map(|(wp, _)| [wp.dot(&chol.solve(wp)), gi.dot(wp), gj.dot(wp), b.dot(wp)]).collect();
-    by_damping::<D, EcgGvr>(bra, ket, go, w, known, |alpha, k| {
+    Some(move |alpha: f64, k: usize| {
         let [c, gwi, gwj, bw] = pairs[k];
         let kappa = alpha / (1.0 + alpha * q);
         let (xa, ya, za) = (x - 0.5 * kappa * bi * bi, y - 0.5 * kappa * bj * bj, z - 0.5 * kappa * bi * bj);

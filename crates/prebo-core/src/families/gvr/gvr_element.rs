@@ -356,11 +356,15 @@ pub fn profile<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &V
     let zs = [(z - gam_i * gam_j) / rt, gam_i * gam_j / rt];
     // Σ_k ĉ_k (XY)^{m−k} (Z²)^k, m = min(K_I, K_J), by Horner in XY: acc ← acc XY + ĉ_k Z^{2k}
     let c = Coefficients::new(bra.k, ket.k, n).c;
-    let (xy, zz) = (times(&xs, &ys), times(&zs, &zs));
-    let (mut acc, mut zz_k) = (vec![c[0]], vec![1.0]);
+    let xy = [xs[0] * ys[0], xs[0] * ys[1] + xs[1] * ys[0], xs[1] * ys[1]];
+    let zz = [zs[0] * zs[0], 2.0 * zs[0] * zs[1], zs[1] * zs[1]];
+    let degree = (bra.k + ket.k + n) as usize;
+    let (mut acc, mut zz_k) = (Vec::with_capacity(degree + 1), Vec::with_capacity(degree + 1));
+    acc.push(c[0]);
+    zz_k.push(1.0);
     for ck in &c[1..] {
-        zz_k = times(&zz_k, &zz);
-        acc = times(&acc, &xy);
+        times(&mut zz_k, &zz);
+        times(&mut acc, &xy);
         for (a, b) in acc.iter_mut().zip(&zz_k) {
             *a += ck * b;
         }
@@ -368,7 +372,7 @@ pub fn profile<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &V
     let m = c.len() as u32 - 1;
     for (factor, power) in [(&xs, bra.k - m), (&ys, ket.k - m), (&zs, n)] {
         for _ in 0..power {
-            acc = times(&acc, factor);
+            times(&mut acc, factor);
         }
     }
     let nf = n as f64;
@@ -378,15 +382,14 @@ pub fn profile<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &V
     acc.iter().map(|g| scale * g).collect()
 }
 
-/// The product of two polynomials (coefficients from the constant term up).
-fn times(a: &[f64], b: &[f64]) -> Vec<f64> {
-    let mut out = vec![0.0; a.len() + b.len() - 1];
-    for (i, ai) in a.iter().enumerate() {
-        for (j, bj) in b.iter().enumerate() {
-            out[i + j] += ai * bj;
-        }
+/// `a ← a b` for polynomials (coefficients from the constant term up), in place: from the top
+/// term down, each new coefficient reads only old ones below it (summed from a's lowest term up).
+fn times(a: &mut Vec<f64>, b: &[f64]) {
+    let n = a.len();
+    a.resize(n + b.len() - 1, 0.0);
+    for i in (0..a.len()).rev() {
+        a[i] = (i.saturating_sub(n - 1)..b.len().min(i + 1)).rev().fold(0.0, |sum, j| sum + a[i - j] * b[j]);
     }
-    out
 }
 
 impl<const D: usize, T: Real> Transform<D, GvrOps<D>> for Gvr<D, T> {

@@ -25,27 +25,35 @@
 //! orbit–orbit element (`orbit`) is read off the same generating function of damped functions.
 use std::f64::consts::PI;
 
-use nalgebra::{Cholesky, Const, SMatrix, SVector};
-use num_dual::{DualNum, HyperDual64};
+use std::ops::{Mul, Sub};
+
+use nalgebra::{Cholesky, Const, RealField, SMatrix, SVector};
+use num_dual::{Dual64, HyperDual64};
 
 use super::gvr_element::{legendre_rule, log_s0, Gvr, GvrOps};
 use super::gvr_series::{omega, Coefficients};
 use crate::ecg::{log_det_cholesky, Vector};
+use crate::scalar::Scalar;
 
 type H = HyperDual64;
 
 /// The generating function's moves (eq. 26a; `Generating::at`): `B' = B + b`, `u_I' = u_I + u_i`, `u_J' = u_J + u_j`,
-/// and Ω's arguments moved by `omega` beyond the covariances under B'.
-struct Moves<const D: usize> {
-    b: SMatrix<H, D, D>,
-    u_i: SVector<H, D>,
-    u_j: SVector<H, D>,
-    omega: [H; 3],
+/// and Ω's arguments moved by `omega` beyond the covariances under B'; in dual numbers where one
+/// derivative is read (`Dual64`), hyper-dual ones where a mixed second one is (`H`).
+struct Moves<T, const D: usize> {
+    b: SMatrix<T, D, D>,
+    u_i: SVector<T, D>,
+    u_j: SVector<T, D>,
+    omega: [T; 3],
 }
 
+/// The numbers the moves are made in: `Dual64` and `H`.
+trait Moving: RealField + Copy + From<f64> + Mul<f64, Output = Self> + Sub<f64, Output = Self> + Scalar {}
+impl<T: RealField + Copy + From<f64> + Mul<f64, Output = T> + Sub<f64, Output = T> + Scalar> Moving for T {}
+
 /// `c (v wᵀ + w vᵀ)/2`: the matrix of the quadratic form `c (vᵀr)·(wᵀr)` (3-vectors dotted).
-fn dyad<const D: usize>(v: &Vector<D>, w: &Vector<D>, c: H) -> SMatrix<H, D, D> {
-    ((v * w.transpose() + w * v.transpose()) * 0.5).map(H::from) * c
+fn dyad<T: Moving, const D: usize>(v: &Vector<D>, w: &Vector<D>, c: T) -> SMatrix<T, D, D> {
+    ((v * w.transpose() + w * v.transpose()) * 0.5).map(T::from) * c
 }
 
 /// What every move of one pair's generating function shares: the factor of `B = A_I + A_J`, Ω's
@@ -75,16 +83,16 @@ impl<'a, const D: usize> Generating<'a, D> {
     }
 
     /// `G(moves) / (S_0(B) e^L)`; None where B' does not factorise.
-    fn at(&self, moves: Moves<D>) -> Option<H> {
+    fn at<T: Moving>(&self, moves: Moves<T, D>) -> Option<T> {
         let (bra, ket) = (self.bra, self.ket);
-        let moved = Cholesky::new((bra.a + ket.a).map(H::from) + moves.b)?;
-        let (ui, uj) = (bra.u.map(H::from) + moves.u_i, ket.u.map(H::from) + moves.u_j);
+        let moved = Cholesky::new((bra.a + ket.a).map(T::from) + moves.b)?;
+        let (ui, uj) = (bra.u.map(T::from) + moves.u_i, ket.u.map(T::from) + moves.u_j);
         let (bi, bj) = (moved.solve(&ui), moved.solve(&uj));
         let [dx, dy, dz] = moves.omega;
         let (x, y, z) = (ui.dot(&bi) * 0.5 + dx, uj.dot(&bj) * 0.5 + dy, ui.dot(&bj) * 0.5 + dz);
         let (l, om, ..) = omega(&self.series.terms(), x, y, z);
         let l_moved = moved.l();
-        let log_det = (0..D).fold(H::from(0.0), |acc, k| acc + l_moved[(k, k)].ln() * 2.0);
+        let log_det = (0..D).fold(T::from(0.0), |acc, k| acc + l_moved[(k, k)].ln() * 2.0);
         // S_0(B')/S_0(B) = (|B|/|B'|)^{3/2}
         Some(((log_det - self.log_det) * -1.5 + (l - self.l)).exp() * om)
     }
@@ -126,26 +134,27 @@ pub fn orbit<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, v: &[Ve
     let q = w.dot(&gen.chol.solve(w));
     let (hi, hj) = (bra.a * g, ket.a * h);
     let (ugi, uhj) = (bra.u.dot(g), ket.u.dot(h));
-    let (e1, e2, zero) = (H::new(0.0, 1.0, 0.0, 0.0), H::new(0.0, 0.0, 1.0, 0.0), H::from(0.0));
+    // the isotropic part needs one derivative (dual numbers), the radial one a mixed second
+    let (d, zero) = (Dual64::new(0.0, 1.0), Dual64::from(0.0));
+    let (e1, e2) = (H::new(0.0, 1.0, 0.0, 0.0), H::new(0.0, 0.0, 1.0, 0.0));
     let lift = |v: &Vector<D>, c: H| v.map(H::from) * c;
     let mut sum = 0.0;
     for &(tau, weight) in legendre_rule(((bra.k + ket.k + go.n_ang) / 2 + 2) as usize) {
         let (t2, shrink) = (tau * tau / (q * (1.0 - tau * tau)), 1.0 - tau * tau);
-        let damping = dyad(w, w, H::from(t2));
         let isotropic = Moves {
-            b: damping + dyad(&hi, &hj, e1 * -4.0),
-            u_i: lift(&hj, e1 * (-2.0 * ugi)),
-            u_j: lift(&hi, e1 * (-2.0 * uhj)),
-            omega: [zero, zero, e1 * (ugi * uhj)],
+            b: dyad(w, w, Dual64::from(t2)) + dyad(&hi, &hj, d * -4.0),
+            u_i: hj.map(Dual64::from) * (d * (-2.0 * ugi)),
+            u_j: hi.map(Dual64::from) * (d * (-2.0 * uhj)),
+            omega: [zero, zero, d * (ugi * uhj)],
         };
         let radial = Moves {
-            b: damping + dyad(w, &hi, e1 * 2.0) + dyad(w, &hj, e2 * 2.0),
+            b: dyad(w, w, H::from(t2)) + dyad(w, &hi, e1 * 2.0) + dyad(w, &hj, e2 * 2.0),
             u_i: lift(w, e1 * ugi),
             u_j: lift(w, e2 * uhj),
-            omega: [zero; 3],
+            omega: [H::from(0.0); 3],
         };
         let (Some(one), Some(two)) = (gen.at(isotropic), gen.at(radial)) else { return f64::NAN };
-        sum += weight * (one.eps1 + 2.0 * t2 * two.eps1eps2) / shrink.powf(1.5);
+        sum += weight * (one.eps + 2.0 * t2 * two.eps1eps2) / shrink.powf(1.5);
     }
     gen.scale * 2.0 / (PI * q).sqrt() * sum
 }
