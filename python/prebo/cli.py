@@ -556,7 +556,7 @@ def parser() -> argparse.ArgumentParser:
                     help="relative overlap eigenvalue below which directions are dropped (default: as for prebo energy)")
     pr.add_argument("--regularised", action="store_true",
                     help="the regularised δ and p⁴ (and the Breit–Pauli correction from them) also where they are "
-                         "slow (floating ECGs, ECG-GVR: up to 1 ms per element); plain ECGs always have them")
+                         "slower (floating ECGs, ECG-GVR: H2 with 500 ECG-GVR functions 55 s against 26 s); plain ECGs always have them")
     pr.add_argument("--json", action="store_true", help="print the properties as JSON")
     pr.set_defaults(func=cmd_properties)
     en = sub.add_parser("energy", help="re-evaluate a stored basis")
