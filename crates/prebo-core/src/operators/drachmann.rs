@@ -535,12 +535,44 @@ mod tests {
         assert!(close(got, want, 1e-12), "{got} vs {want}");
     }
 
+    /// Eq. (38) where the pairs are nearly uncorrelated in the Gaussian (ρ² from 6e-4 down to
+    /// 7e-7, and 0), each product against eq. (19) to 1e-13: ECG-GVR at K = N = 0 by its own path
+    /// and the generic one, floating ECGs at zero centres (measured: 9.1e-16 at most). Where
+    /// 1 − τ² was the difference cos φ − √(1 − ρ²) it lost about ε/ρ² (session 37's code: 2.7e-11
+    /// at ρ² = 6e-6, 6.9e-13 at 7e-5).
+    #[test]
+    fn nearly_uncorrelated_pairs_match_eq_19() {
+        let ops = laboratory([1836.15267343, 1.0, 1.0], [1.0, -1.0, -1.0], false);
+        let go = GvrOps::new(ops.clone(), 0, 0).unwrap();
+        let (w, wp) = (Vector::<3>::new(1.0, 0.0, -1.0), Vector::<3>::new(0.0, 1.0, -1.0));
+        for delta in [3e-2, 1e-2, 3e-3, 1e-3, 0.0] {
+            // (A_I + A_J)⁻¹ = 1 + s (w w'ᵀ + w' wᵀ), so that wᵀ(A_I + A_J)⁻¹w' = 1 + 5s = δ
+            let s = (delta - 1.0) / 5.0;
+            let b = (Mat::<3>::identity() + (w * wp.transpose() + wp * w.transpose()) * s).try_inverse().unwrap();
+            let (ai, aj) = (b * 0.4 + Mat::<3>::identity() * 0.01, b * 0.6 - Mat::<3>::identity() * 0.01);
+            let (gi, gj) = (plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1));
+            let (fi, fj) = (Fecg::new(ai, Centres::<3>::zeros(), 1.0, 0).unwrap(), Fecg::new(aj, Centres::<3>::zeros(), 1.0, 1).unwrap());
+            let none = [None; 3];
+            let want = inverse_products::<3, PlainEcg>(&gi, &gj, &go, &w, &none);
+            let paths = [
+                ("ECG-GVR's own", <EcgGvr as Family<3>>::COULOMB(&gi, &gj, &go, &w, &none)),
+                ("generic, ECG-GVR", products_by_damping::<3, EcgGvr>(&gi, &gj, &go, &w, &none)),
+                ("generic, floating", products_by_damping::<3, FloatingEcg>(&fi, &fj, &ops, &w, &none)),
+            ];
+            for (path, got) in paths {
+                for k in 0..3 {
+                    assert!(close(got[k], want[k], 1e-13), "δ = {delta}, pair {k}, {path}: {} vs {}", got[k], want[k]);
+                }
+            }
+        }
+    }
+
     /// Eq. (38) where the pairs are nearly parallel: a light particle between two heavy ones held
     /// close (`A` grows by `tight` along their pair vector), so that its distances to them
     /// correlate up to ρ² = 1 − 1.2·10⁻⁵; against eq. (19) on plain ECGs and for floating ECGs at
     /// zero centres. The damped functions near α → ∞ round like the condition of `B + αwwᵀ` there,
-    /// which grows with `tight`: 1e-12 + 1e-15·tight relative (measured 3.4e-13, 8.3e-13 and
-    /// 4.2e-11 at tight = 10, 10³, 10⁵, the charges' sum cancelling about tenfold).
+    /// which grows with `tight`: 1e-12 + 1e-15·tight relative (measured 2.1e-14, 2.2e-13 and
+    /// 4.0e-11 at tight = 10, 10³, 10⁵, the charges' sum cancelling about tenfold).
     #[test]
     fn nearly_parallel_pairs_match_eq_19() {
         let ops = laboratory([1836.15267343, 1836.15267343, 1.0], [1.0, 1.0, -1.0], false);
