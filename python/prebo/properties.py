@@ -64,8 +64,8 @@ def reported(family, regularised: bool | None = None) -> list[str]:
     """The operators a level's properties hold for a basis of `family` (`properties`, `prebo run`'s
     result.json): every one the family evaluates, Drachmann's terms, which serve the regularised
     ⟨δ³(r_ij)⟩ and ⟨p⁴⟩ alone, only if `regularised`; None: where ⟨V/r_ij⟩ is in closed form
-    (`drachmann.CLOSED_FORM`). Elsewhere ⟨V/r_ij⟩ is a quadrature of up to a millisecond per element
-    (eq. 38): H2-500's properties take 55 s with them, 26 s without (benchmarks/README.md)."""
+    (`drachmann.CLOSED_FORM`). Elsewhere ⟨V/r_ij⟩ is a quadrature of tens of damped elements per
+    product (eq. 38): H2-500's properties take 55 s with them, 26 s without (benchmarks/README.md)."""
     if regularised is None:
         regularised = family.name in drachmann.CLOSED_FORM
     return [name for name, op in OPERATORS.items()

@@ -24,7 +24,6 @@
 //! both read off one evaluation of G in hyper-dual numbers (ε₁ along D_I, ε₂ along D_J). The
 //! orbit–orbit element (`orbit`) is read off the same generating function of damped functions.
 use std::f64::consts::PI;
-
 use std::ops::{Mul, Sub};
 
 use nalgebra::{Cholesky, Const, RealField, SMatrix, SVector};
