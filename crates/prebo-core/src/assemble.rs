@@ -6,20 +6,24 @@ use crate::matrices::Matrices;
 
 /// The `nb x nb` symmetric matrices: `element(i, j)` for `j >= i`, mirrored.
 pub fn symmetric(nb: usize, element: impl Fn(usize, usize) -> Element + Sync) -> Matrices {
-    let upper = upper(nb, element);
     let mut m = Matrices::zeros(nb, nb);
-    for (i, row) in upper.iter().enumerate() {
-        for (k, e) in row.iter().enumerate() {
-            m.set(i, i + k, e);
-            m.set(i + k, i, e);
-        }
-    }
+    mirror(&upper(nb, element), |i, j, e| m.set(i, j, e));
     m
 }
 
 /// The upper triangle `element(i, j)`, `j >= i`, row by row (rows in parallel).
 pub fn upper<E: Send>(nb: usize, element: impl Fn(usize, usize) -> E + Sync) -> Vec<Vec<E>> {
     (0..nb).into_par_iter().map(|i| (i..nb).map(|j| element(i, j)).collect()).collect()
+}
+
+/// `set(i, j, e)` and `set(j, i, e)` for each element `e` at `(i, j)` of an `upper` triangle.
+pub fn mirror<E>(upper: &[Vec<E>], mut set: impl FnMut(usize, usize, &E)) {
+    for (i, row) in upper.iter().enumerate() {
+        for (k, e) in row.iter().enumerate() {
+            set(i, i + k, e);
+            set(i + k, i, e);
+        }
+    }
 }
 
 /// `k x nb` rows `row(t, j)` and the diagonals `diag(t)`.

@@ -155,14 +155,11 @@ pub fn operator<const D: usize, F: Family<D>>(
         })
     });
     let mut out = vec![0.0; p * nb * nb];
-    for (i, row) in upper.iter().enumerate() {
-        for (k, values) in row.iter().enumerate() {
-            for (m, x) in out.chunks_exact_mut(nb * nb).zip(values) {
-                m[i * nb + i + k] = *x;
-                m[(i + k) * nb + i] = *x;
-            }
+    assemble::mirror(&upper, |i, j, values: &Vec<f64>| {
+        for (m, x) in out.chunks_exact_mut(nb * nb).zip(values) {
+            m[i * nb + j] = *x;
         }
-    }
+    });
     Ok(out)
 }
 
