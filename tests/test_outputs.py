@@ -9,6 +9,7 @@ import math
 import os
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import tempfile
@@ -123,6 +124,91 @@ def test_plot_into_a_folder_writes_its_convergence_png(tmp_path, capsys):
         assert status == 0 and printed == f"wrote {folder / 'convergence.png'}\n"
         assert (folder / "convergence.png").read_bytes()[:4] == b"\x89PNG"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["figs", "plots"]
+
+
+# --- issue 55 case 1: only a regular file is ever replaced ------------------------------------------
+def special(tmp_path: Path, kind: str) -> Path:
+    """A FIFO, a character device (a copy of /dev/null's numbers, made in `tmp_path`: the machine's
+    own /dev is never a test's target) or a socket in `tmp_path`."""
+    path = tmp_path / f"{kind}.out"
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "device":
+        try:
+            os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+        except PermissionError:
+            pytest.skip("mknod needs privileges this machine does not give")
+    else:
+        import socket
+        with socket.socket(socket.AF_UNIX) as s:
+            s.bind(str(path))
+    return path
+
+
+def commands(tmp_path: Path, out: Path) -> dict[str, list]:
+    """Every writer's command line with `out` as the file it writes."""
+    return {"export": ["export", ROOT / "examples" / "bases" / "he" / "basis.json", "--format", "ecgpack", "--out", out],
+            "import": ["import", LI, "--out", out],
+            "plot": ["plot", H_RUN, "--out", out.with_suffix(".png") if out.suffix != ".png" else out],
+            "densities": ["plot", "--densities", H_RUN / "basis.json", "--points", 20, "--out",
+                          out.with_suffix(".png") if out.suffix != ".png" else out]}
+
+
+@pytest.mark.parametrize("force", [[], ["--force"]])
+@pytest.mark.parametrize("kind", ["fifo", "device", "socket"])
+@pytest.mark.parametrize("command", ["export", "import", "plot", "densities"])
+def test_a_device_or_fifo_is_never_replaced(tmp_path, capsys, command, kind, force):
+    """`prebo export B --format ecgpack --out /dev/full --force` said "wrote /dev/full", exit 0,
+    and left a regular file where the device was (a FIFO too): every writer refuses, with
+    --force or without, and leaves the node as it was."""
+    node = special(tmp_path, kind)
+    if command in ("plot", "densities"):
+        node.rename(node := node.with_suffix(".png"))
+    mode = os.lstat(node).st_mode
+    err = refused(capsys, *commands(tmp_path, node)[command], *force)
+    assert f"{node}: a " in err and "not a regular file" in err, err
+    assert os.lstat(node).st_mode == mode and not list(tmp_path.glob("*.tmp"))
+
+
+def test_the_densities_table_beside_the_picture_is_not_replaced_if_a_fifo(tmp_path, capsys):
+    """The CSV beside `prebo plot --densities`' picture is an output too."""
+    table = tmp_path / "d.csv"
+    os.mkfifo(table)
+    err = refused(capsys, "plot", "--densities", H_RUN / "basis.json", "--points", 20, "--out", tmp_path / "d.png")
+    assert f"{table}: a FIFO" in err and stat.S_ISFIFO(os.lstat(table).st_mode)
+    assert not (tmp_path / "d.png").exists()
+
+
+@pytest.mark.parametrize("name", ["basis.json", "result.json", "lowest.json", "folder"])
+def test_a_run_never_replaces_a_fifo_in_or_as_its_folder(tmp_path, capsys, name):
+    """A run's folder, and its checkpoint, lowest state and result, replace only regular files
+    (with --force too, which removes an earlier run's files)."""
+    out = tmp_path / "run"
+    fifo = out if name == "folder" else out / name
+    out.mkdir(exist_ok=name != "folder") if name != "folder" else None
+    os.mkfifo(fifo)
+    (tmp_path / "h.toml").write_text(H_TOML)
+    err = refused(capsys, "run", tmp_path / "h.toml", "--out", out, "--quiet", "--force")
+    assert f"{fifo}: a FIFO" in err and stat.S_ISFIFO(os.lstat(fifo).st_mode)
+
+
+def test_an_output_through_a_symbolic_link_is_written_into_its_file(tmp_path, capsys):
+    """A link to a regular file is kept: the output replaces the file it names, atomically."""
+    real, link = tmp_path / "real.inout.txt", tmp_path / "link.inout.txt"
+    real.write_text("old\n")
+    link.symlink_to(real.name)
+    assert cli(capsys, *commands(tmp_path, link)["export"], "--force")[0] == 0
+    assert link.is_symlink() and real.read_text().split()[:2] == ["BASIS_TYPE", "RG_0S"]
+
+
+def test_the_api_writer_refuses_a_fifo(tmp_path):
+    """Basis.save, the API's writer, goes through the same check."""
+    fifo = tmp_path / "b.json"
+    os.mkfifo(fifo)
+    basis = prebo.Basis.load(H_RUN / "basis.json")
+    with pytest.raises(OutputError, match="a FIFO"):
+        basis.save(fifo)
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
 
 
 # --- case 7 and 13: a run owns its folder; a refused run leaves no trace --------------------------

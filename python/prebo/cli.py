@@ -1,6 +1,7 @@
 """Command line: `prebo run`, `energy`, `import`, `export`, `plot`. Errors print one line and exit 2, never a traceback.
 
-Outputs never replace inputs, and replace earlier outputs only with `--force` (atomically); a run
+Outputs never replace inputs nor anything but a regular file (`io.files.replaceable`), and
+replace earlier outputs only with `--force` (atomically); a run
 owns its folder while it runs (io/lock.py). A closed or full standard output or error ends the
 command with exit 2 once its work is done and its files are written (`Stream`).
 """
@@ -235,10 +236,14 @@ def cmd_run(args) -> int:
 
 def claim(out: Path, force: bool) -> None:
     """Make the folder `out` a new run's: OutputError if it holds an earlier run's checkpoint,
-    lowest state or result, unless `force`, which removes them (the new run writes its own)."""
+    lowest state or result, unless `force`, which removes them (the new run writes its own), and
+    if one of their names is anything but a regular file (`files.replaceable`)."""
+    from .io.files import replaceable
     from .optimise.checkpoint import CHECKPOINT, LOWEST
 
-    earlier = [out / name for name in (CHECKPOINT, LOWEST, RESULT) if (out / name).exists()]
+    earlier = [out / name for name in (CHECKPOINT, LOWEST, RESULT) if os.path.lexists(out / name)]
+    for path in earlier:
+        replaceable(path)
     if earlier and not force:
         if earlier[0].name == RESULT:
             raise OutputError(f"{out}: the output folder holds a run's result ({RESULT}): give another --out, "
@@ -256,7 +261,10 @@ def given(out: str | None, default: Path, what: str) -> Path:
 
 def output_file(path: Path, force: bool, inputs=()) -> Path:
     """`path`, the file a command is to write; OutputError for a folder, for one of the files
-    `inputs` (through a symbolic or hard link too) and, unless `force`, for an existing file."""
+    `inputs` (through a symbolic or hard link too), for anything but a regular file (a device, a
+    FIFO: `files.replaceable`) and, unless `force`, for an existing file."""
+    from .io.files import replaceable
+
     if path.is_dir():
         raise OutputError(f"{path}: cannot write (a folder, not a file)")
     if os.path.lexists(path):
@@ -264,6 +272,7 @@ def output_file(path: Path, force: bool, inputs=()) -> Path:
         if source is not None:
             raise OutputError(f"{path}: the input file {source} itself (an output never replaces its input): "
                               "give another --out")
+        replaceable(path)
         if not force:
             raise OutputError(f"{path}: the file exists: give --force to replace it, or another --out")
     return path

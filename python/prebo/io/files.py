@@ -1,9 +1,12 @@
 """Atomic file writes: a killed writer leaves the old file or the new one, never half of one
-(basis.json and its checkpoints, lowest.json, result.json, ecgpack files, plots)."""
+(basis.json and its checkpoints, lowest.json, result.json, ecgpack files, plots, CSV tables).
+Only a regular file is ever replaced: a device, a FIFO, a socket or a folder at an output's
+path is refused (`replaceable`), since renaming a file over it would destroy it."""
 from __future__ import annotations
 
 import json
 import os
+import stat
 import tempfile
 from glob import escape as glob_escape
 from pathlib import Path
@@ -11,14 +14,37 @@ from pathlib import Path
 from ..errors import OutputError
 
 
+#: what each kind of file that is not a regular one is called in a refusal (`replaceable`)
+KINDS = {stat.S_IFDIR: "a folder", stat.S_IFCHR: "a character device", stat.S_IFBLK: "a block device",
+         stat.S_IFIFO: "a FIFO (named pipe)", stat.S_IFSOCK: "a socket"}
+
+
+def replaceable(path) -> Path:
+    """The file an output at `path` is written into: `path`, or the file a symbolic link there
+    names (the link is kept). OutputError unless that is a regular file or nothing yet."""
+    path = Path(path)
+    target = Path(os.path.realpath(path)) if path.is_symlink() else path
+    try:
+        mode = os.stat(target).st_mode
+    except FileNotFoundError:
+        return target
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write ({exc.strerror})") from exc
+    if not stat.S_ISREG(mode):
+        kind = KINDS.get(stat.S_IFMT(mode), "not a regular file")
+        raise OutputError(f"{path}: {kind}, not a regular file: prebo replaces only regular files; give another path")
+    return target
+
+
 def write_atomic(path, text: str | bytes) -> None:
     """Write `text` (or bytes: an image) to a temporary file in the same folder (PATH.*.tmp), fsync,
     then os.replace: a killed writer leaves the old file or the new one, never half of one.
-    OutputError naming the path if it cannot be written."""
+    OutputError naming the path if it cannot be written or is not a regular file (`replaceable`)."""
     path = Path(path)
+    target = replaceable(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=target.name + ".", suffix=".tmp")
     except OSError as exc:
         raise OutputError(f"{path}: cannot write ({exc.strerror})") from exc
     umask = os.umask(0)
@@ -29,7 +55,7 @@ def write_atomic(path, text: str | bytes) -> None:
             f.write(text)
             f.flush()
             os.fsync(f.fileno())
-        os.replace(tmp, path)
+        os.replace(tmp, target)
     except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)

@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import fcntl
 import os
+import stat
 import threading
 from contextlib import contextmanager
 from pathlib import Path
 
 from ..errors import OutputError
+from .files import KINDS
 
 LOCK = ".lock"
 
@@ -51,6 +53,9 @@ def owned(folder):
 def _make(folder: Path) -> list[Path]:
     """Create `folder` and its missing parents; those created, deepest first."""
     missing = [p for p in (folder, *folder.parents) if not p.exists()]
+    if folder.exists() and not folder.is_dir():
+        kind = KINDS.get(stat.S_IFMT(os.stat(folder).st_mode), "a file")
+        raise OutputError(f"{folder}: {kind}, not a folder: a run writes into a folder of its own; give another --out")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
