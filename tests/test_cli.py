@@ -2,6 +2,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -271,3 +272,47 @@ def test_the_result_and_a_re_evaluation_use_the_threshold_of_the_run(tmp_path):
     full = json.loads(prebo("energy", out / "basis.json", "--threshold", "1e-13", "--json").stdout)
     assert full["kept"] == 400 and full["energy"] < again["energy"]
     assert_clean_error(prebo("energy", out / "basis.json", "--threshold", "0"), "--threshold")
+
+
+def printed(*args, columns: int) -> str:
+    """What `prebo ARGS` prints on a pipe of `columns` columns (COLUMNS, as a terminal of that
+    width or a log would have it); exit 0."""
+    import os
+    r = subprocess.run([sys.executable, "-m", "prebo", *map(str, args)], capture_output=True, text=True,
+                       env=os.environ | {"COLUMNS": str(columns)})
+    assert r.returncode == 0, r.stderr
+    return r.stdout
+
+
+BASES = Path(__file__).resolve().parents[1] / "examples" / "bases"
+
+
+@pytest.mark.parametrize("columns", [80, 40])
+def test_no_printed_number_is_cut_short(run_dir, columns):
+    """In a pipe, a log or an 80-column terminal, `prebo energy BASIS --roots K` printed
+    `-0.597139061…`: rich shortens the column that does not fit. Every table-printing command
+    (energy with levels, properties with the Breit–Pauli terms, a run's result) at 80 columns and
+    narrower shows no ellipsis, and each energy, expectation value and correction it prints is
+    its --json value to the digits printed."""
+    ladder = BASES / "h2plus-ladder" / "basis.json"
+    text = printed("energy", ladder, "--roots", 4, columns=columns)
+    r = json.loads(printed("energy", ladder, "--roots", 4, "--json", columns=columns))
+    assert "…" not in text
+    for level in r["levels"]:
+        assert f"{level['energy']:.12f}" in text and f"{level['energy_uncertainty']:.1e}" in text
+    for d in r["transitions"]:
+        if d["upper"] == d["lower"] + 1:
+            assert f"{d['Eh']:.10f}" in text and f"{d['cm-1']:.6f}" in text
+    for basis in (BASES / "h2-pecg" / "basis.json",):
+        text = printed("properties", basis, columns=columns)
+        p = json.loads(printed("properties", basis, "--json", columns=columns))
+        assert "…" not in text and f"{p['energy']:.12f}" in text
+        values = [v for per in p["expectation"].values() for v in per.values()]
+        values += list(p["delta_regularised"].values()) + list(p["p4_regularised"].values())
+        values = [f"{v:.10g}" for v in values]
+        values += [f"{e:.6e}" for e in p["breit_pauli"]["Eh"].values()]
+        values += [f"{e:.6e}" for per in p["breit_pauli"]["classes"].values() for e in per.values()]
+        assert [v for v in values if v not in text] == []
+    text = printed("energy", run_dir / "basis.json", columns=columns)
+    result = json.loads((run_dir / "result.json").read_text())
+    assert "…" not in text and f"{result['energy']:.12f}" in text and f"{result['energy_lab']:.12f}" in text

@@ -51,7 +51,6 @@ def _result(basis, where, threshold: float, coordinates: str = "lab", operators=
 
 
 def _print_result(r: dict) -> None:
-    from rich.console import Console
     from rich.table import Table
 
     from .optimise.convergence import STOPPED
@@ -91,9 +90,53 @@ def _print_result(r: dict) -> None:
         op = OPERATORS[name]
         for pair, value in values.items():
             t.add_row(f"{name} {pair}", f"{value:.10g} {op.unit}")
-    Console().print(t)
+    show(t)
     if "levels" in r:
         _print_levels(r)
+
+
+#: what rich puts where it shortens a cell that does not fit the console (`show`)
+ELLIPSIS = "…"
+
+
+def show(table) -> None:
+    """Print the rich `table` on standard output with every cell whole: framed if it fits the
+    console's width (rich's, the terminal's or COLUMNS; 80 in a pipe or a log), else without its
+    frame, else as plain lines (`lines`) — never a number shortened to "-0.597139061…", rich's
+    way with a column the width cannot hold."""
+    from rich.console import Console
+
+    console = Console()
+    for form in (table, replace_box(table)):
+        with console.capture() as captured:
+            console.print(form)
+        if ELLIPSIS not in captured.get():
+            console.print(form)
+            return
+    print("\n".join(lines(table)))
+
+
+def replace_box(table):
+    """`table` without its frame (a copy)."""
+    from copy import copy
+
+    frameless = copy(table)
+    frameless.box, frameless.show_edge = None, False
+    return frameless
+
+
+def lines(table) -> list[str]:
+    """The rich `table` as plain text (`show`): its title, a line per row ("header value" per
+    non-empty cell, or the cells of a table without headers), its caption."""
+    columns = list(table.columns)
+    rows = zip(*(column.cells for column in columns))
+    text = [str(table.title)] if table.title else []
+    for row in rows:
+        if table.show_header:
+            text.append("  " + "; ".join(f"{c.header} {v}" for c, v in zip(columns, row) if str(v).strip()))
+        else:
+            text.append("  ".join(str(v) for v in row))
+    return text + ([f"({table.caption})"] if table.caption else [])
 
 
 def _bound(r: dict) -> str:
@@ -108,7 +151,6 @@ def _bound(r: dict) -> str:
 def _print_levels(r: dict) -> None:
     """The levels of a result with several roots, and the transitions from the lowest and between
     neighbours (results.evaluate; every pair is in the JSON)."""
-    from rich.console import Console
     from rich.table import Table
 
     from .results import HARTREE_CM
@@ -122,7 +164,7 @@ def _print_levels(r: dict) -> None:
         gap = gaps[(0, v["root"])]["cm-1"] if v["root"] else 0.0
         levels.add_row(str(v["root"]), f"{v['energy']:.12f}", f"{v['energy_uncertainty']:.1e}", f"{v['virial']:.1e}",
                        f"{gap:.6f}", "yes" if v["bound"] else "no", "yes" if v["root"] in targets else "")
-    Console().print(levels)
+    show(levels)
     unbound = {v["root"] for v in r["levels"] if not v["bound"]}
     steps = Table("transition", "ΔE (Eh)", "ΔE (cm⁻¹)", "uncertainty (cm⁻¹)", title="between neighbouring levels",
                   caption="*: to or from a level not bound in this basis (a discretised continuum state)"
@@ -132,7 +174,7 @@ def _print_levels(r: dict) -> None:
         mark = "*" if {d["lower"], d["upper"]} & unbound else ""
         steps.add_row(f"{d['lower']} → {d['upper']}{mark}", f"{d['Eh']:.10f}", f"{d['cm-1']:.6f}",
                       f"{d['uncertainty'] * HARTREE_CM:.1e}")
-    Console().print(steps)
+    show(steps)
 
 
 def _warn_if_unbound(r: dict) -> None:
@@ -439,8 +481,9 @@ def cmd_properties(args) -> int:
 
 def _print_properties(p: dict, basis) -> None:
     """`prebo properties`' tables (cmd_properties)."""
-    from rich.console import Console
     from rich.table import Table
+
+    from .results import HARTREE_CM
 
     head = Table(show_header=False, box=None)
     head.add_row("level", f"root {p['root']} ({_bound(p)})")
@@ -448,7 +491,7 @@ def _print_properties(p: dict, basis) -> None:
     head.add_row("virial η_TI", f"{p['virial']:.2e}")
     if "n2" in p:
         head.add_row("⟨N²⟩_TI", f"{p['n2']:.3e} ħ²")
-    Console().print(head)
+    show(head)
     for acts_on in ("pairs", "particles"):
         names = [name for name in p["expectation"] if OPERATORS[name].acts_on == acts_on]
         if names:
@@ -462,18 +505,19 @@ def _print_properties(p: dict, basis) -> None:
             if acts_on == "particles" and p.get("p4_regularised"):  # drachmann.py, eq. (27')
                 table.add_row("p4 (regularised)", *(f"{p['p4_regularised'][c]:.10g}" if c in p["p4_regularised"]
                                                     else "" for c in classes), "ħ⁴/bohr⁴")
-            Console().print(table)
+            show(table)
     if "breit_pauli" in p:  # relativistic.py: each term, per class and summed
         bp = p["breit_pauli"]
         kind = ("regularised δ and p⁴ where Drachmann's forms serve (drachmann.py)" if bp["regularised"]
                 else "direct δ and p⁴")
-        table = Table("term", "Eh", "cm⁻¹", "per class (Eh)", title=f"Breit–Pauli correction (α = {bp['alpha']}; {kind})")
+        table = Table("term (class)", "Eh", "cm⁻¹", title=f"Breit–Pauli correction (α = {bp['alpha']}; {kind})")
         for term, e in bp["Eh"].items():
-            per = ", ".join(f"{c} {v:.6e}" for c, v in bp["classes"].get(term, {}).items())
-            table.add_row(term.replace("_", "–"), f"{e:.6e}", f"{bp['cm-1'][term]:.6f}", per)
-        Console().print(table)
+            table.add_row(term.replace("_", "–"), f"{e:.6e}", f"{bp['cm-1'][term]:.6f}")
+            for c, v in bp["classes"].get(term, {}).items():
+                table.add_row(f"  {c}", f"{v:.6e}", f"{v * HARTREE_CM:.6f}")
+        show(table)
     if p["not_derived"]:
-        Console().print(f"not derived for {basis.family.name} functions: {', '.join(p['not_derived'])}"
+        print(f"not derived for {basis.family.name} functions: {', '.join(p['not_derived'])}"
                         + ("" if "breit_pauli" in p else " (so neither is the Breit–Pauli correction)"))
 
 
