@@ -124,3 +124,50 @@ def test_a_heavy_repelling_pair_keeps_the_direct_contact_density(capsys):
     assert main(["properties", str(ROOT / "examples" / "bases" / "h2-pecg" / "basis.json")]) == 0
     out = capsys.readouterr().out
     assert all(f"{p['delta_regularised'][c]:.10g}" in out for c in ("e-p", "e-e"))
+
+
+def raw_delta(rep, basis, C, monkeypatch) -> list[dict]:
+    """⟨δ³(r_ij)⟩ from its elements alone, whatever the symmetry says (`Operator.contact` off)."""
+    from dataclasses import replace
+
+    from prebo import expectation as module
+    with monkeypatch.context() as m:
+        m.setitem(module.OPERATORS, "delta", replace(module.OPERATORS["delta"], contact=False))
+        return expectation(rep, basis, C, "delta")
+
+
+@pytest.mark.parametrize("particles, spin", [(["alpha", "e", "e", "e"], {"e": 1.5}),
+                                             (["p", "p", "e", "e"], {"p": 1, "e": 1})])
+def test_a_contact_density_zero_by_symmetry_is_zero_and_its_elements_agree(particles, spin, monkeypatch):
+    """For random bases of states whose symmetry makes a pair class antisymmetric (`vanishing`), the
+    elements alone give ⟨δ³⟩ of that class at the rounding level (|value| < 1e-12 of the other
+    classes'), and the reported value is 0.0 exactly, as is Drachmann's."""
+    from conftest import random_basis
+    from prebo.expectation import vanishing
+
+    system = prebo.System(particles, spin=spin)
+    basis = random_basis(system, 12, np.random.default_rng(5))
+    rep, C, E = states(basis, 2)
+    zero = vanishing(system)
+    assert zero
+    for raw, reported, regularised in zip(raw_delta(rep, basis, C, monkeypatch), expectation(rep, basis, C, "delta"),
+                                          delta_regularised(rep, basis, C, E)):
+        scale = max(abs(v) for k, v in raw.items() if k not in zero)
+        for label in zero:
+            assert abs(raw[label]) < 1e-12 * scale, (label, raw[label], scale)
+            assert reported[label] == 0.0 and regularised.get(label, 0.0) == 0.0
+        assert all(reported[k] == raw[k] for k in raw if k not in zero)
+
+
+def test_the_triplet_contact_density_is_reported_as_zero(capsys):
+    """He 2³S (examples/bases/he-inf-2-3s): ⟨δ³(r_ee)⟩ printed −1.16e-15 and Drachmann's
+    −1.57e-8, seven orders larger; both are 0 (positive zero), as are the contact terms of the
+    Breit–Pauli correction they give, and the α-e values are untouched."""
+    import math
+    assert main(["properties", str(ROOT / "examples" / "bases" / "he-inf-2-3s" / "basis.json"), "--json"]) == 0
+    p = json.loads(capsys.readouterr().out)
+    assert p["expectation"]["delta"]["e-e"] == 0.0 and p["delta_regularised"]["e-e"] == 0.0
+    assert p["expectation"]["delta"]["He-e"] > 1.3 and p["delta_regularised"]["He-e"] > 1.3
+    for term in ("darwin", "spin_spin"):
+        v = p["breit_pauli"]["classes"][term]["e-e"]
+        assert v == 0.0 and math.copysign(1.0, v) == 1.0

@@ -103,3 +103,17 @@ def test_an_explicit_operator_is_kept_only_when_the_spin_state_does_not_give_it(
     assert back.symmetriser == row and back.symmetriser.young is None  # the label is not stored
     with pytest.raises(InputError, match="not identical"):
         prebo.System(["e", "alpha", "e", "e"], spin={"e": 0.5}, symmetriser=row)
+
+
+@pytest.mark.parametrize("particles, spin, zero", [
+    (["p", "e", "e"], {"e": 0}, []), (["p", "e", "e"], {"e": 1}, ["e-e"]),
+    (["alpha", "e", "e", "e"], {"e": 0.5}, []), (["alpha", "e", "e", "e"], {"e": 1.5}, ["e-e"]),
+    (["p", "p", "e", "e"], {"p": 1, "e": 0}, ["p-p"]), (["p", "p", "e", "e"], {"p": 0, "e": 1}, ["e-e"]),
+    (["d", "d", "e", "e"], {"d": 1, "e": 0}, ["d-d"]), (["d", "d", "e", "e"], {"d": 2, "e": 0}, []),
+    (["e", "e", "e+"], {"e": 0}, [])])
+def test_the_pairs_at_whose_coalescence_every_state_vanishes(particles, spin, zero):
+    """A pair class vanishes by symmetry when the operator makes each of its pairs antisymmetric
+    (P_ij O = O P_ij = −O): two identical fermions with symmetric spins (triplet, quartet), spin-1
+    bosons in S = 1; not the electron pairs of a doublet of three, whose operator mixes both."""
+    from prebo.expectation import vanishing
+    assert vanishing(prebo.System(particles, spin=spin)) == zero

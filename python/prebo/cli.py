@@ -483,6 +483,7 @@ def _print_properties(p: dict, basis) -> None:
     """`prebo properties`' tables (cmd_properties)."""
     from rich.table import Table
 
+    from .expectation import vanishing
     from .results import HARTREE_CM
 
     head = Table(show_header=False, box=None)
@@ -506,6 +507,10 @@ def _print_properties(p: dict, basis) -> None:
                 table.add_row("p4 (regularised)", *(f"{p['p4_regularised'][c]:.10g}" if c in p["p4_regularised"]
                                                     else "" for c in classes), "ħ⁴/bohr⁴")
             show(table)
+            zero = vanishing(basis.system) if acts_on == "pairs" else []
+            if zero and "delta" in names:
+                print(f"⟨δ³(r_ij)⟩ of {', '.join(zero)}: 0 by symmetry (the state changes sign when the two trade "
+                      "places, so it vanishes where they meet)")
     if "breit_pauli" in p:  # relativistic.py: each term, per class and summed
         bp = p["breit_pauli"]
         kind = ("regularised δ and p⁴ where Drachmann's forms serve (drachmann.py)" if bp["regularised"]

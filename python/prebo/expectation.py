@@ -62,6 +62,15 @@ def members(system, pairs: bool) -> dict[str, list[tuple[int, ...]]]:
     return out
 
 
+def vanishing(system) -> list[str]:
+    """The pair classes "a-b" of `system` at whose every coalescence r_i = r_j each of its states
+    vanishes: its symmetry operator makes each pair antisymmetric (`Symmetriser.antisymmetric`,
+    the electrons of a triplet). A contact operator's value there is zero exactly (`Operator.contact`)."""
+    symmetriser = system.symmetriser
+    return [label for label, ms in members(system, pairs=True).items()
+            if all(symmetriser.antisymmetric(i, j) for i, j in ms)]
+
+
 def classes(system, kinds: tuple[str, ...]) -> dict[str, np.ndarray]:
     """{label: vectors (instances, len(kinds), n)} of the `kinds` (see `vector`) per class of
     equivalent pairs if a kind names a pair ("r_ij", "p_j"), else per class of particles
@@ -88,12 +97,15 @@ class Operator:
 
     name: the core's operator name; unit: of its expectation value; meaning: one line for reports;
     vectors: the kinds of its vectors, in the core's order ("r_ij", "r_i", "p_i", "p_j": see
-    `vector`); an operator with an "r_ij" or "p_j" acts on pairs, otherwise on particles."""
+    `vector`); an operator with an "r_ij" or "p_j" acts on pairs, otherwise on particles; contact:
+    it measures Ψ at the pair's coalescence (δ³(r_ij)), so its value is zero, not a rounding of
+    zero, for a class where symmetry makes Ψ vanish there (`vanishing`)."""
 
     name: str
     unit: str
     meaning: str
     vectors: tuple[str, ...] = ("r_ij",)
+    contact: bool = False
 
     def __post_init__(self):
         if not isinstance(self.vectors, tuple) or not set(self.vectors) <= KINDS:
@@ -124,7 +136,8 @@ OPERATORS: dict[str, Operator] = {
     "inv_r": Operator("inv_r", "bohr⁻¹", "⟨1/r_ij⟩, the mean inverse distance of particles i and j"),
     "inv_r2": Operator("inv_r2", "bohr⁻²", "⟨1/r_ij²⟩, the mean inverse square distance of particles i and j"),
     "delta": Operator("delta", "bohr⁻³", "⟨δ³(r_ij)⟩, the density of particles i and j at one point "
-                                         "(direct: converges slowly in Gaussians, which lack the cusp)"),
+                                         "(direct: converges slowly in Gaussians, which lack the cusp)",
+                      contact=True),
     "p2": Operator("p2", "ħ²/bohr²", "⟨p_i²⟩, particle i's mean square momentum in the centre-of-mass frame",
                    ("p_i",)),
     "p4": Operator("p4", "ħ⁴/bohr⁴", "⟨p_i⁴⟩, the mass–velocity term's −Σ⟨p_i⁴⟩/(8m_i³c²) per particle i",
@@ -158,15 +171,17 @@ def expectation(rep, basis, C: np.ndarray, name: str) -> list[dict[str, float]]:
 
     rep: the representation (integrals.laboratory or translationally_invariant) whose matrices gave
     C; basis: a prebo.Basis. Returns, per column, {pair class "a-b": the class average, in the
-    operator's unit}."""
+    operator's unit}; a contact operator's is 0.0 for a class where the state vanishes by symmetry
+    (`vanishing`), where its elements would give a rounding error of either sign."""
     op = operator(name, basis.family)
     classes = op.classes(basis.system)
+    zero = vanishing(basis.system) if op.contact else []
     O = rep.operator(op.name, basis, np.concatenate(list(classes.values())), op.momenta)
     states = []
     for c in C.T:
         values, k = {}, 0
         for label, w in classes.items():
-            values[label] = float(np.mean([c @ O[k + m] @ c for m in range(len(w))]))
+            values[label] = 0.0 if label in zero else float(np.mean([c @ O[k + m] @ c for m in range(len(w))]))
             k += len(w)
         states.append(values)
     return states

@@ -69,6 +69,8 @@ def terms(system, expectation: dict, delta: dict | None = None, p4: dict | None 
         classes["orbit_orbit"][label] = -a2 / 2 * pairs * qq / (a.mass * b.mass) * expectation["orbit_orbit"][label]
         if a.name == b.name and dirac(a):
             classes["spin_spin"][label] = 2 * math.pi * a2 * pairs * qq / a.mass**2 * delta[label]
+    # a negative factor times a contact density zero by symmetry (expectation.vanishing) is −0.0: give +0.0
+    classes = {term: {k: v + 0.0 for k, v in per.items()} for term, per in classes.items()}
     eh = {term: math.fsum(classes[term].values()) for term in TERMS}
     eh["total"] = math.fsum(eh.values())
     return {"Eh": eh, "cm-1": {k: v * HARTREE_CM for k, v in eh.items()}, "classes": classes, "alpha": ALPHA}

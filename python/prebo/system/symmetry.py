@@ -221,6 +221,17 @@ class Symmetriser:
             return False
         return all(abs(a.get(p, 0.0) / a[identity] - b.get(p, 0.0) / b[identity]) <= tol for p in set(a) | set(b))
 
+    def antisymmetric(self, i: int, j: int) -> bool:
+        """Whether every function the operator O makes changes sign when particles i and j trade
+        places, P_ij O = O P_ij = −O (coefficients within ROUNDING of the identity's): then every
+        state Ψ = Σ_k c_k O φ_k vanishes where r_i = r_j — two identical fermions whose spins are
+        symmetric, like the electrons of a triplet — and its ⟨δ³(r_ij)⟩ is zero exactly."""
+        n = len(self.permutations[0])
+        swap = tuple(j if k == i else i if k == j else k for k in range(n))
+        op = self.operator()
+        minus = {p: -c for p, c in op.items()}
+        return same(product({swap: 1.0}, op), minus, ROUNDING) and same(product(op, {swap: 1.0}), minus, ROUNDING)
+
     def check_projector(self, groups: list[Group]) -> None:
         """Refuse (SpinError) an operator O that is not a projector onto functions of the spin state
         of `groups`: O† = O (c_P = c_{P⁻¹}), O² ∝ O, and Z O ∝ O for Z the central idempotent of
