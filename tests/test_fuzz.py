@@ -7,6 +7,7 @@ import contextlib
 import json
 import os
 import signal
+import stat
 import subprocess
 import sys
 from pathlib import Path
@@ -14,7 +15,7 @@ from unittest import mock
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import prebo
@@ -23,6 +24,9 @@ from prebo.cli import main
 from prebo.errors import PreboError
 from prebo.optimise import SETTINGS
 from test_validation import h_input, toml_text
+
+ROOT = Path(__file__).resolve().parents[1]
+BASES = ROOT / "examples" / "bases"
 
 #: where the optimisation is looked up: the package (by cli) and its driver (by resume_from);
 #: sys.modules, because prebo.optimise is the function
@@ -381,3 +385,63 @@ def test_killed_run_started_anew_leaves_nothing_behind(tmp_path):
     (out / "basis.json").unlink()  # given up: start anew
     assert main(list(map(str, args))) == 0
     assert not list(out.glob("*.tmp"))
+
+
+# --- writers onto what is not a regular file -------------------------------------------------------
+def node(path: Path, kind: str) -> None:
+    """Make a FIFO, a character device (/dev/null's numbers, inside the test's folder), a socket or a
+    folder at `path`."""
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "device":
+        os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+    elif kind == "socket":
+        import socket
+        socket.socket(socket.AF_UNIX).bind(str(path))
+    else:
+        path.mkdir()
+
+
+WRITERS = {"export": lambda out: ["export", BASES / "he" / "basis.json", "--format", "ecgpack", "--out", out],
+           "import": lambda out: ["import", ROOT / "tests" / "data" / "ecgpack" / "ecgpack-Li7-100.inout.txt",
+                                  "--out", out],
+           "plot": lambda out: ["plot", BASES / "auto-h", "--out", out],
+           "densities": lambda out: ["plot", "--densities", BASES / "h" / "basis.json", "--points", 10, "--out", out],
+           "run": lambda out: ["run", BASES.parent / "h.toml", "--out", out, "--quiet"]}
+
+
+@FUZZ
+@given(writer=st.sampled_from(sorted(WRITERS)), kind=st.sampled_from(["fifo", "device", "socket", "folder"]),
+       where=st.sampled_from(["itself", "link", "link to a link", "inside"]), force=st.booleans(),
+       name=st.sampled_from(["basis.json", "result.json", "lowest.json"]))
+def test_writers_onto_devices_and_fifos(tmp_path_factory, capsys, writer, kind, where, force, name):
+    """Whatever writer, whatever is at its output's path (a FIFO, a device node, a socket, a folder;
+    reached through links or not) or at a file it writes beside it (a run's checkpoint or result,
+    the densities' table), with --force or without: one line, exit 2, and the node left as it was —
+    never replaced by a regular file (`prebo export --out /dev/full --force` did that). A run into
+    a folder, and a plot into one (its convergence.png), are what they are documented to be."""
+    assume(not (kind == "folder" and writer == "run" and where != "inside"))  # a run's folder: its normal case
+    d = tmp_path_factory.mktemp("writer")
+    out = d / ("out.png" if writer in ("plot", "densities") else "out")
+    if where == "inside" and writer == "run":
+        out.mkdir()
+        target = out / name
+    elif where == "inside" and writer == "densities":
+        target = out.with_suffix(".csv")
+    else:
+        target = out if where in ("itself", "inside") else d / "node"
+    try:
+        node(target, kind)
+    except PermissionError:
+        pytest.skip("mknod needs privileges this machine does not give")
+    if where.startswith("link"):
+        (d / "link").symlink_to(target)
+        out.symlink_to(d / "link" if where == "link to a link" else target)
+    mode = os.lstat(target).st_mode
+    status = main(list(map(str, WRITERS[writer](out) + ["--force"] * force)))
+    err = capsys.readouterr().err
+    if writer == "plot" and kind == "folder":
+        assert status == 0 and (target / "convergence.png").is_file()
+    else:
+        assert status == 2 and err.startswith("prebo: error: ") and err.count("\n") == 1, (status, err)
+    assert os.lstat(target).st_mode == mode and not list(d.rglob("*.tmp"))
