@@ -35,4 +35,4 @@ __all__ = [
     # basis, solving, results
     "Basis", "Optimiser", "optimise", "evaluate", "properties", "densities", "PreboError",
 ]
-__version__ = "0.1.0"
+from .provenance import VERSION as __version__  # noqa: E402 (the package metadata's)

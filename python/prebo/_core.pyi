@@ -25,6 +25,9 @@ Matrices = dict[str, NDArray[np.float64]]
 MAX_DIM: int
 """Largest number of coordinates compiled (laboratory frame: particles)."""
 
+GIT_COMMIT: str
+"""The git commit the module was built from ("" outside a checkout; crates/prebo-py/build.rs)."""
+
 OPERATORS: dict[str, list[str]]
 """Per basis family ("pecg", "ecg-gvr", "fecg"), the names of the registered extra operators of
 `Engine.operator` it evaluates (the others are refused: not derived for that family)."""

@@ -211,6 +211,7 @@ def cmd_run(args) -> int:
     from .optimise import optimise, resume_from
     from .properties import corrections, reported
     from .optimise.checkpoint import CHECKPOINT, LOWEST
+    from .provenance import provenance
 
     t0 = time.perf_counter()
     if args.resume is not None and (args.input is not None or args.out is not None or args.force):
@@ -254,7 +255,7 @@ def cmd_run(args) -> int:
         if levels is not None:
             r["targets"] = levels
         r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
-              "convergence": basis.convergence}
+              "convergence": basis.convergence, "provenance": provenance()}
         if root:
             write_json_atomic(out / RESULT, r)
     if not root:
@@ -590,7 +591,11 @@ def positive_integer(text: str) -> int:
 
 def parser() -> argparse.ArgumentParser:
     """The `prebo` argument parser with its five subcommands."""
+    from .provenance import VERSION, commit
+
     p = Parser(prog="prebo", description="pre-Born–Oppenheimer ECG solver")
+    p.add_argument("--version", action="version",
+                   version=f"prebo {VERSION}" + (f" (commit {commit()})" if commit() else ""))
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="optimise a basis for the system of a TOML input")
     run.add_argument("input", nargs="?", help="TOML input file")

@@ -270,6 +270,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(inverse_iteration, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add("MAX_DIM", prebo_core::ecg::MAX_DIM)?;
+    m.add("GIT_COMMIT", env!("PREBO_GIT_COMMIT"))?;
     let operators = PyDict::new(m.py());
     for kind in [Kind::Pecg, Kind::EcgGvr, Kind::Fecg] {
         operators.set_item(kind.name(), kind.operators())?;

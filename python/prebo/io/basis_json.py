@@ -26,6 +26,7 @@ from ..basis.families import FAMILIES, family
 from ..basis.family import Family
 from ..coordinates import by_name
 from ..errors import BasisFileError, InputError, PreboError
+from ..provenance import provenance
 from ..system import System
 from ..validation import MAX_SIZE, number
 from .files import write_json_atomic
@@ -41,7 +42,7 @@ CONVENTIONS = {
 #: the keys of a basis file: the basis, then the energy, the settings and a run's state (prebo.optimise.resume)
 KEYS = ("format", "version", "conventions", "system", "symmetry", "basis_type", "functions", "coefficients",
         "energy", "objective", "optimiser", "progress", "rng", "history", "elapsed", "schedule", "stopped", "momentum",
-        "levels", "followed")
+        "levels", "followed", "provenance")
 #: every function's arrays beside its family's extras (name -> shape, "n": particles); and a channel
 COMMON = {"A": ("n", "n"), "c_A": ()}
 #: bytes allowed per function (twice a checkpoint's two copies of a function of 8 particles) and
@@ -69,7 +70,7 @@ def to_dict(basis, extra: dict | None = None) -> dict:
         d["coefficients"] = np.asarray(basis.coefficients).tolist()
     if extra:
         d.update(extra)
-    return d
+    return d | {"provenance": provenance()}
 
 
 def _function_dict(basis, i: int) -> dict:
@@ -115,6 +116,8 @@ def arguments(d: dict, where: str) -> dict:
         if coef is not None and not _holds(coef, (len(funcs),), False):
             raise BasisFileError(f"coefficients must be {len(funcs)} numbers, one per function, or null")
         check_settings(d.get("optimiser"))
+        if not isinstance(d.get("provenance", {}), dict):
+            raise BasisFileError(f"provenance = {reprlib.repr(d['provenance'])}: must be an object (what wrote the file)")
         for key in ("energy", "objective"):
             if d.get(key) is not None:
                 number(d[key], key)
