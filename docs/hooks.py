@@ -105,7 +105,7 @@ def cli_reference() -> str:
         for action in sub._actions:
             if isinstance(action, argparse._HelpAction):
                 continue
-            lines.append(f"| {escape(formatter._format_action_invocation(action))} "
+            lines.append(f"| `{formatter._format_action_invocation(action)}` "
                          f"| {escape(formatter._expand_help(action) if action.help else '')} |")
         lines.append("")
     return "\n".join(lines)
