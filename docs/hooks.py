@@ -39,8 +39,8 @@ def site_path(path: str) -> str | None:
 
 
 def outside_targets(page: str, markdown: str):
-    """(match, repository path) of every link of the page `page` (a repository path) to a file
-    of the repository outside docs/ or to the README, code blocks left out."""
+    """(match, repository path) of every link of the page `page` (a repository path) that leaves
+    docs/ (from the README: every link), code blocks left out."""
     for part in FENCE.split(markdown)[::2]:
         for match in LINK.finditer(part):
             target = match[3].split("#")[0]
@@ -75,7 +75,7 @@ def on_page_markdown(markdown, page, config, files):
         anchor = target[len(target.split("#")[0]):]
         uri = site_path(path) or (f"{PICTURES}/{path}" if image else None)
         if uri is not None and files.get_file_from_path(uri) is not None:
-            return f"{image}[{text}]({posixpath.relpath(uri, posixpath.dirname(page.file.src_uri))}{anchor})"
+            return f"{image}[{text}]({posixpath.relpath(uri, posixpath.dirname(page.file.src_uri) or '.')}{anchor})"
         if not image and (ROOT / path).exists():
             return f"`{path}`" if text.strip("`") == target else f"{text} (`{path}`)"
         return match[0]
