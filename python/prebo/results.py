@@ -99,6 +99,9 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         radii = grids(basis.system, radii)
     basis = replace(basis)  # built again: the constructor's checks against the system it has now
     targets = basis.system.state.levels[0]
+    if roots is None and max(targets) >= len(basis):
+        raise InputError(f"state: targets levels {reprlib.repr(list(targets))}: level {max(targets)} is not one of "
+                         f"a basis of {len(basis)} functions (0..{len(basis) - 1})")
     roots = max(targets) + 1 if roots is None else roots
     roots = checked(Integer(1, len(basis)), roots, "evaluate: roots", f"levels of a basis of {len(basis)} functions")
     basis.validate()  # a Basis built in Python: symmetric, positive definite, CM-separable A

@@ -158,6 +158,10 @@ def check_functions(funcs, system: System, fam: Family) -> None:
                 what = ("an integer" if integer else "a number") if not dims else \
                     f"{' x '.join(map(str, dims))} {'integers' if integer else 'numbers'}"
                 raise BasisFileError(f"function {i}: {key} must be {what}, not {reprlib.repr(f[key])}")
+        for key in fam.integers:  # powers (K): within the family's limit before numpy holds them
+            if not 0 <= f[key] <= fam.K_limit:
+                raise BasisFileError(f"function {i}: {key} = {reprlib.repr(f[key])}: must be an integer in "
+                                     f"0..{fam.K_limit}")
         if not isinstance(f.get("channel", ""), str):
             raise BasisFileError(f"function {i}: channel must be a string, not {reprlib.repr(f['channel'])}")
     for name in {f["channel"] for f in funcs if "channel" in f}:
