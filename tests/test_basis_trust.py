@@ -194,6 +194,19 @@ def test_a_function_whose_integrals_overflow_is_refused_without_a_warning(tmp_pa
     assert f"{f}: the Hamiltonian matrix is not finite: H[0, 1] = inf" in cli_error(capsys, "energy", f)
 
 
+@pytest.mark.parametrize("old,new,words", [
+    ('"version": 1', '"version": true', "version = True: must be an integer (this prebo reads 1)"),
+    ('"version": 1', '"version": 1.0', "version = 1.0: must be an integer (this prebo reads 1)"),
+    ('"version": 1,', '"version": 2, "version": 1,', "key 'version' given twice in one object"),
+    ('"c_A": 1.0,', '"c_A": 1.0, "c_A": 2.0,', "key 'c_A' given twice in one object"),
+])
+def test_a_version_that_is_no_integer_and_keys_given_twice_are_refused(tmp_path, capsys, old, new, words):
+    """Issue 55, item 7: `"version": true` was read as 1; of a key given twice the last was kept."""
+    f = tmp_path / "basis.json"
+    f.write_text(HE.read_text().replace(old, new, 1))
+    assert cli_error(capsys, "energy", f) == f"prebo: error: {f}: {words}\n"
+
+
 def test_files_larger_than_the_bound_are_not_read(tmp_path, capsys, monkeypatch):
     """/dev/zero is refused after MAX_BYTES + 1 bytes (patched small here), not read until memory
     runs out; the bound holds a checkpoint of MAX_SIZE functions of the most particles."""

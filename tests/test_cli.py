@@ -271,3 +271,24 @@ def test_the_result_and_a_re_evaluation_use_the_threshold_of_the_run(tmp_path):
     full = json.loads(prebo("energy", out / "basis.json", "--threshold", "1e-13", "--json").stdout)
     assert full["kept"] == 400 and full["energy"] < again["energy"]
     assert_clean_error(prebo("energy", out / "basis.json", "--threshold", "0"), "--threshold")
+
+
+@pytest.mark.parametrize("argv,line", [
+    (["energy", "he.json", "--bogus"], "prebo: error: unrecognized arguments: --bogus (see prebo --help)"),
+    (["nosuch"], "prebo: error: argument command: invalid choice: 'nosuch' (choose from 'run', 'properties', "
+                 "'energy', 'import', 'export', 'plot') (see prebo --help)"),
+    (["run", "--budget", "0"], "prebo: error: run: argument --budget: '0' is not a number of seconds above 0 "
+                               "(see prebo run --help)"),
+    (["properties", "he.json", "--root", "x"], "prebo: error: properties: argument --root: 'x' is not an integer ≥ 0 "
+                                               "(see prebo properties --help)"),
+    (["energy"], "prebo: error: energy: the following arguments are required: basis (see prebo energy --help)"),
+    (["import"], "prebo: error: import: the following arguments are required: file (see prebo import --help)"),
+    (["export", "he.json"], "prebo: error: export: the following arguments are required: --format "
+                            "(see prebo export --help)"),
+    (["plot"], "prebo: error: plot: the following arguments are required: runs (see prebo plot --help)"),
+])
+def test_command_line_errors_name_the_program_once(argv, line):
+    """Issue 55, item 7: an unknown option printed `prebo: error: prebo: unrecognized arguments` (and a
+    subcommand's errors `prebo: error: prebo energy: ...`)."""
+    r = prebo(*argv)
+    assert r.returncode == 2 and r.stdout == "" and r.stderr == line + "\n", r.stderr

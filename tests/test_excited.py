@@ -86,6 +86,7 @@ def test_a_level_is_never_followed_below_its_target():
     ({"roots": [1, 1]}, "state: roots = [1, 1]: must be distinct eigenvalue indices"),
     ({"roots": 0}, "state: roots = 0: must be an integer in 1.."),
     ({"roots": [0, 2], "weights": [1.0]}, "state: weights = [1.0]: 1 number for 2 roots"),
+    ({"weights": [1.0, 0.5]}, "state: weights = [1.0, 0.5] without roots: weights weigh the levels roots names"),
     ({"roots": 2, "weights": [1.0, 0.0]}, "state: weights = 0.0: must be a finite number"),
     ({"root": 1, "roots": 2}, "state: root = 1 and roots = 2: give one of them"),
     ({"root": True}, "state: root = True: must be an integer"),

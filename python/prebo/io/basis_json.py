@@ -93,9 +93,11 @@ def arguments(d: dict, where: str) -> dict:
     anything wrong in the file (module docstring). A run's state is checked by prebo.optimise.resume."""
     if not isinstance(d, dict) or d.get("format") != FORMAT:
         raise BasisFileError(f"{where}: not a prebo basis file (format must be {FORMAT!r})")
-    if d.get("version") != VERSION:
-        raise BasisFileError(f"{where}: unsupported version {reprlib.repr(d.get('version'))} "
-                             f"(this prebo reads {VERSION})")
+    version = d.get("version")
+    if not isinstance(version, int) or isinstance(version, bool):
+        raise BasisFileError(f"{where}: version = {reprlib.repr(version)}: must be an integer (this prebo reads {VERSION})")
+    if version != VERSION:
+        raise BasisFileError(f"{where}: unsupported version {reprlib.repr(version)} (this prebo reads {VERSION})")
     unknown = [k for k in d if k not in KEYS]
     if unknown:
         raise BasisFileError(f"{where}: unknown keys {reprlib.repr(unknown)} (a basis file holds {', '.join(KEYS)})")
@@ -202,11 +204,11 @@ def read(path):
     """The parsed content of basis.json file `path` (not yet checked: `arguments`, `Basis.from_dict`); BasisFileError
     naming the file when it is unreadable, larger than MAX_BYTES, not JSON, or holds an integer
     of more than MAX_DIGITS digits, a number beyond the largest double, NaN or Infinity (naming
-    the line), or more than MAX_DEPTH levels of nesting."""
+    the line), a key twice in one object, or more than MAX_DEPTH levels of nesting."""
     path = Path(path)
     text = read_text(path, BasisFileError)
     try:
-        d = json.loads(text, parse_int=_integer, parse_float=_real, parse_constant=_constant)
+        d = json.loads(text, parse_int=_integer, parse_float=_real, parse_constant=_constant, object_pairs_hook=_unique)
     except json.JSONDecodeError as exc:
         raise BasisFileError(f"{path}: corrupt or truncated JSON (line {exc.lineno}: {exc.msg})") from exc
     except RecursionError:  # deeper than Python's recursion limit
@@ -251,6 +253,15 @@ def _real(text: str) -> float:
 def _constant(text: str):
     """NaN, Infinity and -Infinity: refused (JSON has no such numbers; prebo never writes them)."""
     raise _Refused(f"{text}: not a finite number", text)
+
+
+def _unique(pairs: list) -> dict:
+    """A JSON object whose keys are distinct (JSON would keep the last of a key given twice)."""
+    d = dict(pairs)
+    if len(d) < len(pairs):
+        key = next(k for i, (k, _) in enumerate(pairs) if k in dict(pairs[:i]))
+        raise _Refused(f"key {reprlib.repr(key)} given twice in one object")
+    return d
 
 
 def nested(obj, where: str, error: type[PreboError]) -> None:

@@ -87,6 +87,9 @@ class State:
             count = checked(Integer(1, MAX_SIZE), self.roots, "state: roots",
                             "how many of the lowest levels, or a list of eigenvalue indices")
             roots = list(range(count))
+        if self.weights is not None and self.roots is None:
+            raise InputError(f"state: weights = {self.weights!r} without roots: weights weigh the levels roots "
+                             "names (e.g. roots = [0, 1], weights = [1, 0.5])")
         if self.weights is None:
             weights = [1.0] * len(roots)
         elif not isinstance(self.weights, (list, tuple)):
