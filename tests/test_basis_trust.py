@@ -136,7 +136,7 @@ def set_function(key, value, i=3):
     (HE, lambda d: d["system"].update(title="He"), "system: unknown keys ['title']"),
     (HE, lambda d: d.update(coefficients=["1.0"] * 150), "coefficients must be 150 numbers"),
     (HE, lambda d: d.update(energy="-2.9"), "energy = '-2.9': must be a finite number"),
-    (HE, lambda d: d.update(optimiser={"threshold": math.nan}), "optimiser threshold = nan"),
+    (HE, lambda d: d.update(optimiser={"threshold": 2.0}), "optimiser threshold = 2.0"),
     (HE, lambda d: d.update(optimiser={"threshold": 5.0}), "optimiser threshold = 5.0"),
     (HE, lambda d: d.update(optimiser={"thresold": 1e-10}), "optimiser: unknown setting 'thresold'"),
     (HE, lambda d: d["conventions"].update(gaussian="exp(-r^T A r / 2)"), "conventions = "),
@@ -165,11 +165,46 @@ def test_deep_nesting_and_long_integers_are_refused_in_one_line(tmp_path, capsys
     assert "nested more than 16 levels deep" in cli_error(capsys, "energy", shallow)
     digits = tmp_path / "digits.json"
     digits.write_text(HE.read_text().replace('"version": 1', '"version": 1' + "0" * 5000, 1))
-    assert f"{digits}: an integer of 5001 digits (at most 100 are read)" in cli_error(capsys, "energy", digits)
+    assert f"{digits}:3: an integer of 5001 digits (at most 100 are read)" in cli_error(capsys, "energy", digits)
     toml = tmp_path / "in.toml"
     for text in ["a = " + "[" * 100_000 + "]" * 100_000, "[basis]\nsize = " + "1" * 5000]:
         toml.write_text(text)
         assert str(toml) in cli_error(capsys, "run", toml, "--out", tmp_path / "out", "--quiet")
+
+
+@pytest.mark.filterwarnings("error")  # no RuntimeWarning before the error
+@pytest.mark.parametrize("number", ["1e400", "-2e308", "NaN", "-Infinity"])
+def test_numbers_no_double_holds_are_refused_naming_the_line(tmp_path, capsys, number):
+    """Issue 55, item 2: 1e400 read as inf, refused later as `Basis: A[2, 0, 0] = inf` without its line."""
+    f = tmp_path / "basis.json"
+    text = HE.read_text()
+    f.write_text(text.replace('"c_A": 1.0', f'"c_A": {number}', 1))
+    line = text[:text.index('"c_A": 1.0')].count("\n") + 1
+    assert cli_error(capsys, "energy", f).startswith(f"prebo: error: {f}:{line}: {number}: ")
+
+
+@pytest.mark.filterwarnings("error")
+def test_a_function_whose_integrals_overflow_is_refused_without_a_warning(tmp_path, capsys):
+    """Issue 55, item 2: floating ECGs scaled by 1e301 printed `RuntimeWarning: invalid value encountered
+    in add` (T + V) before the Hamiltonian's error."""
+    def scale(d):
+        f = d["functions"][1]
+        f["A"], f["c_A"] = [[a * 1e301 for a in row] for row in f["A"]], f["c_A"] * 1e301
+    f = edited(tmp_path, FECG, scale)
+    assert f"{f}: the Hamiltonian matrix is not finite: H[0, 1] = inf" in cli_error(capsys, "energy", f)
+
+
+@pytest.mark.parametrize("old,new,words", [
+    ('"version": 1', '"version": true', "version = True: must be an integer (this prebo reads 1)"),
+    ('"version": 1', '"version": 1.0', "version = 1.0: must be an integer (this prebo reads 1)"),
+    ('"version": 1,', '"version": 2, "version": 1,', "key 'version' given twice in one object"),
+    ('"c_A": 1.0,', '"c_A": 1.0, "c_A": 2.0,', "key 'c_A' given twice in one object"),
+])
+def test_a_version_that_is_no_integer_and_keys_given_twice_are_refused(tmp_path, capsys, old, new, words):
+    """Issue 55, item 7: `"version": true` was read as 1; of a key given twice the last was kept."""
+    f = tmp_path / "basis.json"
+    f.write_text(HE.read_text().replace(old, new, 1))
+    assert cli_error(capsys, "energy", f) == f"prebo: error: {f}: {words}\n"
 
 
 def test_files_larger_than_the_bound_are_not_read(tmp_path, capsys, monkeypatch):

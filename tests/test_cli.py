@@ -316,3 +316,24 @@ def test_no_printed_number_is_cut_short(run_dir, columns):
     text = printed("energy", run_dir / "basis.json", columns=columns)
     result = json.loads((run_dir / "result.json").read_text())
     assert "…" not in text and f"{result['energy']:.12f}" in text and f"{result['energy_lab']:.12f}" in text
+
+
+@pytest.mark.parametrize("argv,line", [
+    (["energy", "he.json", "--bogus"], "prebo: error: unrecognized arguments: --bogus (see prebo --help)"),
+    (["nosuch"], "prebo: error: argument command: invalid choice: 'nosuch' (choose from 'run', 'properties', "
+                 "'energy', 'import', 'export', 'plot') (see prebo --help)"),
+    (["run", "--budget", "0"], "prebo: error: run: argument --budget: '0' is not a number of seconds above 0 "
+                               "(see prebo run --help)"),
+    (["properties", "he.json", "--root", "x"], "prebo: error: properties: argument --root: 'x' is not an integer ≥ 0 "
+                                               "(see prebo properties --help)"),
+    (["energy"], "prebo: error: energy: the following arguments are required: basis (see prebo energy --help)"),
+    (["import"], "prebo: error: import: the following arguments are required: file (see prebo import --help)"),
+    (["export", "he.json"], "prebo: error: export: the following arguments are required: --format "
+                            "(see prebo export --help)"),
+    (["plot"], "prebo: error: plot: the following arguments are required: runs (see prebo plot --help)"),
+])
+def test_command_line_errors_name_the_program_once(argv, line):
+    """Issue 55, item 7: an unknown option printed `prebo: error: prebo: unrecognized arguments` (and a
+    subcommand's errors `prebo: error: prebo energy: ...`)."""
+    r = prebo(*argv)
+    assert r.returncode == 2 and r.stdout == "" and r.stderr == line + "\n", r.stderr

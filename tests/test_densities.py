@@ -9,7 +9,7 @@ import pytest
 
 import prebo
 from prebo.cli import main
-from prebo.errors import InputError
+from prebo.errors import InputError, NonFiniteError
 from prebo import eigen
 from prebo.expectation import densities
 from prebo.integrals import laboratory, translationally_invariant
@@ -17,6 +17,7 @@ from prebo.results import grids
 from prebo.properties import rms
 
 from conftest import ROOT, hydrogen_s
+from test_validation import cli_error
 
 BASES = ROOT / "examples" / "bases"
 
@@ -103,6 +104,19 @@ def test_bad_grids_and_roots_are_refused_in_one_line():
     for bad in ([0, 0], [-1], [len(basis)], []):
         with pytest.raises(InputError, match="roots"):
             prebo.densities(basis, roots=bad, r=[1.0])
+
+
+@pytest.mark.filterwarnings("error")  # no RuntimeWarning before the error
+def test_a_grid_reaching_where_r_squared_overflows_is_refused_naming_the_radius(tmp_path, capsys):
+    """Issue 55, item 2: `--rmax 1e300` printed `RuntimeWarning: overflow encountered in square` before
+    its error; the core's densities are not finite where r² overflows against the exponents."""
+    basis = BASES / "he" / "basis.json"
+    err = cli_error(capsys, "plot", "--densities", basis, "--rmax", "1e300", "--out", tmp_path / "he.png")
+    assert err == (f"prebo: error: {basis}: densities: P(r) of alpha-e (root 0) is not finite from r = 2.51e+297 "
+                   "bohr on: r² overflows against the basis's exponents there: end the grid nearer\n")
+    with pytest.raises(NonFiniteError, match="alpha-e .* not finite from r = 1e\\+300 bohr on"):
+        prebo.densities(prebo.Basis.load(basis), r=[0.0, 1.0, 1e300])
+    assert not (tmp_path / "he.png").exists()
 
 
 def test_prebo_plot_densities_writes_the_picture_and_its_table(tmp_path, capsys):

@@ -221,6 +221,18 @@ def test_malformed_files_name_the_line(tmp_path, old, new, line, words):
         assert w in msg, msg
 
 
+@pytest.mark.filterwarnings("error")  # no RuntimeWarning before the error
+@pytest.mark.parametrize("value", ["1.0E+301", "-1.0D+308", "1.0E+155"])
+def test_an_exponent_that_overflows_is_refused_naming_its_line_and_value(tmp_path, value):
+    """Issue 55, item 2: 1.0E+301 printed RuntimeWarning lines and then `Basis: A[6, 0, 0] = inf: must be
+    a finite number`, naming neither the file nor the line."""
+    p = _edit(tmp_path, "      7  0.5631628846634819E+00", f"      7  {value}")
+    with pytest.raises(BasisFileError) as exc:
+        ecgpack.read_inout(p)
+    assert str(exc.value) == (f"{p}:640: basis function 7: {value!r} overflows: L Lᵀ exceeds the largest double "
+                              "(1.8e+308)")
+
+
 def test_which_eigenvalue_is_the_level_the_state_targets(tmp_path):
     """WHICH_EIGENVALUE k: the basis was optimised for root k − 1, which the imported state targets
     (its evaluation reports the levels up to it); the export writes it back, with CURRENT_ENERGY that

@@ -5,11 +5,14 @@ or a hang. Derandomised, so CI sees the same examples; the CLI runs in-process. 
 run real processes: a closed output pipe, and a kill during a checkpoint write."""
 import contextlib
 import json
+import math
 import os
+import shutil
 import signal
 import stat
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 from unittest import mock
 
@@ -19,6 +22,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import prebo
+import prebo.io.ecgpack
 from prebo.basis import FAMILIES
 from prebo.cli import main
 from prebo.errors import PreboError
@@ -142,6 +146,66 @@ def test_basis_files_relabelled_to_another_state_or_type(checkpoints, tmp_path, 
 #: small stored bases whose states have one-dimensional symmetry (every operator of such a state is
 #: its own up to a factor): an edited one that is taken must give exactly the energy of its label
 LABELLED = ["he", "h2plus-gvr", "h2plus-fecg", "h2-pecg"]
+
+
+#: numbers at and beyond the edges of double precision, as a file may hold them
+EDGE_NUMBERS = st.sampled_from(["1e300", "1.0E+301", "-1e308", "1.7976931348623157e308", "1e154", "-1e154", "1e-300",
+                                "1e-320", "1e400", "-2.5e308"])
+PLACE = '"@number@"'
+
+
+def number_in_basis_json(doc: dict, data) -> str:
+    """The text of basis file `doc` with one edge number put where a file holds numbers: a
+    function's A and c_A scaled by it (as a whole: still symmetric and separable), or one of its
+    u or s, or one coefficient."""
+    doc = json.loads(json.dumps(doc))
+    f = data.draw(st.sampled_from(doc["functions"]))
+    where = data.draw(st.sampled_from(["scale"] + [k for k in ("u", "s") if k in f]
+                                      + (["coefficients"] if doc.get("coefficients") else [])))
+    x = data.draw(EDGE_NUMBERS)
+    if where == "scale":  # a product beyond the largest double (or 1e400 itself) written as the number's text
+        def scaled(a):
+            return a * float(x) if math.isfinite(a * float(x)) else PLACE
+        f["A"], f["c_A"] = [[scaled(a) for a in row] for row in f["A"]], scaled(f["c_A"])
+    elif where == "coefficients":
+        doc["coefficients"][data.draw(st.integers(0, len(doc["coefficients"]) - 1))] = PLACE
+    else:
+        row = f[where] if not isinstance(f[where][0], list) else data.draw(st.sampled_from(f[where]))
+        row[data.draw(st.integers(0, len(row) - 1))] = PLACE
+    return json.dumps(doc, allow_nan=False).replace(json.dumps(PLACE), x)
+
+
+@pytest.fixture(scope="module")
+def inout(tmp_path_factory, checkpoints):
+    """The pecg checkpoint as an ecgpack file's lines."""
+    path = tmp_path_factory.mktemp("inout") / "pecg.inout.txt"
+    prebo.io.ecgpack.write_inout(prebo.Basis.from_dict(checkpoints["pecg"]), path)
+    return path.read_text().splitlines()
+
+
+@FUZZ
+@given(data=st.data())
+def test_numbers_at_the_edge_of_double_precision_in_files(checkpoints, inout, tmp_path, capsys, data):
+    """Issue 55, item 2: a number at or beyond the largest double in a basis.json's exponents,
+    coefficients, u or s, or in an ecgpack basis line: a finite result or one line naming the file,
+    and no numpy warning ahead of either (warnings are errors here)."""
+    if data.draw(st.booleans()):
+        f = tmp_path / "basis.json"
+        f.write_text(number_in_basis_json(checkpoints[data.draw(st.sampled_from(sorted(checkpoints)))], data))
+    else:
+        f = tmp_path / "edge.inout.txt"
+        lines = list(inout)
+        k = data.draw(st.integers(len(lines) - 3, len(lines) - 1))
+        values = lines[k].split()
+        values[data.draw(st.integers(1, len(values) - 1))] = data.draw(EDGE_NUMBERS)
+        lines[k] = " ".join(values)
+        f.write_text("\n".join(lines) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rc = main(["energy", str(f), "--json"])
+    out, err = capsys.readouterr()
+    assert_clean(rc, out, err)
+    assert rc == 0 or err.startswith(f"prebo: error: {f}"), err
 
 
 @pytest.fixture(scope="module")
@@ -445,3 +509,23 @@ def test_writers_onto_devices_and_fifos(tmp_path_factory, capsys, writer, kind, 
     else:
         assert status == 2 and err.startswith("prebo: error: ") and err.count("\n") == 1, (status, err)
     assert os.lstat(target).st_mode == mode and not list(d.rglob("*.tmp"))
+
+
+@pytest.mark.parametrize("text,words", [
+    ('[system]\nparticles = ["p", "zz"]\n', "unknown particle 'zz'"),
+    ('[system]\nparticles = ["p", "e"]\n[state]\nweights = [1, 2]\n', "weights = [1, 2] without roots"),
+    ('[system]\nparticles = ["p", "e"]\n[basis]\nsize = 0\n', "size"),
+    ('[system\nparticles = ["p", "e"]\n', "line 1"),
+])
+def test_a_bad_input_under_two_ranks_prints_one_line(tmp_path, text, words):
+    """Issue 55, item 3: under `mpiexec -n 2` a bad input's line was followed by MPICH's `Abort(2) on
+    node 0 ...`; now exactly the one line, exit status 2."""
+    pytest.importorskip("mpi4py")
+    mpiexec = shutil.which("mpiexec") or pytest.skip("no mpiexec on the PATH")
+    (tmp_path / "bad.toml").write_text(text)
+    r = subprocess.run([mpiexec, "-n", "2", sys.executable, "-m", "prebo", "run", tmp_path / "bad.toml", "--out",
+                        tmp_path / "out", "--quiet"], capture_output=True, text=True, timeout=120,
+                       env=os.environ | {"RAYON_NUM_THREADS": "1"})
+    assert r.returncode == 2 and r.stdout == "", r
+    assert r.stderr.startswith(f"prebo: error: {tmp_path / 'bad.toml'}") and r.stderr.count("\n") == 1, r.stderr
+    assert words in r.stderr, r.stderr

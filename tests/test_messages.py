@@ -235,3 +235,36 @@ def test_an_angular_momentum_beyond_the_core_is_refused():
     with pytest.raises(InputError, match=r"state: N = 1180591620717411303424: must be an integer in 0\.\.1000"):
         prebo.State(N=2**70, parity=1)
     assert prebo.State(N=np.int64(1000)).N == 1000
+
+
+# --- issue 55, item 3: an error names what was read -------------------------------------------
+def test_a_power_beyond_its_limit_is_named_with_its_function_and_value(tmp_path, capsys):
+    """`K = 10**50` was "Basis: K = an array of shape (180,): must be one number per function"."""
+    d = json.loads((BASES / "h2plus-gvr" / "basis.json").read_text())
+    d["functions"][3]["K"] = 10**50
+    (tmp_path / "b.json").write_text(json.dumps(d))
+    err = cli_error(capsys, "energy", tmp_path / "b.json")
+    assert err == (f"prebo: error: {tmp_path / 'b.json'}: function 3: K = 100000000000000000...0000000000000000000: "
+                   "must be an integer in 0..60\n")
+
+
+def test_targeted_levels_beyond_the_basis_are_named_as_the_file_gives_them(tmp_path, capsys):
+    """`roots = [0, 500]` in a basis of 150 functions was "evaluate: roots = 501", a number not in the file."""
+    d = json.loads((BASES / "he" / "basis.json").read_text())
+    d["system"]["state"]["roots"] = [0, 500]
+    (tmp_path / "b.json").write_text(json.dumps(d))
+    err = cli_error(capsys, "energy", tmp_path / "b.json")
+    assert err == (f"prebo: error: {tmp_path / 'b.json'}: state: targets levels [0, 500]: level 500 is not one of a "
+                   "basis of 150 functions (0..149)\n")
+
+
+@pytest.mark.parametrize("roots,weights,words", [
+    ([0, 2], [1, 0.5, 2], "state: weights = [1, 0.5, 2]: 3 numbers for 2 roots"),
+    (3, [1.0], "state: weights = [1.0]: 1 number for 3 roots"),
+    ([1, 3], 0.5, "state: weights = 0.5: must be a list of positive numbers, one per root"),
+])
+def test_weights_of_another_length_say_how_many_for_how_many_roots(capsys, tmp_path, roots, weights, words):
+    """A wrong length of weights was "must be 1 positive numbers, one per root"."""
+    doc = h_input()
+    doc["state"] = {"roots": roots, "weights": weights}
+    refused_run(capsys, tmp_path, doc, words)

@@ -58,6 +58,7 @@ def test_a_bad_input_under_two_ranks_is_reported_once_with_exit_status_2(tmp_pat
     p = prebo_run(2, tmp_path / "bad.toml", "--out", tmp_path / "out")
     _, err = p.communicate(timeout=60)
     assert p.returncode == 2 and err.count("prebo: error:") == 1 and "unknown particle 'zz'" in err
+    assert err.count("\n") == 1, err  # not followed by MPICH's "Abort(2) on node 0 ..." (issue 55, item 3)
 
 
 def test_ranks_whose_copies_differ_stop_with_an_error_naming_it():

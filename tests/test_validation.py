@@ -272,7 +272,7 @@ def test_unknown_option_values_give_one_line(capsys):
         main(["energy", "x.json", "--coordinates", "polar"])
     out, err = capsys.readouterr()
     assert stop.value.code == 2 and out == "" and err.count("\n") == 1
-    assert err.startswith("prebo: error: prebo energy: argument --coordinates: invalid choice: 'polar'")
+    assert err.startswith("prebo: error: energy: argument --coordinates: invalid choice: 'polar'")
 
 
 # --- 6: messages that say what is wrong ---------------------------------------------------

@@ -531,8 +531,9 @@ class Parser(argparse.ArgumentParser):
     """argparse with the one-line errors of every other failure (exit 2)."""
 
     def error(self, message):
-        """Exit 2 with one line naming the subcommand and its --help."""
-        self.exit(2, f"prebo: error: {self.prog}: {message} (see {self.prog} --help)\n")
+        """Exit 2 with one line naming the subcommand (if any) and its --help."""
+        command = self.prog.removeprefix("prebo").strip()
+        self.exit(2, f"prebo: error: {command + ': ' if command else ''}{message} (see {self.prog} --help)\n")
 
 
 def finite(text: str) -> float:

@@ -221,7 +221,8 @@ def stop_all(status: int, report: str | None = None) -> int:
     collective call for ever. A failure every rank meets (a bad input) is reported once: rank 0
     reports at once and stops every rank FORWARD seconds later (the launcher forwards the report
     meanwhile), another rank reports only after twice that, when a rank 0 that failed too has
-    stopped it."""
+    stopped it. The standard error is then pointed at /dev/null: the report is the one line, not
+    followed by the MPI library's own of the abort."""
     try:
         ranks = world()
     except UnsupportedError:  # no MPI to stop with: every rank ends by itself
@@ -233,6 +234,8 @@ def stop_all(status: int, report: str | None = None) -> int:
     if ranks.comm is not None:
         sys.stderr.flush()
         time.sleep(FORWARD)
+        null = os.open(os.devnull, os.O_WRONLY)  # MPI's own "Abort(...)" line: the report above says it
+        os.dup2(null, 2)
         ranks.comm.Abort(status)
     return status
 

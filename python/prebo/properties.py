@@ -22,7 +22,7 @@ import numpy as np
 
 from . import drachmann, eigen
 from .basis import Basis
-from .errors import InputError
+from .errors import InputError, NonFiniteError
 from .expectation import OPERATORS
 from .relativistic import NEEDS, terms
 from .results import evaluate, grids
@@ -102,8 +102,10 @@ def densities(basis, roots=(0,), r=None, points: int = POINTS, coordinates: str 
     Returns {"r": {"pairs": {"a-b": radii}, "particles": {"a": radii}}, "levels": [{"root",
     "energy", "pairs": {"a-b": P}, "particles": {"a": P}}]} with P(r) = 4πr²ρ̄(r) (bohr⁻¹; ∫P dr = 1
     over a grid that reaches far enough). InputError for roots that are not distinct non-negative
-    integers below the basis size, or radii that are empty or not finite distances ≥ 0; the errors
-    of `results.evaluate` otherwise."""
+    integers below the basis size, or radii that are empty or not finite distances ≥ 0;
+    NonFiniteError naming the class and the first radius where P is not finite (a grid that
+    reaches where r² overflows against the exponents, ~1e148 bohr for He); the errors of
+    `results.evaluate` otherwise."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"densities: basis = {basis!r}: must be a prebo.Basis with at least one function")
     roots = [roots] if not isinstance(roots, (list, tuple)) else list(roots)
@@ -121,9 +123,20 @@ def densities(basis, roots=(0,), r=None, points: int = POINTS, coordinates: str 
     radii = grids(basis.system, r)
     e = evaluate(basis, coordinates=coordinates, threshold=threshold, roots=max(roots) + 1, radii=radii)
     levels = e.get("levels", [e])
-    return {"r": radii, "levels": [{"root": k, "energy": levels[k]["energy"]} | {
-        group: {c: 4.0 * math.pi * radii[group][c] ** 2 * rho for c, rho in levels[k]["densities"][group].items()}
-        for group in radii} for k in roots]}
+    with np.errstate(over="ignore", invalid="ignore"):  # a value that is not finite is refused below
+        table = {"r": radii, "levels": [{"root": k, "energy": levels[k]["energy"]} | {
+            group: {c: 4.0 * math.pi * radii[group][c] ** 2 * rho for c, rho in levels[k]["densities"][group].items()}
+            for group in radii} for k in roots]}
+    for level in table["levels"]:
+        for group in radii:
+            for c, p in level[group].items():
+                if not np.all(np.isfinite(p)):
+                    far = radii[group][c][np.argmin(np.isfinite(p))]
+                    why = ("the basis's integrals overflow or lost their digits" if far == 0 else
+                           "r² overflows against the basis's exponents there: end the grid nearer")
+                    raise NonFiniteError(f"densities: P(r) of {c} (root {level['root']}) is not finite from "
+                                         f"r = {far:.3g} bohr on: {why}")
+    return table
 
 
 def rms(system, r2: dict) -> dict:

@@ -99,6 +99,9 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         radii = grids(basis.system, radii)
     basis = replace(basis)  # built again: the constructor's checks against the system it has now
     targets = basis.system.state.levels[0]
+    if roots is None and max(targets) >= len(basis):
+        raise InputError(f"state: targets levels {reprlib.repr(list(targets))}: level {max(targets)} is not one of "
+                         f"a basis of {len(basis)} functions (0..{len(basis) - 1})")
     roots = max(targets) + 1 if roots is None else roots
     roots = checked(Integer(1, len(basis)), roots, "evaluate: roots", f"levels of a basis of {len(basis)} functions")
     basis.validate()  # a Basis built in Python: symmetric, positive definite, CM-separable A
@@ -107,7 +110,9 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         rep = laboratory(system)
         m = rep.matrices(basis)
         rep.require_resolved(m)
-        lab = eigen.solve(m["T"] + m["V"], m["S"], threshold)
+        with np.errstate(over="ignore", invalid="ignore"):  # eigen.solve refuses an H that is not finite
+            H = m["T"] + m["V"]
+        lab = eigen.solve(H, m["S"], threshold)
         energy_lab = float(lab.energies[0])
     elif coordinates == "ti":
         c_A = require_shared_c_A(basis.c_A)
@@ -117,7 +122,9 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         energy_lab = None  # filled below: CM factor exp(-c_A X^2) common to all functions
     else:
         raise InputError(f"evaluate: coordinates = {coordinates!r}: must be 'lab' or 'ti'")
-    ti = eigen.solve(m["T_ti"] + m["V"], m["S"], threshold, roots)
+    with np.errstate(over="ignore", invalid="ignore"):
+        H = m["T_ti"] + m["V"]
+    ti = eigen.solve(H, m["S"], threshold, roots)
     low = lowest(system)
     n2 = None if basis.family.conserves_L else laboratory(system).operator("n2", basis, system.cm_vector[None])[0]
     values = {name: expectation(rep, basis, ti.vectors[:, :roots], name) for name in operators}

@@ -17,7 +17,10 @@ checked `arguments` and validates its functions; `to_dict` reads a basis through
 from __future__ import annotations
 
 import json
+import math
+import re
 import reprlib
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -91,9 +94,11 @@ def arguments(d: dict, where: str) -> dict:
     anything wrong in the file (module docstring). A run's state is checked by prebo.optimise.resume."""
     if not isinstance(d, dict) or d.get("format") != FORMAT:
         raise BasisFileError(f"{where}: not a prebo basis file (format must be {FORMAT!r})")
-    if d.get("version") != VERSION:
-        raise BasisFileError(f"{where}: unsupported version {reprlib.repr(d.get('version'))} "
-                             f"(this prebo reads {VERSION})")
+    version = d.get("version")
+    if not isinstance(version, int) or isinstance(version, bool):
+        raise BasisFileError(f"{where}: version = {reprlib.repr(version)}: must be an integer (this prebo reads {VERSION})")
+    if version != VERSION:
+        raise BasisFileError(f"{where}: unsupported version {reprlib.repr(version)} (this prebo reads {VERSION})")
     unknown = [k for k in d if k not in KEYS]
     if unknown:
         raise BasisFileError(f"{where}: unknown keys {reprlib.repr(unknown)} (a basis file holds {', '.join(KEYS)})")
@@ -158,6 +163,10 @@ def check_functions(funcs, system: System, fam: Family) -> None:
                 what = ("an integer" if integer else "a number") if not dims else \
                     f"{' x '.join(map(str, dims))} {'integers' if integer else 'numbers'}"
                 raise BasisFileError(f"function {i}: {key} must be {what}, not {reprlib.repr(f[key])}")
+        for key in fam.integers:  # powers (K): within the family's limit before numpy holds them
+            if not 0 <= f[key] <= fam.K_limit:
+                raise BasisFileError(f"function {i}: {key} = {reprlib.repr(f[key])}: must be an integer in "
+                                     f"0..{fam.K_limit}")
         if not isinstance(f.get("channel", ""), str):
             raise BasisFileError(f"function {i}: channel must be a string, not {reprlib.repr(f['channel'])}")
     for name in {f["channel"] for f in funcs if "channel" in f}:
@@ -197,26 +206,65 @@ def check_settings(block) -> None:
 def read(path):
     """The parsed content of basis.json file `path` (not yet checked: `arguments`, `Basis.from_dict`); BasisFileError
     naming the file when it is unreadable, larger than MAX_BYTES, not JSON, or holds an integer
-    of more than MAX_DIGITS digits or more than MAX_DEPTH levels of nesting."""
+    of more than MAX_DIGITS digits, a number beyond the largest double, NaN or Infinity (naming
+    the line), a key twice in one object, or more than MAX_DEPTH levels of nesting."""
     path = Path(path)
     text = read_text(path, BasisFileError)
     try:
-        d = json.loads(text, parse_int=_integer)
+        d = json.loads(text, parse_int=_integer, parse_float=_real, parse_constant=_constant, object_pairs_hook=_unique)
     except json.JSONDecodeError as exc:
         raise BasisFileError(f"{path}: corrupt or truncated JSON (line {exc.lineno}: {exc.msg})") from exc
     except RecursionError:  # deeper than Python's recursion limit
         raise BasisFileError(f"{path}: JSON {TOO_DEEP}") from None
-    except BasisFileError as exc:
-        raise BasisFileError(f"{path}: {exc}") from None
+    except _Refused as exc:
+        raise BasisFileError(f"{path}{_line(text, exc.token)}: {exc}") from None
     nested(d, f"{path}: JSON", BasisFileError)
     return d
+
+
+class _Refused(BasisFileError):
+    """A JSON token `read` does not take; `token`, its text, to find its line by."""
+
+    def __init__(self, message: str, token: str | None = None):
+        super().__init__(message)
+        self.token = token
+
+
+def _line(text: str, token: str | None) -> str:
+    """":LINE" of the first number or constant `token` in the JSON `text` (the first `read` parses), or ""."""
+    if token is None:
+        return ""
+    found = re.search(rf"(?<![\w.+-]){re.escape(token)}(?![\w.])", text)
+    return f":{text.count(chr(10), 0, found.start()) + 1}" if found else ""
 
 
 def _integer(text: str) -> int:
     """A JSON integer, if it has at most MAX_DIGITS digits (Python refuses 4300 with a ValueError)."""
     if len(text.lstrip("-")) > MAX_DIGITS:
-        raise BasisFileError(f"an integer of {len(text.lstrip('-'))} digits (at most {MAX_DIGITS} are read)")
+        raise _Refused(f"an integer of {len(text.lstrip('-'))} digits (at most {MAX_DIGITS} are read)", text)
     return int(text)
+
+
+def _real(text: str) -> float:
+    """A JSON number with a fraction or exponent, if a double holds it (1e400 is no number prebo computes with)."""
+    x = float(text)
+    if math.isinf(x):
+        raise _Refused(f"{text}: a number beyond the largest double ({sys.float_info.max:.3g})", text)
+    return x
+
+
+def _constant(text: str):
+    """NaN, Infinity and -Infinity: refused (JSON has no such numbers; prebo never writes them)."""
+    raise _Refused(f"{text}: not a finite number", text)
+
+
+def _unique(pairs: list) -> dict:
+    """A JSON object whose keys are distinct (JSON would keep the last of a key given twice)."""
+    d = dict(pairs)
+    if len(d) < len(pairs):
+        key = next(k for i, (k, _) in enumerate(pairs) if k in dict(pairs[:i]))
+        raise _Refused(f"key {reprlib.repr(key)} given twice in one object")
+    return d
 
 
 def nested(obj, where: str, error: type[PreboError]) -> None:

@@ -351,13 +351,22 @@ def _basis(f: InoutFile, c_A: float) -> Basis:
     c_A = check("c_A", c_A)
     system = _system(f)
     hpc = heavy_particle_centred(system.masses, 0)
-    A_int = f.exponents()
-    bad = [k for k, a in enumerate(A_int) if not _pd(a)]
-    if bad:
-        k = bad[0]
-        _fail(f.path, _basis_line(f, k), f"basis function {k + 1}: L Lᵀ is not positive definite "
-                                         "(a zero on the diagonal of L)")
-    A = np.array([_to_lab(hpc, a, c_A) for a in A_int]).reshape(len(A_int), system.n, system.n)
+    with np.errstate(over="ignore", invalid="ignore"):  # a function that overflows is refused below, by its line
+        A_int = f.exponents()
+        A = np.array([_to_lab(hpc, a, c_A) for a in A_int]).reshape(len(A_int), system.n, system.n)
+    for k in range(len(A)):
+        if not np.all(np.isfinite(A[k])):
+            line, values = _basis_line(f, k)
+            largest = max(values, key=lambda v: abs(float(v.replace("D", "E").replace("d", "e"))), default="")
+            _fail(f.path, line, f"basis function {k + 1}: {largest!r} overflows: L Lᵀ exceeds the largest double "
+                                f"({np.finfo(float).max:.3g})")
+        if not _pd(A_int[k]):
+            _fail(f.path, _basis_line(f, k)[0], f"basis function {k + 1}: L Lᵀ is not positive definite "
+                                                "(a zero on the diagonal of L)")
+        if not _pd(A[k]):
+            _fail(f.path, _basis_line(f, k)[0], f"basis function {k + 1}: its laboratory-frame exponent is not "
+                                                "positive definite in double precision (L's reals span too many "
+                                                "orders of magnitude)")
     basis = Basis(system, A, np.full(len(A), float(c_A)), [hpc.name] * len(A))
     try:
         basis.validate()
@@ -380,19 +389,21 @@ def _pd(a) -> bool:
         return False
 
 
-def _basis_line(f: InoutFile, k: int) -> int | None:
+def _basis_line(f: InoutFile, k: int) -> tuple[int | None, list[str]]:
+    """The line number of basis function `k` (0-based) in the file and its reals as written
+    (None and [] if the file changed since it was read)."""
     try:
         lines = f.path.read_text().splitlines()
     except OSError:
-        return None
+        return None, []
     last = max(i for i, l in enumerate(lines) if _SEP.match(l))
     count = -1
     for i in range(last + 1, len(lines)):
         if lines[i].split():
             count += 1
             if count == k:
-                return i + 1
-    return None
+                return i + 1, lines[i].split()[1:]
+    return None, []
 
 
 def read_inout(path, c_A: float = 1.0) -> Basis:

@@ -87,10 +87,16 @@ class State:
             count = checked(Integer(1, MAX_SIZE), self.roots, "state: roots",
                             "how many of the lowest levels, or a list of eigenvalue indices")
             roots = list(range(count))
+        if self.weights is not None and self.roots is None:
+            raise InputError(f"state: weights = {self.weights!r} without roots: weights weigh the levels roots "
+                             "names (e.g. roots = [0, 1], weights = [1, 0.5])")
         if self.weights is None:
             weights = [1.0] * len(roots)
-        elif not isinstance(self.weights, (list, tuple)) or len(self.weights) != len(roots):
-            raise InputError(f"state: weights = {self.weights!r}: must be {len(roots)} positive numbers, one per root")
+        elif not isinstance(self.weights, (list, tuple)):
+            raise InputError(f"state: weights = {self.weights!r}: must be a list of positive numbers, one per root")
+        elif len(self.weights) != len(roots):
+            raise InputError(f"state: weights = {list(self.weights)!r}: {_count(len(self.weights), 'number')} for "
+                             f"{_count(len(roots), 'root')}")
         else:
             weights = [checked(WEIGHT_RANGE, w, "state: weights", "one per root") for w in self.weights]
         order = sorted(range(len(roots)), key=roots.__getitem__)
@@ -100,6 +106,11 @@ class State:
     def levels(self) -> tuple[tuple, tuple]:
         """The targeted root indices (ascending) and their weights in the objective."""
         return self._levels()
+
+
+def _count(k: int, noun: str) -> str:
+    """"1 root", "2 roots"."""
+    return f"{k} {noun}{'' if k == 1 else 's'}"
 
 
 class System:
