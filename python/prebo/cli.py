@@ -408,9 +408,6 @@ def plot_densities(args) -> int:
         table = densities(basis, args.roots or [0], r, points, threshold=stored)
     except PreboError as exc:
         raise type(exc)(f"{source}: {exc}") from exc
-    if not all(np.all(np.isfinite(p)) for level in table["levels"] for g in ("pairs", "particles")
-               for p in level[g].values()):
-        raise NonFiniteError(f"{source}: the densities are not finite: the basis's integrals overflow or lost their digits")
     try:
         draw(table, png)
         write_atomic(table_file, csv_text(table))
