@@ -15,7 +15,6 @@ from ..errors import BasisFileError, PreboError
 from ..io import basis_json
 from ..system import System
 from ..validation import number
-from .adaptive import pruned
 from .checkpoint import CHECKPOINT
 from .convergence import STOPPED
 from .cursor import Cursor
@@ -46,11 +45,18 @@ def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> t
     nb = len(basis)
     if (cursor.phase != "grow" and nb == 0) or (cursor.phase in ("sweep", "refine") and cursor.index >= nb):
         raise BasisFileError(f"{where}: progress {vars(cursor)} does not fit a basis of {nb} functions")
-    beyond = max(opts.prune or 0, pruned(opts.size))  # a pruning pass grows past the size, then removes
+    beyond = growth_past_size(opts)
     if nb > opts.size + beyond:
-        raise BasisFileError(f"{where}: {nb} functions, more than the run's size = {opts.size} (and {beyond} more "
-                             "while pruning) allows")
+        pruning = f" (and {beyond} more while pruning)" if beyond else ""
+        raise BasisFileError(f"{where}: {nb} functions, more than the run's size = {opts.size}{pruning} allows")
     return basis, cursor, history, elapsed, schedule, stopped
+
+
+def growth_past_size(opts: Optimiser) -> int:
+    """The functions a checkpoint of `opts`'s run may hold past its size: a fixed schedule's
+    pruning grows `prune` functions past it a step at a time, a checkpoint after each; an adaptive
+    one grows and prunes in one step (methods.PrunePass), so its checkpoints never stand above it."""
+    return 0 if opts.adaptive else opts.prune or 0
 
 
 def followed_roots(d: dict, targets: tuple, where: str) -> tuple[tuple, list]:
