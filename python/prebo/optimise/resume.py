@@ -6,6 +6,7 @@ refused in one line naming the file and the key.
 from __future__ import annotations
 
 import reprlib
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -62,7 +63,8 @@ def growth_past_size(opts: Optimiser) -> int:
     return 0 if opts.adaptive else opts.prune or 0
 
 
-def followed_roots(d: dict, targets: tuple, where: str, recorded=None) -> tuple[tuple, list]:
+def followed_roots(d: dict, targets: tuple, where: str,
+                   recorded: Callable[[tuple], bool] | None = None) -> tuple[tuple, list]:
     """The root indices at which a run with several or higher targeted levels (`targets`, the
     state's) stood, and the record of its re-assignments (objective.py, following), from checkpoint
     content `d` (the state's own indices where it has none); BasisFileError naming `where`, the key
