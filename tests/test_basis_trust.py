@@ -159,7 +159,7 @@ def test_floating_ecgs_of_another_N_are_refused_naming_the_file(tmp_path, capsys
 # --- case 10: resources, before anything is built -------------------------------------------
 def test_deep_nesting_and_long_integers_are_refused_in_one_line(tmp_path, capsys):
     deep = tmp_path / "deep.json"
-    deep.write_text("[" * 100_000 + "]" * 100_000)
+    deep.write_text('{"functions": ' + "[" * 100_000 + "]" * 100_000 + "}")
     assert f"{deep}: JSON nested more than 16 levels deep" in cli_error(capsys, "energy", deep)
     shallow = edited(tmp_path, HE, lambda d: d["system"]["state"].update(N=json.loads("[" * 900 + "]" * 900)))
     assert "nested more than 16 levels deep" in cli_error(capsys, "energy", shallow)
@@ -209,12 +209,16 @@ def test_a_version_that_is_no_integer_and_keys_given_twice_are_refused(tmp_path,
 
 def test_files_larger_than_the_bound_are_not_read(tmp_path, capsys, monkeypatch):
     """/dev/zero is refused after MAX_BYTES + 1 bytes (patched small here), not read until memory
-    runs out; the bound holds a checkpoint of MAX_SIZE functions of the most particles."""
+    runs out, as an input, and by its first bytes as a basis (io.stored); so is a basis file that
+    starts as one; the bound holds a checkpoint of MAX_SIZE functions of the most particles."""
     monkeypatch.setattr(basis_json, "MAX_BYTES", 1 << 16)
-    for argv in (["energy", "/dev/zero"], ["run", "/dev/zero", "--out", tmp_path / "out"]):
-        assert "/dev/zero: larger than 65536 bytes, the most prebo reads" in cli_error(capsys, *argv)
+    assert "/dev/zero: larger than 65536 bytes, the most prebo reads" in cli_error(
+        capsys, "run", "/dev/zero", "--out", tmp_path / "out")
+    assert "/dev/zero: neither a basis.json" in cli_error(capsys, "energy", "/dev/zero")
     big = tmp_path / "big.inout.txt"
-    big.write_text(" " * (1 << 17))
+    for start in ("{", " BASIS_TYPE RG_0S\n"):
+        big.write_text(start + " " * (1 << 17))
+        assert f"{big}: larger than 65536 bytes" in cli_error(capsys, "energy", big)
     with pytest.raises(BasisFileError, match="larger than 65536 bytes"):
         ecgpack.read_inout(big)
     monkeypatch.undo()

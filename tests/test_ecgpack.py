@@ -1,5 +1,11 @@
 """ecgpack / ATOM-MOL-nonBO real-ECG bases (*.inout.txt): reading, writing, and prebo's energies
 against ecgpack's (issue 5). Data and the Li-100 reference: tests/data/ecgpack/README.md."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +18,8 @@ from prebo.errors import BasisFileError, InputError
 from prebo.integrals import laboratory
 from prebo.io import ecgpack
 from prebo.system.young import young_operator, young_product, young_string
+
+from conftest import ROOT
 
 DATA = Path(__file__).parent / "data" / "ecgpack"
 HE = DATA / "ecgpack-He4-490.inout.txt"
@@ -80,6 +88,90 @@ def test_he_evaluated_as_ecgpack_solves_it(tmp_path, references):
     assert prebo.evaluate(basis)["energy"] == r["energy"]
     assert prebo.evaluate(basis, threshold=1e-13)["energy"] - HE_ECGPACK > 1e-10
 
+
+
+@pytest.fixture(scope="module")
+def inout(tmp_path_factory):
+    """H (examples/bases/h) exported as ecgpack's own file name, inout.txt, with its energy."""
+    from prebo.cli import main
+
+    folder = tmp_path_factory.mktemp("inout")
+    assert main(["export", str(ROOT / "examples" / "bases" / "h" / "basis.json"), "--format", "ecgpack",
+                 "--out", str(folder / "inout.txt")]) == 0
+    return folder / "inout.txt", energy(Basis.load(ROOT / "examples" / "bases" / "h" / "basis.json"))
+
+
+def test_ecgpacks_own_file_name_is_read_by_every_command_that_reads_a_basis(inout, tmp_path, capsys):
+    """`prebo energy inout.txt` answered "corrupt or truncated JSON": only names ending in .inout.txt
+    were taken for ecgpack files. A basis file is recognised by its content whatever its name, by
+    the commands (energy, properties, plot --densities, export, import), and the API's loaders of one
+    kind say which they were given; the names derived from inout.txt are inout.json,
+    inout.inout.txt, inout.densities.png and .csv."""
+    from prebo.cli import main
+
+    path, E = inout
+    shutil.copy(path, tmp_path / "inout.txt")
+    path = tmp_path / "inout.txt"
+    capsys.readouterr()
+    assert main(["energy", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["energy"] == pytest.approx(E, rel=1e-14)
+    assert main(["properties", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["energy"] == pytest.approx(E, rel=1e-14)
+    assert main(["plot", "--densities", str(path), "--points", "20"]) == 0
+    assert main(["import", str(path)]) == 0
+    assert main(["export", str(path), "--format", "ecgpack"]) == 0
+    names = {"inout.txt", "inout.densities.png", "inout.densities.csv", "inout.json", "inout.inout.txt"}
+    assert {f.name for f in tmp_path.iterdir()} == names
+    shutil.copy(tmp_path / "inout.json", tmp_path / "basis")  # a basis.json by any name
+    capsys.readouterr()
+    assert main(["energy", str(tmp_path / "basis"), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["energy"] == pytest.approx(E, rel=1e-14)
+    assert energy(Basis.load(tmp_path / "basis")) == energy(ecgpack.read_inout(path)) == pytest.approx(E, rel=1e-14)
+    with pytest.raises(BasisFileError, match=r"basis: a basis.json, not an ecgpack file \(prebo.Basis.load reads it\)"):
+        ecgpack.read_inout(tmp_path / "basis")
+    with pytest.raises(BasisFileError, match=r"inout.txt: an ecgpack file, not a basis.json \(prebo.io.ecgpack.read_"):
+        Basis.load(path)
+
+
+@pytest.mark.parametrize("text", ["", "  \n", "hello\n", "[1, 2]\n", "MASS 1\n"])
+def test_a_file_that_is_neither_a_basis_json_nor_an_ecgpack_file_is_refused_in_one_line(tmp_path, capsys, text):
+    from prebo.cli import main
+
+    f = tmp_path / "inout.txt"
+    f.write_text(text)
+    assert main(["energy", str(f)]) == 2
+    assert capsys.readouterr().err == (f"prebo: error: {f}: neither a basis.json (a JSON object) nor an ecgpack file "
+                                       "(a header line, BASIS_TYPE, first)\n")
+
+
+def test_a_basis_in_a_fifo_is_read_once_and_one_that_never_ends_is_refused_by_its_start(inout, tmp_path):
+    """A FIFO is read once: a basis written into one is evaluated; one whose writer sent zeros and
+    keeps it open (as /dev/zero) is refused by its first bytes, not read until it ends."""
+    def feed(fifo, data: bytes, hold: threading.Event):
+        with open(fifo, "wb") as f:
+            f.write(data)
+            f.flush()
+            hold.wait(120)
+
+    path, E = inout
+    for data, expected in ((path.read_bytes(), 0), (bytes(1 << 16), 2)):
+        fifo, hold = tmp_path / f"fifo{expected}", threading.Event()
+        os.mkfifo(fifo)
+        writer = threading.Thread(target=feed, args=(fifo, data, hold))
+        writer.start()
+        if expected == 0:
+            hold.set()  # the writer closes: the end of the file
+        try:
+            r = subprocess.run([sys.executable, "-m", "prebo", "energy", str(fifo), "--json"], capture_output=True,
+                               text=True, timeout=60)
+        finally:
+            hold.set()
+            writer.join()
+        assert r.returncode == expected, r.stderr
+        if expected == 0:
+            assert json.loads(r.stdout)["energy"] == pytest.approx(E, rel=1e-14)
+        else:
+            assert r.stderr.startswith(f"prebo: error: {fifo}: neither a basis.json") and r.stderr.count("\n") == 1
 
 def test_li_system_keeps_the_files_operator(li):
     sys_ = li.system
@@ -265,7 +357,7 @@ def test_missing_header_and_not_a_file(tmp_path):
         ecgpack.read_inout(p)
     q = tmp_path / "empty.txt"
     q.write_text("hello\n")
-    with pytest.raises(BasisFileError, match="not an ecgpack"):
+    with pytest.raises(BasisFileError, match="neither a basis.json .* nor an ecgpack file"):
         ecgpack.read_inout(q)
     with pytest.raises(BasisFileError, match="cannot read"):
         ecgpack.read_inout(tmp_path / "missing.inout.txt")

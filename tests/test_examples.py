@@ -6,6 +6,8 @@ import sys
 
 import pytest
 
+import prebo
+
 from conftest import ROOT
 
 BASES = ROOT / "examples" / "bases"
@@ -152,6 +154,36 @@ def test_h2_fecg_basis_meets_the_issue_target_and_reports_n2():
     assert r["n_basis"] <= 600 and r["basis_type"] == "fecg"
     assert r["energy"] <= -1.16272 and 0.0 <= r["n2"] < 1e-3
 
+
+
+#: every stored basis file (a run's result.json is not one) in examples/ and tests/data
+STORED = sorted(f.relative_to(ROOT) for folder in ("examples", "tests/data") for f in (ROOT / folder).rglob("*.json")
+                if f.name != "result.json")
+
+
+@pytest.mark.parametrize("path", STORED, ids=str)
+def test_stored_basis_files_hold_what_the_format_says(path):
+    """docs/basis-format.md on every stored basis file: only its keys; `energy` the lowest root's
+    translation-free energy of the file's own functions; `objective` (with `levels` and `followed`)
+    only in the checkpoint of a run for other levels than the lowest, Σ w_k E_k of the targeted
+    levels where they stand. he-2-1s, he-inf-2-1s, h2plus-ladder and h2plus-n1 held that sum in
+    `energy` and had no objective; h, h2-pecg and h2plus-pecg held the energy of the code they were
+    written with (1e-10, 1.3e-11 and 1.1e-8 relative from their functions')."""
+    from prebo.cli import load_basis
+    from prebo.io.basis_json import KEYS
+
+    d = json.loads((ROOT / path).read_text())
+    assert set(d) <= set(KEYS), set(d) - set(KEYS)
+    basis, threshold = load_basis(ROOT / path)
+    targets, weights = basis.system.state.levels
+    for_levels = targets != (0,) and "progress" in d
+    assert ("objective" in d) == ("levels" in d) == ("followed" in d) == for_levels
+    levels = d.get("levels", list(targets))
+    r = prebo.evaluate(basis, threshold=threshold, roots=max(levels) + 1)
+    E = [level["energy"] for level in r["levels"]] if "levels" in r else [r["energy"]]
+    assert d["energy"] == pytest.approx(E[0], rel=1e-13, abs=0)
+    if for_levels:
+        assert d["objective"] == pytest.approx(sum(w * E[k] for k, w in zip(levels, weights)), rel=1e-13, abs=0)
 
 #: the two evaluation paths, with the eigenvalues refined in extended precision, agree to 2e-15
 #: (H, overlap condition 1.4e12; 1e-10 with LAPACK's eigenvalues alone), 6e-16 (He), 7e-16 (H2+)

@@ -130,6 +130,43 @@ def test_a_run_for_several_roots_resumes_bit_for_bit(tmp_path):
     assert d["objective"] == pytest.approx(levels[0] + 2 * levels[1], rel=1e-13) == d["history"][-1][1]
 
 
+
+@pytest.fixture(scope="module")
+def roots_2(tmp_path_factory):
+    """The checkpoint of a short fixed-schedule run of H for roots = 2 (levels [0, 1], never moved)."""
+    folder = tmp_path_factory.mktemp("roots_2")
+    optimise(prebo.System(["p", "e"], prebo.State(roots=2, weights=[1.0, 2.0])),
+             Optimiser(size=6, seed=4, refine=1, polish=1), out=folder, progress=False)
+    return json.loads((folder / "basis.json").read_text())
+
+
+@pytest.mark.parametrize("edit, message", [
+    ({"levels": [0, 0]}, "levels = [0, 0]: must be distinct root indices, one per targeted level"),
+    ({"levels": [1, 0]}, "levels = [1, 0]: must be 2 root indices, one per targeted level, each at or above its "
+                         "target [0, 1]"),
+    ({"levels": [0]}, "levels = [0]: must be 2 root indices, one per targeted level, each at or above its target "
+                      "[0, 1]"),
+    ({"roots": [0, 2]}, "system.state: roots = [0, 2]: not the roots the run targeted (its objective is not Σ w_k "
+                        "E_k there; its levels = [0, 1] never moved)"),
+    ({"roots": [0, 1, 2], "weights": [1.0, 1.0, 1.0]}, "system.state: roots = [0, 1, 2]: not the roots the run "
+                                                       "targeted (its objective is not Σ w_k E_k there;"),
+    ({"followed": [[1.0, [0, 1], [0, 2]]], "levels": [0, 2], "roots": [0, 3]},
+     "system.state: roots = [0, 3]: not the roots the run targeted (where its levels started, followed[0]: [0, 1])"),
+], ids=["levels-repeated", "levels-swapped", "levels-short", "roots", "roots-and-weights", "roots-followed"])
+def test_an_edited_checkpoints_levels_or_roots_are_named_with_the_file(roots_2, tmp_path, capsys, edit, message):
+    """A checkpoint whose levels or state's roots were edited was refused as "checkpoint: levels =
+    …" — no file, and an edit of the roots reported as the levels (the old ones, which fit no
+    longer); now the file, the key edited and its value as read: the roots where the levels do not
+    start there (the record of where they moved, or the objective the checkpoint records)."""
+    d = json.loads(json.dumps(roots_2))
+    for key, value in edit.items():
+        (d["system"]["state"] if key in ("roots", "weights") else d)[key] = value
+    (tmp_path / "basis.json").write_text(json.dumps(d))
+    assert main(["run", "--resume", str(tmp_path), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"prebo: error: {tmp_path / 'basis.json'}: {message}") and err.count("\n") == 1, err
+
+
 @pytest.mark.parametrize("particles", [["p", "e", "e"], ["e+", "e", "e"]], ids=["H-", "Ps-"])
 def test_root_1_of_h_minus_and_ps_minus_is_optimised_and_reported_not_bound(tmp_path, capsys, particles):
     """H⁻ and Ps⁻ have one bound S state: optimised for roots = 2, root 0 is bound and root 1 lies

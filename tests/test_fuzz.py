@@ -330,6 +330,43 @@ def test_corrupted_checkpoints_on_resume(checkpoints, tmp_path, capsys, data):
     assert_clean(rc, out, err)
 
 
+
+@pytest.fixture(scope="module")
+def sized(tmp_path_factory):
+    """Checkpoints of six functions of H, of each schedule kind: a fixed one that does not prune,
+    and an adaptive one (which prunes in one step)."""
+    d = tmp_path_factory.mktemp("sized")
+    system = prebo.System(["p", "e"])
+    prebo.optimise(system, prebo.Optimiser(size=6, trials=2, seed=1, refine=0, polish=0), out=d / "fixed",
+                   progress=False)
+    prebo.optimise(system, prebo.Optimiser(size=6, trials=2, seed=1), out=d / "adaptive", progress=False)
+    return {name: json.loads((d / name / "basis.json").read_text()) for name in ("fixed", "adaptive")}
+
+
+@FUZZ
+@given(name=st.sampled_from(["fixed", "adaptive"]), change=st.integers(-4, 3), prune=st.sampled_from([None, 0, 1, 2]))
+def test_checkpoints_whose_size_is_edited_around_their_functions(sized, tmp_path, capsys, name, change, prune):
+    """A checkpoint's size edited to values around its count of functions (a fixed one's `prune`
+    too, and its place between growth and pruning): refused in one line naming the file, or resumed
+    to a basis no larger than the size (a fixed schedule to its end, an adaptive one with the
+    budget it had spent)."""
+    doc = json.loads(json.dumps(sized[name]))
+    nb = len(doc["functions"])
+    doc["optimiser"]["size"] = max(1, nb + change)
+    if name == "fixed" and prune is not None:
+        doc["optimiser"]["prune"], doc["progress"] = prune, {"phase": "prune", "sweep": 0, "index": 1, "cycle": 0}
+    run = tmp_path / "run"
+    run.mkdir(exist_ok=True)
+    (run / "result.json").unlink(missing_ok=True)
+    (run / "basis.json").write_text(json.dumps(doc))
+    spent = ["--budget", str(max(doc["elapsed"], 0.1))] if name == "adaptive" else []  # not grown on to a new size
+    rc = main(["run", "--resume", str(run), "--quiet", *spent])
+    out, err = capsys.readouterr()
+    if rc == 0:
+        assert json.loads((run / "result.json").read_text())["n_basis"] <= doc["optimiser"]["size"]
+    else:
+        assert rc == 2 and err.startswith(f"prebo: error: {run / 'basis.json'}: ") and err.count("\n") == 1, err
+
 TOML_KEYS = {"system": ["particles"], "state": ["N", "parity", "spin", "threshold", "root", "roots", "weights"],
              "basis": ["type", "size", "c_A", "K_max"],
              "optimiser": sorted(s.key.partition(" ")[2] for s in SETTINGS.values() if s.key.startswith("[optimiser]"))}

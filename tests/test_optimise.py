@@ -100,6 +100,41 @@ def test_a_checkpoint_holding_more_functions_than_its_size_allows_is_refused(tmp
     assert f"{f}: 6 functions, more than the run's size = 3" in err and err.count("\n") == 1, err
 
 
+
+@pytest.fixture(scope="module")
+def six(tmp_path_factory):
+    """Checkpoints of six functions of H: of a fixed schedule that does not prune and of an adaptive
+    one run to its end."""
+    d = tmp_path_factory.mktemp("six")
+    system = prebo.System(["p", "e"])
+    prebo.optimise(system, Optimiser(size=6, trials=2, seed=1, refine=0, polish=0), out=d / "fixed", progress=False)
+    prebo.optimise(system, Optimiser(size=6, trials=2, seed=1), out=d / "adaptive", progress=False)
+    return {name: json.loads((d / name / "basis.json").read_text()) for name in ("fixed", "adaptive")}
+
+
+@pytest.mark.parametrize("name", ["fixed", "adaptive"])
+def test_a_checkpoint_one_function_above_its_size_is_refused_where_the_schedule_does_not_prune_past_it(
+        six, tmp_path, capsys, name):
+    """A checkpoint of six functions whose size is edited to 5 resumed and ended with six (so did
+    one of 40 edited to 37 or 39): the margin of a pruning pass (adaptive.pruned) was granted to a
+    fixed schedule that does not prune and to an adaptive one, which prunes in one step and so
+    never leaves a checkpoint above its size. A fixed schedule's pruning keeps its margin: that
+    checkpoint with size 5 and prune = 1, between its growth and its removal, resumes to five."""
+    from prebo.cli import main
+    d = json.loads(json.dumps(six[name]))
+    assert len(d["functions"]) == 6
+    d["optimiser"]["size"] = 5
+    f = tmp_path / "basis.json"
+    f.write_text(json.dumps(d))
+    assert main(["run", "--resume", str(tmp_path), "--quiet", "--budget", "1e9"]) == 2
+    err = capsys.readouterr().err
+    assert err == f"prebo: error: {f}: 6 functions, more than the run's size = 5 allows\n"
+    if name == "fixed":
+        d["optimiser"]["prune"], d["progress"] = 1, {"phase": "prune", "sweep": 0, "index": 1, "cycle": 0}
+        f.write_text(json.dumps(d))
+        assert main(["run", "--resume", str(tmp_path), "--quiet"]) == 0
+        assert len(functions(tmp_path)) == 5 and json.loads((tmp_path / "result.json").read_text())["n_basis"] == 5
+
 def test_fixed_schedule():
     opts = resolved(Optimiser(size=2, sweeps=1, refine=2, polish=2), prebo.System(["p", "e"]))
     schedule = Fixed(opts)

@@ -332,11 +332,12 @@ def same_file(a, b) -> bool:
 def cmd_import(args) -> int:
     """`prebo import FILE.inout.txt [--out X.json] [--force] [--c-A C]`: an ecgpack basis as basis.json."""
     from .eigen import THRESHOLD
+    from .io import stored
     from .io.ecgpack import read_inout
     from .optimise.settings import check
 
     c_A = check("c_A", args.c_A, "--c-A")
-    default = Path(str(args.file).removesuffix(".txt").removesuffix(".inout") + ".json")
+    default = Path(stored.stem(args.file) + ".json")
     out = output_file(given(args.out, default, "a file name"), args.force, [args.file])
     basis = read_inout(args.file, c_A=c_A)
     basis.save(out, {"optimiser": {"threshold": THRESHOLD}})  # every direction kept, as ecgpack solves it
@@ -346,9 +347,10 @@ def cmd_import(args) -> int:
 
 def cmd_export(args) -> int:
     """`prebo export BASIS.json --format ecgpack [--out FILE] [--force]`: a plain-ECG basis as an ecgpack file."""
+    from .io import stored
     from .io.ecgpack import write_inout
 
-    default = Path(str(args.basis).removesuffix(".json") + ".inout.txt")
+    default = Path(stored.stem(args.basis) + ".inout.txt")
     out = output_file(given(args.out, default, "a file name"), args.force, [args.basis])
     basis, _ = load_basis(args.basis)
     write_inout(basis, out)
@@ -390,6 +392,7 @@ def plot_densities(args) -> int:
     import numpy as np
 
     from .errors import InputError
+    from .io import stored
     from .io.files import write_atomic
     from .plot import densities as draw
     from .properties import POINTS, csv_text, densities
@@ -397,7 +400,7 @@ def plot_densities(args) -> int:
     if len(args.runs) != 1:
         raise InputError(f"--densities draws one basis, not {len(args.runs)} ({' '.join(map(str, args.runs))})")
     source = args.runs[0]
-    default = Path(str(source).removesuffix(".json").removesuffix(".inout.txt") + ".densities.png")
+    default = Path(stored.stem(source) + ".densities.png")
     png = given(args.out, default, "an image file")
     png = output_file(png if png.suffix else png.with_suffix(".png"), args.force, [source])
     table_file = output_file(png.with_suffix(".csv"), args.force, [source])
@@ -418,20 +421,22 @@ def plot_densities(args) -> int:
 
 
 def load_basis(path) -> tuple:
-    """A basis.json, or an ecgpack ``*.inout.txt`` (recognised by its name), and the overlap
-    threshold of the code that wrote it: a run's (its "optimiser" block), else eigen.THRESHOLD
-    (every direction double precision resolves, as ecgpack keeps them)."""
+    """A basis.json or an ecgpack file (ecgpack's own name: inout.txt), recognised by its content
+    whatever its name (io.stored), and the overlap threshold of the code that wrote it: a run's
+    (its "optimiser" block), else eigen.THRESHOLD (every direction double precision resolves, as
+    ecgpack keeps them)."""
     from .basis import Basis
     from .eigen import THRESHOLD
     from .errors import InputError
-    from .io import basis_json
+    from .io import basis_json, stored
+    from .io.ecgpack import parse_inout
 
-    if str(path).endswith(".inout.txt"):
-        from .io.ecgpack import read_inout
-        return read_inout(path), THRESHOLD
     if str(path).endswith(".toml"):
         raise InputError(f"{path}: a TOML input, not a basis; optimise it with `prebo run {path}`")
-    d = basis_json.read(path)
+    what, text = stored.read(path)
+    if what == "ecgpack":
+        return parse_inout(path, text).to_basis(), THRESHOLD
+    d = basis_json.parse(text, path)
     basis = Basis.from_dict(d, str(path))  # d, its settings included, is checked from here on
     return basis, (d.get("optimiser") or {}).get("threshold", THRESHOLD)
 

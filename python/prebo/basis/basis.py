@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import BasisFileError, InputError, NotPositiveDefiniteError, PreboError, SeparabilityError
-from ..io import basis_json
+from ..io import basis_json, stored
 from ..system import System
 from ..validation import path_name
 from .families import family as family_of
@@ -192,9 +192,14 @@ class Basis:
 
     @classmethod
     def load(cls, path) -> "Basis":
-        """The basis of a basis.json file; BasisFileError naming the file for anything wrong."""
+        """The basis of a basis.json file, recognised by its content whatever its name
+        (prebo.io.stored); BasisFileError naming the file for anything wrong, an ecgpack file
+        included (prebo.io.ecgpack.read_inout reads it)."""
         path = _file("Basis.load", path)
-        return cls.from_dict(basis_json.read(path), str(path))
+        what, text = stored.read(path)
+        if what == "ecgpack":
+            raise BasisFileError(f"{path}: an ecgpack file, not a basis.json (prebo.io.ecgpack.read_inout reads it)")
+        return cls.from_dict(basis_json.parse(text, path), str(path))
 
 
 def _finite(name: str, value, shape: tuple, what: str) -> np.ndarray:

@@ -209,7 +209,11 @@ def read(path):
     of more than MAX_DIGITS digits, a number beyond the largest double, NaN or Infinity (naming
     the line), a key twice in one object, or more than MAX_DEPTH levels of nesting."""
     path = Path(path)
-    text = read_text(path, BasisFileError)
+    return parse(read_text(path, BasisFileError), path)
+
+
+def parse(text: str, path):
+    """The parsed content of the basis.json text `text` read from `path` (`read`'s checks)."""
     try:
         d = json.loads(text, parse_int=_integer, parse_float=_real, parse_constant=_constant, object_pairs_hook=_unique)
     except json.JSONDecodeError as exc:
@@ -286,6 +290,11 @@ def read_text(path: Path, error: type[PreboError]) -> str:
             data = f.read(MAX_BYTES + 1)
     except OSError as exc:
         raise error(f"{path}: cannot read ({exc.strerror})") from exc
+    return decoded(data, path, error)
+
+
+def decoded(data: bytes, path: Path, error: type[PreboError]) -> str:
+    """The text of the first MAX_BYTES + 1 bytes `data` read from `path` (`read_text`'s checks)."""
     if len(data) > MAX_BYTES:
         raise error(f"{path}: larger than {MAX_BYTES} bytes, the most prebo reads (a run's checkpoint of "
                     f"{MAX_SIZE} functions, the largest basis this machine holds)")

@@ -89,6 +89,7 @@ from ..system.young import young_operator, young_product, young_string
 from ..optimise.settings import check
 from ..validation import MAX_PARTICLES, MAX_SIZE, path_name
 from .basis_json import MAX_DIGITS, read_text
+from . import stored
 from .files import write_atomic
 
 __all__ = ["read_inout", "write_inout", "parse_inout", "InoutFile"]
@@ -189,10 +190,11 @@ def _count(values: list) -> int | None:
     return int(values[0])
 
 
-def parse_inout(path) -> InoutFile:
-    """Read an ecgpack ``*.inout.txt`` without converting it; BasisFileError names the line."""
+def parse_inout(path, text: str | None = None) -> InoutFile:
+    """Read an ecgpack ``*.inout.txt`` (or its `text`, read already: io.stored) without converting
+    it; BasisFileError names the line."""
     path = Path(path_name(path, "parse_inout: path", "a file name (a str or path)"))
-    lines = read_text(path, BasisFileError).splitlines()
+    lines = (read_text(path, BasisFileError) if text is None else text).splitlines()
     seps = [i for i, l in enumerate(lines) if _SEP.match(l)]
     if not seps:
         _fail(path, None, "no ===== section separators: not an ecgpack .inout file")
@@ -423,8 +425,13 @@ def read_inout(path, c_A: float = 1.0) -> Basis:
 
     Raises BasisFileError naming the file and line for anything prebo cannot take: complex
     ECGs, L > 0 basis types, a malformed header or basis line, a size mismatch, a symmetry
-    exchanging different particles; InputError for a `path` that is not a file name."""
-    return parse_inout(path_name(path, "read_inout: path", "a file name (a str or path)")).to_basis(c_A)
+    exchanging different particles, or a file that is not an ecgpack file (recognised by its
+    content, io.stored); InputError for a `path` that is not a file name."""
+    path = path_name(path, "read_inout: path", "a file name (a str or path)")
+    what, text = stored.read(path)
+    if what == "json":
+        raise BasisFileError(f"{path}: a basis.json, not an ecgpack file (prebo.Basis.load reads it)")
+    return parse_inout(path, text).to_basis(c_A)
 
 
 def _fmt(x: float) -> str:

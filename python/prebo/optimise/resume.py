@@ -6,21 +6,24 @@ refused in one line naming the file and the key.
 from __future__ import annotations
 
 import reprlib
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from ..basis import Basis
 from ..errors import BasisFileError, PreboError
+from ..integrals import laboratory
 from ..io import basis_json
 from ..system import System
 from ..validation import number
-from .adaptive import pruned
 from .checkpoint import CHECKPOINT
 from .convergence import STOPPED
 from .cursor import Cursor
+from .expansion import Expansion
 from .history import Step, check_history
 from .momentum import Momentum
+from .objective import Levels
 from .schedule import schedule_of
 from .settings import Optimiser
 
@@ -46,27 +49,55 @@ def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> t
     nb = len(basis)
     if (cursor.phase != "grow" and nb == 0) or (cursor.phase in ("sweep", "refine") and cursor.index >= nb):
         raise BasisFileError(f"{where}: progress {vars(cursor)} does not fit a basis of {nb} functions")
-    beyond = max(opts.prune or 0, pruned(opts.size))  # a pruning pass grows past the size, then removes
+    beyond = growth_past_size(opts)
     if nb > opts.size + beyond:
-        raise BasisFileError(f"{where}: {nb} functions, more than the run's size = {opts.size} (and {beyond} more "
-                             "while pruning) allows")
+        pruning = f" (and {beyond} more while pruning)" if beyond else ""
+        raise BasisFileError(f"{where}: {nb} functions, more than the run's size = {opts.size}{pruning} allows")
     return basis, cursor, history, elapsed, schedule, stopped
 
 
-def followed_roots(d: dict, targets: tuple, where: str) -> tuple[tuple, list]:
+def growth_past_size(opts: Optimiser) -> int:
+    """The functions a checkpoint of `opts`'s run may hold past its size: a fixed schedule's
+    pruning grows `prune` functions past it a step at a time, a checkpoint after each; an adaptive
+    one grows and prunes in one step (methods.PrunePass), so its checkpoints never stand above it."""
+    return 0 if opts.adaptive else opts.prune or 0
+
+
+def followed_roots(d: dict, targets: tuple, where: str,
+                   recorded: Callable[[tuple], bool] | None = None) -> tuple[tuple, list]:
     """The root indices at which a run with several or higher targeted levels (`targets`, the
     state's) stood, and the record of its re-assignments (objective.py, following), from checkpoint
-    content `d` (the state's own indices where it has none); BasisFileError naming `where` for a
-    block that is not distinct root indices, one per targeted level at or above it."""
+    content `d` (the state's own indices where it has none); BasisFileError naming `where`, the key
+    and its value for `levels` that are not distinct root indices, `followed` rows that are not
+    [seconds, roots before, roots after], and levels that do not stand one per targeted level at or
+    above it. A run's levels start at its targets and move only as `followed` records, so there the
+    edited key is the state's `roots` if they are not where the levels started — the first row's
+    roots before, or, for levels that never moved, the roots at which the checkpoint's objective is
+    Σ w_k E_k (`recorded(roots)`: whether it is at `roots`; without it, `levels` is named)."""
     levels, followed = d.get("levels", list(targets)), d.get("followed", [])
-    if not (isinstance(levels, list) and len(levels) == len(targets) and len(set(levels)) == len(levels)
-            and all(type(r) is int and r >= t for r, t in zip(levels, targets))):
-        raise BasisFileError(f"{where}: levels = {reprlib.repr(levels)}: must be {len(targets)} distinct root "
-                             f"indices, one per targeted level, each at or above its target {list(targets)}")
-    if not (isinstance(followed, list) and all(isinstance(f, list) and len(f) == 3 for f in followed)):
+    if not indices(levels):
+        raise BasisFileError(f"{where}: levels = {reprlib.repr(levels)}: must be distinct root indices, one per "
+                             "targeted level")
+    if not (isinstance(followed, list) and all(isinstance(f, list) and len(f) == 3 and indices(f[1])
+                                               and indices(f[2]) for f in followed)):
         raise BasisFileError(f"{where}: followed = {reprlib.repr(followed)}: must be [seconds, roots before, "
                              "roots after] rows")
-    return tuple(levels), followed
+    if len(levels) == len(targets) and all(r >= t for r, t in zip(levels, targets)):
+        return tuple(levels), followed
+    state = d["system"]["state"]
+    if followed[0][1] != list(targets) if followed else recorded is not None and not recorded(targets):
+        read = f"roots = {reprlib.repr(state['roots'])}" if "roots" in state else "no roots (the lowest alone)"
+        how = f"where its levels started, followed[0]: {followed[0][1]}" if followed else \
+            f"its objective is not Σ w_k E_k there; its levels = {levels} never moved"
+        raise BasisFileError(f"{where}: system.state: {read}: not the roots the run targeted ({how}): a resumed run "
+                             "goes on for its own; start a new run for other roots")
+    raise BasisFileError(f"{where}: levels = {reprlib.repr(levels)}: must be {len(targets)} root indices, one per "
+                         f"targeted level, each at or above its target {list(targets)}")
+
+
+def indices(roots) -> bool:
+    """Whether `roots` is a list of distinct root indices (integers ≥ 0)."""
+    return isinstance(roots, list) and all(type(r) is int and r >= 0 for r in roots) and len(set(roots)) == len(roots)
 
 
 def check_rng(block) -> dict:
@@ -87,7 +118,8 @@ def check_rng(block) -> dict:
 
 def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
     """The content of folder/basis.json with its system and settings, checked as a whole: the
-    basis, the settings, the run state and the momentum block (BasisFileError naming the file)."""
+    basis, the settings, the run state, the levels and the momentum block (BasisFileError naming
+    the file)."""
     path = Path(folder) / CHECKPOINT
     if not path.exists():
         raise BasisFileError(f"{path}: no checkpoint to resume")
@@ -99,5 +131,18 @@ def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
     except PreboError as exc:
         raise BasisFileError(f"{path}: {exc}") from exc
     basis, *_ = resumed(d, opts, np.random.default_rng(), str(path))
+    followed_roots(d, basis.system.state.levels[0], str(path), lambda roots: objective_at(d, basis, opts, roots))
     Momentum.from_dict(d.get("momentum"), basis, str(path))
     return d, basis.system, opts
+
+
+def objective_at(d: dict, basis: Basis, opts: Optimiser, roots: tuple) -> bool:
+    """Whether checkpoint content `d`'s objective is Σ w_k E_k of `basis` at `roots` (the state's
+    weights; the run's representation and linear-dependence settings), to 1e-10 relative."""
+    recorded = d.get("objective")
+    try:
+        value = Expansion(basis, laboratory(basis.system), opts.threshold, opts.min_norm, opts.max_overlap,
+                          Levels(roots, basis.system.state.levels[1])).energy
+    except PreboError:
+        return False
+    return type(recorded) is float and abs(value - recorded) <= 1e-10 * abs(recorded)
