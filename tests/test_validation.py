@@ -258,7 +258,7 @@ def test_outputs_that_cannot_be_written(bases, tmp_path, capsys):
     f.write_text(H_TOML)
     existing = tmp_path / "a-file"
     existing.write_text("")
-    assert "cannot create the output folder (File exists)" in cli_error(capsys, "run", f, "--out", existing, "--quiet")
+    assert f"{existing}: a file, not a folder" in cli_error(capsys, "run", f, "--out", existing, "--quiet")
     assert "Not a directory" in cli_error(capsys, "run", f, "--out", existing / "sub", "--quiet")
     err = cli_error(capsys, "import", li, "--out", existing / "li.json")
     assert str(existing / "li.json") in err and "cannot write" in err
