@@ -73,7 +73,7 @@ def to_dict(basis, extra: dict | None = None) -> dict:
         d["coefficients"] = np.asarray(basis.coefficients).tolist()
     if extra:
         d.update(extra)
-    return d | {"provenance": provenance()}
+    return d
 
 
 def _function_dict(basis, i: int) -> dict:
@@ -84,8 +84,9 @@ def _function_dict(basis, i: int) -> dict:
 
 
 def save(basis, path, extra: dict | None = None) -> None:
-    """Write `to_dict(basis, extra)` to `path` atomically."""
-    write_json_atomic(path, to_dict(basis, extra))
+    """Write `to_dict(basis, extra)` to `path` atomically, with the provenance of the writer (what
+    made the file; not in `to_dict`, whose mapping also serves as a checkpoint's momentum block)."""
+    write_json_atomic(path, to_dict(basis, extra) | {"provenance": provenance()})
 
 
 def arguments(d: dict, where: str) -> dict:
