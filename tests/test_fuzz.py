@@ -50,6 +50,7 @@ TOML = EDGES | EDGES | st.recursive(SCALARS.filter(lambda v: v is not None),
                                     lambda inner: st.lists(inner, max_size=3)
                                     | st.dictionaries(st.text("abcNe", min_size=1, max_size=3), inner, max_size=2),
                                     max_leaves=4)
+POSIX_FILES = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs, device nodes and sockets are POSIX files")
 
 
 #: positions a corruption most often matters at (the state, the particles, the functions, the symmetry)
@@ -511,6 +512,7 @@ WRITERS = {"export": lambda out: ["export", BASES / "he" / "basis.json", "--form
            "run": lambda out: ["run", BASES.parent / "h.toml", "--out", out, "--quiet"]}
 
 
+@POSIX_FILES
 @FUZZ
 @given(writer=st.sampled_from(sorted(WRITERS)), kind=st.sampled_from(["fifo", "device", "socket", "folder"]),
        where=st.sampled_from(["itself", "link", "link to a link", "inside"]), force=st.booleans(),

@@ -30,6 +30,7 @@ LI = ROOT / "tests" / "data" / "ecgpack" / "ecgpack-Li7-100.inout.txt"
 H_RUN = ROOT / "examples" / "bases" / "auto-h"  # a run of 20 functions: its checkpoint and result
 PREBO = [sys.executable, "-m", "prebo"]
 H_TOML = '[system]\nparticles = ["p", "e"]\n[basis]\nsize = 3\n[optimiser]\ntrials = 4\nseed = 3\n'
+POSIX_FILES = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs, device nodes and sockets are POSIX files")
 
 
 def cli(capsys, *args):
@@ -154,6 +155,7 @@ def commands(tmp_path: Path, out: Path) -> dict[str, list]:
                           out.with_suffix(".png") if out.suffix != ".png" else out]}
 
 
+@POSIX_FILES
 @pytest.mark.parametrize("force", [[], ["--force"]])
 @pytest.mark.parametrize("kind", ["fifo", "device", "socket"])
 @pytest.mark.parametrize("command", ["export", "import", "plot", "densities"])
@@ -170,6 +172,7 @@ def test_a_device_or_fifo_is_never_replaced(tmp_path, capsys, command, kind, for
     assert os.lstat(node).st_mode == mode and not list(tmp_path.glob("*.tmp"))
 
 
+@POSIX_FILES
 def test_the_densities_table_beside_the_picture_is_not_replaced_if_a_fifo(tmp_path, capsys):
     """The CSV beside `prebo plot --densities`' picture is an output too."""
     table = tmp_path / "d.csv"
@@ -179,6 +182,7 @@ def test_the_densities_table_beside_the_picture_is_not_replaced_if_a_fifo(tmp_pa
     assert not (tmp_path / "d.png").exists()
 
 
+@POSIX_FILES
 @pytest.mark.parametrize("name", ["basis.json", "result.json", "lowest.json", "folder"])
 def test_a_run_never_replaces_a_fifo_in_or_as_its_folder(tmp_path, capsys, name):
     """A run's folder, and its checkpoint, lowest state and result, replace only regular files
@@ -201,6 +205,7 @@ def test_an_output_through_a_symbolic_link_is_written_into_its_file(tmp_path, ca
     assert link.is_symlink() and real.read_text().split()[:2] == ["BASIS_TYPE", "RG_0S"]
 
 
+@POSIX_FILES
 def test_the_api_writer_refuses_a_fifo(tmp_path):
     """Basis.save, the API's writer, goes through the same check."""
     fifo = tmp_path / "b.json"

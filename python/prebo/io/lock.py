@@ -1,6 +1,7 @@
-"""A run folder's advisory lock: the file FOLDER/.lock, held (fcntl.flock, exclusive) by the one
-process whose run owns the folder and removed when the run ends. The kernel drops the lock with
-the process however it ends (an exception, a signal, a kill), so a stale .lock owns nothing.
+"""A run folder's advisory lock: the file FOLDER/.lock, held (fcntl.flock, exclusive; on Windows
+msvcrt.locking of one byte past the owner's id) by the one process whose run owns the folder and
+removed when the run ends. The system drops the lock with the process however it ends (an
+exception, a signal, a kill), so a stale .lock owns nothing.
 
 `owned` creates the folder if it is missing, and removes what it created if the run left it
 empty: a refused run leaves no trace. A run nested in one that owns the folder (the CLI's run
@@ -8,7 +9,7 @@ around `prebo.optimise`, `resume_from` around it) holds it already.
 """
 from __future__ import annotations
 
-import fcntl
+import errno
 import os
 import stat
 import threading
@@ -18,7 +19,14 @@ from pathlib import Path
 from ..errors import OutputError
 from .files import KINDS
 
+try:
+    import fcntl
+except ImportError:  # Windows
+    fcntl = None
+    import msvcrt
+
 LOCK = ".lock"
+_BYTE = 1 << 20  # Windows: the locked byte, past the id a second run reads
 
 _held = threading.local()  # the folders (device, inode) this thread owns
 
@@ -45,8 +53,15 @@ def owned(folder):
         yield
     finally:
         held.discard(key)
-        (folder / LOCK).unlink(missing_ok=True)  # while held: whoever opened it before finds it gone (_acquire)
-        os.close(fd)
+        if fcntl:
+            (folder / LOCK).unlink(missing_ok=True)  # while held: whoever opened it before finds it gone (_acquire)
+            os.close(fd)
+        else:  # Windows removes no open file; one opened meanwhile by another run stays, unlocked or its own
+            os.close(fd)
+            try:
+                (folder / LOCK).unlink(missing_ok=True)
+            except PermissionError:
+                pass
         _remove_empty(created)
 
 
@@ -80,7 +95,7 @@ def _acquire(path: Path) -> int:
         except OSError as exc:
             raise OutputError(f"{path.parent}: cannot lock the output folder ({exc.strerror})") from exc
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            _lock(fd)
         except BlockingIOError:
             pid = os.read(fd, 32).decode(errors="replace").strip()
             os.close(fd)
@@ -101,3 +116,20 @@ def _acquire(path: Path) -> int:
     except OSError:
         pass  # the id only names the owner to a second run; a full disk stops the run at its first write
     return fd
+
+
+def _lock(fd: int) -> None:
+    """Lock the open file `fd` for this process, without waiting: BlockingIOError when another
+    holds it, OSError when the file system has no locks."""
+    if fcntl:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return
+    os.lseek(fd, _BYTE, os.SEEK_SET)
+    try:
+        msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+    except OSError as exc:  # a held region: EACCES, or EDEADLOCK
+        if exc.errno in (errno.EACCES, errno.EDEADLOCK):
+            raise BlockingIOError(exc.errno, exc.strerror) from None
+        raise
+    finally:
+        os.lseek(fd, 0, os.SEEK_SET)
