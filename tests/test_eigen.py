@@ -290,8 +290,9 @@ def test_poor_eigenbasis_is_resolved_by_inverse_iteration(problem):
     _, _, _, m = problem
     H, S = m["T_ti"] + m["V"], m["S"]
     sol = eigen.solve(H, S)
-    poor = eigen.Eigen(np.full_like(sol.energies, sol.energies[0] + 1e-12), sol.vectors, sol.kept,
-                       sol.overlap_condition)
+    C = sol.vectors.copy()
+    C[:, 0] += 1e-6 * C[:, 1]  # a lowest vector 1e-6 off, whatever LAPACK's kernel gave
+    poor = eigen.Eigen(np.full_like(sol.energies, sol.energies[0] + 1e-12), C, sol.kept, sol.overlap_condition)
     assert not _core.refine_eigenpairs(H, S, poor.energies, poor.vectors, 1)[3][0]
     energy = eigen.refine(H, S, poor).energies[0]
     assert abs(energy - sol.energies[0]) <= 2 * np.spacing(abs(energy))
@@ -307,8 +308,9 @@ def test_poor_eigenbasis_with_a_dropped_direction_is_refused(problem):
     H, S = m["T_ti"] + m["V"], m["S"]
     sol = eigen.solve(H, S)
     assert sol.kept == len(S) - 1
-    poor = eigen.Eigen(np.full_like(sol.energies, sol.energies[0] + 1e-12), sol.vectors, sol.kept,
-                       sol.overlap_condition)
+    C = sol.vectors.copy()
+    C[:, 0] += 1e-6 * C[:, 1]  # a lowest vector 1e-6 off, whatever LAPACK's kernel gave
+    poor = eigen.Eigen(np.full_like(sol.energies, sol.energies[0] + 1e-12), C, sol.kept, sol.overlap_condition)
     with pytest.raises(LinearDependenceError, match="cannot resolve this basis \\(overlap condition"):
         eigen.refine(H, S, poor)
 
