@@ -4,14 +4,18 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 import prebo
+from prebo.errors import InputError
 from prebo.optimise import Cursor, Optimiser
+from prebo.optimise.adaptive import Adaptive
 from prebo.optimise.defaults import resolved
 from prebo.optimise.fixed import Fixed
+from prebo.optimise.schedule import kind_of
 from conftest import ROOT
 
 INPUT = """
@@ -152,14 +156,62 @@ def test_fixed_schedule():
     assert schedule.restart("grow", 2, 0.0, -1.0) is None and schedule.resume(c, "budget", 2, -0.5, 1.0) == (c, "budget")
 
 
-def test_a_fixed_schedule_stores_the_schedule_block_of_an_adaptive_one_before_its_first_pass():
-    """One "schedule" block format for both kinds, as every checkpoint so far holds it."""
-    from prebo.optimise.adaptive import Adaptive
+def test_a_fixed_schedule_stores_its_own_schedule_block_and_reads_the_older_ones():
+    """A fixed schedule's checkpoint holds its own "schedule" block; that of the checkpoints before
+    it (an adaptive schedule's before its first pass, fixed.IDLE) and none are read too; another
+    kind's block is refused, not read as the adaptive one's."""
+    from prebo.optimise.fixed import IDLE
     from prebo.optimise.schedule import schedule_of
     opts = resolved(Optimiser(size=2, sweeps=1), prebo.System(["p", "e"]))
-    assert Fixed(opts).to_dict() == Adaptive(opts).to_dict()
-    assert isinstance(schedule_of(opts, json.loads(json.dumps(Fixed(opts).to_dict()))), Fixed)
+    assert Fixed(opts).to_dict() == {"schedule": "fixed"} != Adaptive(opts).to_dict()
+    for block in (Fixed(opts).to_dict(), IDLE, None):
+        assert isinstance(schedule_of(opts, json.loads(json.dumps(block))), Fixed)
+    with pytest.raises(ValueError, match="schedule"):
+        schedule_of(opts, Adaptive(opts).to_dict() | {"restarts": 1})
     assert isinstance(schedule_of(resolved(Optimiser(size=2), prebo.System(["p", "e"]))), Adaptive)
+
+
+def test_the_schedule_kind_is_explicit_or_implied_as_before_and_contradictions_are_refused():
+    """[optimiser] schedule names the kind; without it a fixed-schedule setting implies the fixed
+    one (the inputs before it); a setting of the other kind is refused in one line naming it."""
+    he = prebo.System(["alpha", "e", "e"])
+    assert kind_of(Optimiser()) is Adaptive and kind_of(Optimiser(polish=1)) is Fixed
+    assert kind_of(Optimiser(schedule="fixed")) is Fixed and kind_of(Optimiser(schedule="adaptive", tolerance=1e-9)) is Adaptive
+    explicit = resolved(Optimiser(schedule="fixed"), he)
+    assert [getattr(explicit, k) for k in ("prune", "sweeps", "refine", "polish", "cycles")] == [0, 0, 0, 0, 1]
+    assert resolved(Optimiser(schedule="adaptive"), he) == replace(resolved(Optimiser(), he), schedule="adaptive")
+    with pytest.raises(InputError, match=r"^\[optimiser\] sweeps = 2: a setting of the fixed schedule, but "
+                                               r"schedule = 'adaptive'$"):
+        Optimiser(schedule="adaptive", sweeps=2)
+    with pytest.raises(InputError, match=r"^\[optimiser\] tolerance = 1e-09: a setting of the adaptive"):
+        Optimiser(schedule="fixed", tolerance=1e-9)
+    with pytest.raises(InputError, match="schedule"):
+        Optimiser(schedule="steady")
+
+
+@pytest.mark.parametrize("kind", ["fixed", "adaptive"])
+def test_a_progress_block_written_before_the_cursor_fields_had_one_meaning_is_read(kind):
+    """Before, `sweep` held an adaptive growth pass's target and a sweep pass's count, `cycle` its
+    pass number, and a fixed pruning's `index` said growth (0) or removal (1): each schedule reads
+    those blocks into the fields of one meaning."""
+    opts = resolved(Optimiser(size=10, prune=2, refine=1) if kind == "fixed" else Optimiser(size=10),
+                    prebo.System(["p", "e"]))
+    s = Fixed(opts) if kind == "fixed" else Adaptive(opts)
+    new = Cursor("refine", index=4, sweep=1, cycle=2, number=3, visited=5)
+    assert s.cursor(json.loads(json.dumps(new.to_dict())), 10) == new
+    if kind == "fixed":
+        assert s.cursor({"phase": "prune", "sweep": 0, "index": 0, "cycle": 1}, 10) == Cursor("prune", target=12, cycle=1)
+        assert s.cursor({"phase": "prune", "sweep": 0, "index": 1, "cycle": 1}, 11) == Cursor("prune", target=10, cycle=1)
+        assert s.cursor({"phase": "refine", "sweep": 1, "index": 4, "cycle": 2}, 10) == Cursor("refine", index=4, sweep=1,
+                                                                                               cycle=2)
+        assert s.cursor({"phase": "grow", "sweep": 0, "index": 0, "cycle": 0}, 3) == s.first()
+    else:
+        assert s.cursor({"phase": "grow", "sweep": 9, "index": 0, "cycle": 3}, 8) == Cursor("grow", target=9, number=3)
+        assert s.cursor({"phase": "sweep", "sweep": 6, "index": 7, "cycle": 4}, 10) == Cursor("sweep", index=7, number=4,
+                                                                                              visited=6)
+        assert s.cursor({"phase": "prune", "sweep": 0, "index": 0, "cycle": 5}, 10) == s.begin("prune", 10, 5)
+    with pytest.raises(TypeError):
+        s.cursor({"phase": "grow", "steps": 1}, 3)
 
 
 def test_a_fixed_schedule_repeats_the_block_after_growth_in_cycles():
@@ -178,12 +230,13 @@ def test_each_cycle_grows_past_the_size_and_prunes_back_first():
     schedule = Fixed(opts)
     c, seen, nb = schedule.first(), [], 0
     while c.phase != "done":
-        seen.append((c.phase, c.index, c.cycle, nb))
-        nb += 1 if c.phase == "grow" or (c.phase == "prune" and c.index == 0) else -1 if c.phase == "prune" else 0
+        seen.append((c.phase, c.target, c.index, c.cycle, nb))
+        nb += 1 if c.phase == "grow" or (c.phase == "prune" and nb < c.target) else -1 if c.phase == "prune" else 0
         c = schedule.advance(c, nb, -0.5, 0.0)
-    block = [("prune", 0, 3), ("prune", 0, 4), ("prune", 1, 5), ("prune", 1, 4)] + [("refine", i, 3) for i in range(3)]
-    assert seen == [("grow", 0, 0, k) for k in range(3)] + [(p, i, cycle, n) for cycle in (0, 1)
-                                                           for p, i, n in block]
+    block = [("prune", 5, 0, 3), ("prune", 5, 0, 4), ("prune", 3, 0, 5), ("prune", 3, 0, 4)] + [("refine", 0, i, 3)
+                                                                                                for i in range(3)]
+    assert seen == [("grow", 3, 0, 0, k) for k in range(3)] + [(p, t, i, cycle, n) for cycle in (0, 1)
+                                                              for p, t, i, n in block]
 
 
 def test_pruning_removes_the_function_that_costs_least():
@@ -201,17 +254,18 @@ def test_pruning_removes_the_function_that_costs_least():
     fresh = np.array([ex.without(i).energies[0] for i in range(40)])
     assert np.all(without >= ex.energy) and np.allclose(without, fresh, rtol=1e-13, atol=0)
     cheapest = int(np.argmin(fresh))
-    S = ex.m["S"]
+    S = ex.m.S
     overlap = np.abs(S[cheapest]) / np.sqrt(S[cheapest, cheapest] * np.diag(S))
     overlap[cheapest] = 0
     partner = int(np.argmax(overlap)) - (int(np.argmax(overlap)) > cheapest)  # its index after the removal
     kept = ex.basis.subset(np.flatnonzero(np.arange(40) != cheapest))
     opts = resolved(Optimiser(size=39, prune=1, refine=1), basis.system)
-    PruneStep(Grow(5), Minimiser(5, "gradient")).step(Run(ex, None, Reporter(opts, False, 40)), Cursor("prune", index=1))
+    PruneStep(Grow(5), Minimiser(5, "gradient")).step(Run(ex, None, Reporter(opts, False, 40)),
+                                                       Cursor("prune", target=39))
     moved = [k for k in range(39) if not np.array_equal(ex.basis.A[k], kept.A[k])]
     assert len(ex.basis) == 39 and moved == [partner] and ex.energy < fresh[cheapest]
     rebuilt = laboratory(basis.system).matrices(ex.basis)
-    assert all(np.array_equal(rebuilt[k], ex.m[k]) for k in rebuilt)
+    assert all(np.array_equal(rebuilt[k], getattr(ex.m, k)) for k in rebuilt)
 
 
 def test_each_phase_has_its_method_configured_by_the_settings():
@@ -290,7 +344,7 @@ def test_a_batch_keeps_each_change_only_if_it_still_gains_after_the_ones_before(
                                                                 Cursor("refine"))
     assert visited == 3 and ex.energy == changes(0, 2) < energy(0)
     rebuilt = rep.matrices(ex.basis)
-    assert all(np.array_equal(rebuilt[k], ex.m[k]) for k in rebuilt)
+    assert all(np.array_equal(rebuilt[k], getattr(ex.m, k)) for k in rebuilt)
 
 
 def test_refinement_and_learning_lower_the_energy():
@@ -320,12 +374,12 @@ def test_patched_matrices_have_the_bits_of_a_full_build(kind, extra):
     _, rows, diag = st.candidates(b.subset([4]))
     assert st.put(4, b.subset([4]), {k: v[0] for k, v in rows.items()}, diag[0])
     keep = np.arange(5) != 1
-    sub = eigen.solve((st.m["T_ti"] + st.m["V"])[np.ix_(keep, keep)], st.m["S"][np.ix_(keep, keep)])
+    sub = eigen.solve((st.m.T_ti + st.m.V)[np.ix_(keep, keep)], st.m.S[np.ix_(keep, keep)])
     _, rows, diag = st.candidates(b.subset([1]), exclude=1, eig=sub)
     assert st.put(1, b.subset([1]), {k: v[0] for k, v in rows.items()}, diag[0])
     full = rep.matrices(st.basis)
     for k in full:
-        assert np.array_equal(full[k], st.m[k]), k
+        assert np.array_equal(full[k], getattr(st.m, k)), k
 
 
 def test_a_change_within_the_numerical_uncertainty_is_refused():
@@ -339,14 +393,14 @@ def test_a_change_within_the_numerical_uncertainty_is_refused():
     rep = laboratory(basis.system)
     st = Expansion(basis, rep, 1e-13)
     assert st.sigma > 1e-10
-    A0, m0, e0 = st.basis.A.copy(), {k: v.copy() for k, v in st.m.items()}, st.energy
+    A0, m0, e0 = st.basis.A.copy(), st.m.map(np.copy).to_dict(), st.energy
     for i in (0, 17, 42):
         f = st.basis.subset([i])
         f.A[0] *= 1 + 1e-10
         rows, diag = rep.rows(f, st.basis, i)
         assert not st.put(i, f, {k: v[0] for k, v in rows.items()}, diag[0])
         assert np.array_equal(st.basis.A, A0) and st.energy == e0
-        assert all(np.array_equal(st.m[k], m0[k]) for k in m0)
+        assert all(np.array_equal(getattr(st.m, k), m0[k]) for k in m0)
     small = Expansion(basis.subset(np.arange(len(basis) - 1)), rep, 1e-13)
     last = basis.subset([len(basis) - 1])
     _, rows, diag = small.candidates(last)
@@ -437,7 +491,7 @@ def test_a_change_must_gain_a_hundred_times_what_it_adds_to_the_uncertainty():
         ex.energy, ex.sigma = E0 - gain, sigma
         assert ex.keep_if_lower(before) == kept, (gain, sigma)
         ex.energy, ex.sigma = E0, sigma0
-    before = ex.snapshot()[:4] + (1e-13,)  # an uncertain basis may still grow by what pays its small additions
+    before = replace(ex.snapshot(), sigma=1e-13)  # an uncertain basis may still grow by what pays its small additions
     ex.energy, ex.sigma = E0 - 2e-13, 1.01e-13
     assert ex.keep_if_lower(before)
 
@@ -456,16 +510,16 @@ def test_the_progress_line_is_what_the_schedule_says():
     """The progress line's description and counts come from the schedule (Schedule.progress): a
     fixed schedule counts the functions of a sweep and the steps of a joint pass, the adaptive one
     the functions of a pass of at most CHUNK; growth counts functions to the size in both."""
-    from prebo.optimise.adaptive import CHUNK, Adaptive
+    from prebo.optimise.adaptive import CHUNK
     from prebo.optimise.fixed import Fixed
     opts = Optimiser(size=80, polish=4)
     fixed, adaptive = Fixed(opts), Adaptive(opts)
     assert fixed.progress(Cursor("grow"), 30) == adaptive.progress(Cursor("grow"), 30) == ("growing", 30, 80)
     assert fixed.progress(Cursor("refine", sweep=1, index=9, cycle=2), 80) == ("refine 2 (cycle 3)", 10, 80)
     assert fixed.progress(Cursor("polish", sweep=2, cycle=0), 80) == ("polish (cycle 1)", 3, 4)
-    assert fixed.progress(Cursor("prune", index=1, cycle=0), 83) == ("prune (cycle 1)", 3, opts.prune)
-    assert adaptive.progress(Cursor("sweep", sweep=4, cycle=6), 80) == ("sweep (pass 7)", 5, min(CHUNK, 80))
-    assert adaptive.progress(Cursor("momentum", cycle=1), 80) == ("momentum (pass 2)", 1, 1)
+    assert fixed.progress(Cursor("prune", target=80, cycle=0), 83) == ("prune (cycle 1)", 3, opts.prune)
+    assert adaptive.progress(Cursor("sweep", visited=4, number=6), 80) == ("sweep (pass 7)", 5, min(CHUNK, 80))
+    assert adaptive.progress(Cursor("momentum", number=1), 80) == ("momentum (pass 2)", 1, 1)
 
 def test_a_growth_step_refines_the_newcomer_before_it_joins_and_solves_once(monkeypatch):
     """A grown function is refined against the basis it joins, then appended: one eigen-solution
@@ -486,7 +540,7 @@ def test_a_growth_step_refines_the_newcomer_before_it_joins_and_solves_once(monk
     raw = float(np.min(ex.candidates(trials)[0]))
     solves, solve = [], eigen.solve
     monkeypatch.setattr(eigen, "solve", lambda *a, **k: solves.append(1) or solve(*a, **k))
-    Grow(5, Minimiser(30, "gradient")).step(Run(ex, sampler, Reporter(opts, False, 6)), Cursor("grow", sweep=7))
+    Grow(5, Minimiser(30, "gradient")).step(Run(ex, sampler, Reporter(opts, False, 6)), Cursor("grow", target=7))
     assert len(ex.basis) == 7 and len(solves) == 1
     assert ex.energy < raw - 1e-9
 
@@ -516,8 +570,8 @@ def test_history_rows_are_named_in_memory_and_stored_as_they_were(tmp_path):
     steps = [Step(*row) for row in check_history(json.loads(json.dumps(rows)))]
     assert [(h.size, h.energy, h.phase, h.seconds) for h in steps] == [(1, -0.4, "grow", None), (2, -0.45, "grow", 1.5),
                                                                         (2, -0.47, "refine", 3.0)]
-    assert steps[1] == Step(2, -0.45, "grow", 1.5) and len(Step(1, -0.4, "grow")) == 3
-    write_json_atomic(tmp_path / "h.json", {"history": steps})
+    assert steps[1] == Step(2, -0.45, "grow", 1.5) and Step(1, -0.4, "grow").row() == [1, -0.4, "grow"]
+    write_json_atomic(tmp_path / "h.json", {"history": [step.row() for step in steps]})
     written = (tmp_path / "h.json").read_text()
     write_json_atomic(tmp_path / "h.json", {"history": rows})
     assert written == (tmp_path / "h.json").read_text() and len(written.splitlines()) == 4 + len(rows)  # a row per line
@@ -538,7 +592,8 @@ def test_a_function_grown_past_the_size_is_refined_with_its_partners(monkeypatch
     calls, group = [], m.refine_group
     monkeypatch.setattr(m, "refine_group", lambda st, i, size, *a: calls.append((i, size)) or group(st, i, size, *a))
     step = m.methods(opts)["prune"]
-    step.step(m.Run(ex, Sampler(system, opts, np.random.default_rng(5)), Reporter(opts, False, 6)), Cursor("prune"))
+    step.step(m.Run(ex, Sampler(system, opts, np.random.default_rng(5)), Reporter(opts, False, 6)),
+              Cursor("prune", target=8))
     assert len(ex.basis) == 7 and calls == [(6, 3)]
 
 
@@ -554,14 +609,14 @@ def test_an_adaptive_pruning_keeps_the_size_and_is_undone_unless_it_gains(monkey
     system = prebo.System(["p", "e", "e"], spin={"e": 0})
     basis = prebo.optimise(system, Optimiser(size=20, trials=5, seed=4, sweeps=0), progress=False)  # grown only
     opts = resolved(Optimiser(size=20, trials=10, seed=5), system)
-    assert opts.adaptive and isinstance(m.methods(opts)["prune"], m.PrunePass)
+    assert kind_of(opts) is Adaptive and isinstance(m.methods(opts)["prune"], m.PrunePass)
     ex = Expansion(basis, laboratory(system), 1e-13)
     run = m.Run(ex, Sampler(system, opts, np.random.default_rng(5)), Reporter(opts, False, 20),
                 momentum=m.Momentum(basis))
     E0, grown, removed = ex.energy, [], []
     monkeypatch.setattr(m.Expansion, "remove", lambda st, i, f=m.Expansion.remove: grown.append(len(st.basis))
                         or removed.append(i) or f(st, i))
-    m.methods(opts)["prune"].step(run, Cursor("prune"))
+    m.methods(opts)["prune"].step(run, Adaptive(opts).begin("prune", 20, 0))
     assert len(ex.basis) == 20 and grown == [22, 21] and ex.energy < E0  # pruned(20) = 2
     origin = np.delete(np.delete(np.r_[np.arange(20), [-1, -1]], removed[0]), removed[1])  # -1: grown
     reference = run.momentum.reference  # the momentum's reference follows the survivors (momentum.Momentum.follow)
@@ -569,7 +624,7 @@ def test_an_adaptive_pruning_keeps_the_size_and_is_undone_unless_it_gains(monkey
                                         for k, j in enumerate(origin))
     before, E1 = ex.basis.subset(slice(None)), ex.energy
     monkeypatch.setattr(m.np, "argmin", np.argmax)  # the removals now cost the most
-    m.methods(opts)["prune"].step(run, Cursor("prune"))
+    m.methods(opts)["prune"].step(run, Adaptive(opts).begin("prune", 20, 0))
     assert len(ex.basis) == 20 and ex.energy == E1 and np.array_equal(ex.basis.A, before.A)
 
 

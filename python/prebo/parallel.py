@@ -37,6 +37,7 @@ from functools import lru_cache
 import numpy as np
 
 from .errors import NotPositiveDefiniteError, RanksDivergedError, UnsupportedError
+from .matrices import NAMES
 
 #: environment variables by which MPI launchers (MPICH/Hydra and Slurm's PMI, Open MPI, PMIx) give
 #: the number of ranks
@@ -205,7 +206,7 @@ def refusing(engine, trials: tuple, params: tuple, position: int | None) -> tupl
     except NotPositiveDefiniteError:
         k, nb = len(trials[0]), len(params[0])
         if k == 1:
-            return {name: np.full((1, nb), np.nan) for name in ("S", "T", "T_ti", "V")}, np.full((1, 4), np.nan)
+            return {name: np.full((1, nb), np.nan) for name in NAMES}, np.full((1, len(NAMES)), np.nan)
     parts = [refusing(engine, take(trials, slice(i, i + 1)), params, position) for i in range(k)]
     return joined([rows for rows, _ in parts], axis=0), np.concatenate([diag for _, diag in parts])
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from .history import Step
 from .methods import stalled
+from .schedule import kind_of
 from .settings import Optimiser
 
 RECENT = 10
@@ -48,9 +49,9 @@ def convergence(history: list[Step], opts: Optimiser, stopped: str | None, secon
     steps = [h for h in history if h.seconds is not None]
     pruned = [k for k in range(1, len(steps)) if steps[k].size < steps[k - 1].size]
     steps = steps[pruned[-1]:] if pruned else steps
-    report = {"stopped": stopped, "seconds": seconds, "adaptive": opts.adaptive, "advantage": advantage,
-              "recent": None, "extrapolation": None,
-              "stalled": None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts, condition, sigma)}}
+    why = None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts, condition, sigma)}
+    report = ({"stopped": stopped, "seconds": seconds} | kind_of(opts).report(advantage)
+              | {"recent": None, "extrapolation": None, "stalled": why})
     if len(steps) >= 2:
         last = steps[-min(RECENT + 1, len(steps)):]
         gain, span = last[0].energy - last[-1].energy, last[-1].seconds - last[0].seconds

@@ -136,11 +136,11 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         if out is not None:
             objective = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
             ex.basis.save(Path(out) / CHECKPOINT, {
-                "energy": ex.lowest_root, "optimiser": opts.to_dict(), "progress": vars(cursor),
-                "rng": rng.bit_generator.state, "history": history, "elapsed": seconds,
+                "energy": ex.lowest_root, "optimiser": opts.to_dict(), "progress": cursor.to_dict(),
+                "rng": rng.bit_generator.state, "history": [step.row() for step in history], "elapsed": seconds,
                 "schedule": schedule.to_dict(), "stopped": stopped, "momentum": run.momentum.to_dict()}
                 | ({} if ex.objective.lowest else {"objective": objective, "levels": list(ex.objective.roots),
-                                                   "followed": followed}))
+                                                   "followed": [f.row() for f in followed]}))
 
     with run.report, eigen.lapack_threads(opts.size):
         while cursor.phase != "done":
@@ -156,8 +156,8 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                     raise
                 run.stalled = 0
             if ex.followed is not None:  # a targeted level moved to another root (objective.py, following)
-                followed.append([wall(), *map(list, ex.followed)])
-                run.report.followed(*ex.followed)
+                followed.append(replace(ex.followed, seconds=wall()))
+                run.report.followed(ex.followed.before, ex.followed.after)
                 ex.followed = None
             if ex.energy < old:
                 history.append(Step(len(ex.basis), ex.energy, cursor.phase, wall()))
@@ -182,7 +182,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     best.convergence = convergence(history, opts, stopped, wall(), schedule.stalled, schedule.advantage(len(ex.basis)),
                                    ex.eig.overlap_condition, ex.sigma)
     if not ex.objective.lowest:
-        best.convergence |= {"levels": list(ex.objective.roots), "followed": followed}
+        best.convergence |= {"levels": list(ex.objective.roots), "followed": [f.row() for f in followed]}
     return best
 
 
