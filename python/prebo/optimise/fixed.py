@@ -10,9 +10,9 @@ from .settings import FIXED, Optimiser
 
 #: the fixed schedule's settings where the input leaves them out: no pruning, sweeps or joint steps, one cycle
 SETTINGS = dict(zip(FIXED, (0, 0, 0, 0, 1)))
-#: a "schedule" block of checkpoints written before the fixed schedule had one of its own: an empty
-#: adaptive schedule's (adaptive.Adaptive.to_dict)
-IDLE = {"passes": [], "start": [None, 0.0], "next": {"refine": 0, "sweep": 0}, "stalled": None, "restarts": 0}
+#: the "schedule" block of checkpoints written before the fixed schedule had one of its own: an empty
+#: adaptive schedule's (adaptive.Adaptive.to_dict), with "restarts": 0 in the later ones
+IDLE = {"passes": [], "start": [None, 0.0], "next": {"refine": 0, "sweep": 0}, "stalled": None}
 
 
 class Fixed:
@@ -154,6 +154,8 @@ class Fixed:
     def check(cls, opts: Optimiser, block) -> Fixed:
         """The schedule of a checkpoint's "schedule" block (`to_dict`; IDLE in checkpoints written
         before it, none in older ones); ValueError for another."""
-        if block is not None and block != IDLE and block != {"schedule": cls.name}:
+        idle = isinstance(block, dict) and block.get("restarts", 0) == 0 and block.keys() - {"restarts"} == IDLE.keys() \
+            and all(block[k] == v for k, v in IDLE.items())
+        if not (block is None or idle or block == {"schedule": cls.name}):
             raise ValueError(f"schedule = {block!r}: must be {{schedule: {cls.name}}} for a fixed schedule")
         return cls(opts)
