@@ -16,7 +16,7 @@ among the ranks and gathered, so that every rank goes on with the same bits:
 Every element is evaluated by the core exactly as in one process, so the matrices and rows of R
 ranks equal one rank's bit for bit; what is done with them (eigen-solutions, objectives,
 minimisers) is repeated on every rank from the same bits. The run's clock is rank 0's (`agreed`),
-so that decisions taken by time (budget, adaptive schedule) are the same on every rank.
+so that decisions taken by time (budget, the choices of a schedule by rates) are the same on every rank.
 
 Threads: unless RAYON_NUM_THREADS is set, each rank's core uses its node's cores divided by the
 node's ranks, so that ranks x threads does not oversubscribe it; LAPACK stays on one thread below

@@ -94,13 +94,23 @@ PRUNE = 20
 RESTART_AT = 20
 #: the most fresh starts of one run
 RESTARTS = 2
-#: competitive trials per step (defaults.py)
+#: competitive trials per step (defaults.py): a trial costs one row of N_b integrals and the winner's
+#: refinement EVALUATIONS energies with gradients, (1 + P) rows each, so a wider competition is nearly
+#: free and picks better functions (H2 with 300 functions after 600 s: 6.7e-7 and 7.2e-7 Eh above
+#: with 100 trials against 1.2e-6 and 2.4e-6 with 30; He with 400 in 300 s: 7.5e-10 and 8.7e-10
+#: against 1.3–2.1e-9 with 20; benchmarks/README, "Trials in the adaptive schedule")
 TRIALS = 100
-#: energies per refinement of one function (defaults.py)
+#: energies per refinement of one function: L-BFGS converges a function in 15–40 (benchmarks/README)
 EVALUATIONS = 30
-#: functions a refinement pass moves together (defaults.py)
+#: functions a refinement pass moves together: each with the GROUP − 1 it overlaps most
+#: (near-duplicate partners hold a lone function in place; benchmarks/README, "The H2 campaign" and
+#: issue 17's rows)
 GROUP = 3
-#: the share of an atom's growth trials drawn near the basis (defaults.py)
+#: the share of an atom's growth trials that perturb functions of the basis at their own scale, its
+#: sweeps then trying moves of the function replaced only (sampler.py): He with 700 functions in
+#: 300 s, 5.1–6.0e-11 Eh above in three runs against 2.7–6.0e-10 with every trial drawn
+#: (benchmarks/README, "Trials near the basis"); 0 for molecules (H2⁺ from defaults ended at 5.5e-7
+#: with it, 5.6e-8 without: the perturbations keep u and K)
 NEAR = 0.5
 
 

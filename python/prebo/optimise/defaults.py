@@ -12,29 +12,14 @@ None), from the physics of the particles:
   the paper's tables were computed with (30); 0 for atoms;
 - channels: every coordinate set for molecules (functions drawn in Jacobi and heavy-particle
   coordinates reach the vibrating nuclei), the particle pairs otherwise;
-- trials per step: adaptive.TRIALS in the adaptive schedule — a trial costs one row of N_b integrals and
-  the winner's refinement 30 energies with gradients, (1 + P) rows each, so a wider competition
-  is nearly free and picks better functions (H2 with 300 functions after 600 s: 6.7e-7 and
-  7.2e-7 Eh above with 100 trials against 1.2e-6 and 2.4e-6 with 30; He with 400 in 300 s:
-  7.5e-10 and 8.7e-10 against 1.3–2.1e-9 with 20;
-  benchmarks/README, "Trials in the adaptive schedule"); in a fixed one 20, or 30 for molecules;
-- near: adaptive.NEAR of an atom's growth trials in the adaptive schedule perturb functions of the basis
-  at their own scale, and its sweeps try moves of the function replaced only (sampler.py): He
-  with 700 functions in 300 s, 5.1–6.0e-11 Eh above in three runs against 2.7–6.0e-10 with every
-  trial drawn (benchmarks/README, "Trials near the basis"); 0 for molecules (H2⁺ from defaults
-  ended at 5.5e-7 with it, 5.6e-8 without: the perturbations keep u and K) and in a fixed
-  schedule, whose runs are reproduced as they were measured;
-- refine_evaluations: adaptive.EVALUATIONS (30) in the adaptive schedule (L-BFGS converges a function in 15–40
-  energies, benchmarks/README), 200 in a fixed one;
-- refine_group: adaptive.GROUP in the adaptive schedule, whose refinement passes then move each function
-  with the GROUP − 1 it overlaps most (near-duplicate partners hold a lone function in place;
-  benchmarks/README, "The H2 campaign" and issue 17's rows), 1 in a fixed one;
+- trials per step, refinement energies and groups, trials near the basis: the kind of
+  schedule's (schedule.kind_of, its `defaults`), with their reasons beside them (fixed.py and
+  the other kind's module), each depending on whether the system is a molecule;
 - batch: the number of MPI ranks (parallel.py; 1 in one process), each working on one function
   of a sweep's batch; kept in the checkpoint, so a run resumed on another number of ranks goes on
   as it would have;
-- the schedule's own settings: the fixed schedule's missing ones at 0, 0, 0, 0 and 1
+- the fixed schedule's own settings, when it is the kind: the missing ones at 0, 0, 0, 0 and 1
   (fixed.SETTINGS).
-Each value that depends on the kind of schedule (schedule.kind_of) is the kind's (`defaults`).
 """
 from __future__ import annotations
 

@@ -34,7 +34,8 @@ class Fixed:
     def defaults(opts: Optimiser, molecule: bool) -> dict:
         """The settings the schedule chooses where the input leaves them out (defaults.py): 20
         trials per step (30 for a `molecule`), 200 energies per refinement, one function at a time,
-        no trials near the basis, and SETTINGS."""
+        no trials near the basis (the runs of the fixed schedule are reproduced as they were
+        measured), and SETTINGS."""
         return {"trials": 30 if molecule else 20, "refine_evaluations": 200, "refine_group": 1, "near": 0.0} | SETTINGS
 
     @staticmethod

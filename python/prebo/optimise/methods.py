@@ -22,8 +22,8 @@ phase of the cursor names the method (`methods`).
   Eh against −1.5e-11 … 7.7e-11 without; benchmarks/README, "Pruning that refines after each
   removal"): pruning a basis grown past its size keeps the functions that matter and moves the
   basis out of the basin refinement has settled in (benchmarks/README, "Grow and prune").
-- `PrunePass` ("prune", adaptive schedule): a whole pruning, growth steps up to the cursor's
-  target (adaptive.pruned) and the removals back to N_b, in one step, undone unless the energy fell: the schedule's size is a cap
+- `PrunePass` ("prune", a schedule whose pruning is one step, `whole_pruning`): a whole pruning,
+  growth steps up to the cursor's target and the removals back to N_b, in one step, undone unless the energy fell: the schedule's size is a cap
   at every step and its energy never rises.
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed, or with the
   functions it overlaps most (`refine_group`; refine.py), as `Minimiser` says.
@@ -32,10 +32,10 @@ phase of the cursor names the method (`methods`).
   gains.
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
 - `MomentumMove` ("momentum"): the basis moved on along its displacement since the last move
-  (momentum.py; adaptive schedule).
+  (momentum.py; a schedule that `moves`).
 Replacements and pruning reach new basins, joint refinement converges within one; the
-prune-sweep-refine-polish block is repeated `cycles` times (fixed.py), or the adaptive schedule
-chooses among grow, sweep, refine, polish and prune and moves the basis on (adaptive.py).
+prune-sweep-refine-polish block is repeated `cycles` times (fixed.py), or the schedule chooses
+among grow, sweep, refine, polish and prune by their rates and moves the basis on (schedule.py).
 """
 from __future__ import annotations
 
