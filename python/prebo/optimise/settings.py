@@ -117,7 +117,8 @@ class Optimiser:
     joint and pruning passes by the energy each gains per second), stopping at `budget` seconds,
     or when every kind of pass gains less than `tolerance` Eh; "fixed" (fixed.py) runs the
     settings FIXED; not given (inputs written before it), fixed if any of FIXED is given, else
-    adaptive (schedule.kind_of), and a setting of the other kind is refused: prune — functions grown
+    adaptive (schedule.kind_of); given, a setting of the other kind (FIXED, ADAPTIVE) is refused.
+    prune — functions grown
     past `size` and then removed, those whose removal costs least, at the start of each cycle; sweeps — replacement
     sweeps per cycle; refine — refinement sweeps per cycle (and refinement of every grown or
     replacing function when > 0); polish — joint L-BFGS steps per cycle; cycles — repetitions of
