@@ -51,7 +51,8 @@ def test_the_schedule_kind_is_explicit_or_implied_as_before_and_contradictions_a
     one (the inputs before it); a setting of the other kind is refused in one line naming it."""
     he = prebo.System(["alpha", "e", "e"])
     assert kind_of(Optimiser()) is Adaptive and kind_of(Optimiser(polish=1)) is Fixed
-    assert kind_of(Optimiser(schedule="fixed")) is Fixed and kind_of(Optimiser(schedule="adaptive", tolerance=1e-9)) is Adaptive
+    assert kind_of(Optimiser(schedule="fixed")) is Fixed
+    assert kind_of(Optimiser(schedule="adaptive", tolerance=1e-9)) is Adaptive
     explicit = resolved(Optimiser(schedule="fixed"), he)
     assert [getattr(explicit, k) for k in ("prune", "sweeps", "refine", "polish", "cycles")] == [0, 0, 0, 0, 1]
     assert resolved(Optimiser(schedule="adaptive"), he) == replace(resolved(Optimiser(), he), schedule="adaptive")
@@ -75,15 +76,16 @@ def test_a_progress_block_written_before_the_cursor_fields_had_one_meaning_is_re
     new = Cursor("refine", index=4, sweep=1, cycle=2, number=3, visited=5)
     assert s.cursor(json.loads(json.dumps(new.to_dict())), 10) == new
     if kind == "fixed":
-        assert s.cursor({"phase": "prune", "sweep": 0, "index": 0, "cycle": 1}, 10) == Cursor("prune", target=12, cycle=1)
-        assert s.cursor({"phase": "prune", "sweep": 0, "index": 1, "cycle": 1}, 11) == Cursor("prune", target=10, cycle=1)
-        assert s.cursor({"phase": "refine", "sweep": 1, "index": 4, "cycle": 2}, 10) == Cursor("refine", index=4, sweep=1,
-                                                                                               cycle=2)
+        growing, removing = {"phase": "prune", "sweep": 0, "index": 0, "cycle": 1}, {"index": 1}
+        assert s.cursor(growing, 10) == Cursor("prune", target=12, cycle=1)
+        assert s.cursor(growing | removing, 11) == Cursor("prune", target=10, cycle=1)
+        refine = {"phase": "refine", "sweep": 1, "index": 4, "cycle": 2}
+        assert s.cursor(refine, 10) == Cursor("refine", index=4, sweep=1, cycle=2)
         assert s.cursor({"phase": "grow", "sweep": 0, "index": 0, "cycle": 0}, 3) == s.first()
     else:
         assert s.cursor({"phase": "grow", "sweep": 9, "index": 0, "cycle": 3}, 8) == Cursor("grow", target=9, number=3)
-        assert s.cursor({"phase": "sweep", "sweep": 6, "index": 7, "cycle": 4}, 10) == Cursor("sweep", index=7, number=4,
-                                                                                              visited=6)
+        sweep = {"phase": "sweep", "sweep": 6, "index": 7, "cycle": 4}
+        assert s.cursor(sweep, 10) == Cursor("sweep", index=7, number=4, visited=6)
         assert s.cursor({"phase": "prune", "sweep": 0, "index": 0, "cycle": 5}, 10) == s.begin("prune", 10, 5)
     with pytest.raises(TypeError):
         s.cursor({"phase": "grow", "steps": 1}, 3)

@@ -155,8 +155,8 @@ class Fixed:
     def check(cls, opts: Optimiser, block) -> Fixed:
         """The schedule of a checkpoint's "schedule" block (`to_dict`; IDLE in checkpoints written
         before it, none in older ones); ValueError for another."""
-        idle = isinstance(block, dict) and block.get("restarts", 0) == 0 and block.keys() - {"restarts"} == IDLE.keys() \
-            and all(block[k] == v for k, v in IDLE.items())
+        idle = (isinstance(block, dict) and block.get("restarts", 0) == 0
+                and block.keys() - {"restarts"} == IDLE.keys() and all(block[k] == v for k, v in IDLE.items()))
         if not (block is None or idle or block == {"schedule": cls.name}):
             raise ValueError(f"schedule = {block!r}: must be {{schedule: {cls.name}}} for a fixed schedule")
         return cls(opts)

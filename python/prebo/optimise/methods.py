@@ -13,9 +13,10 @@ phase of the cursor names the method (`methods`).
   perturbed at its own scale, or random functions with `near` = 0 (Sampler.replacements);
   with `newcomer`, the winner is refined and kept only if it then beats the incumbent, which is
   refined otherwise (refine.regenerate_function).
-- `PruneStep` ("prune", fixed schedule): growth past the size up to the cursor's target (as `Grow`, each grown function then refined with the functions
-  it overlaps most, so that it joins the basis before the removals are weighed; without that the
-  cheapest to remove are the newcomers themselves), then the removal of the function whose
+- `PruneStep` ("prune", fixed schedule): growth past the size up to the cursor's target (as
+  `Grow`, each grown function then refined with the functions it overlaps most, so that it joins
+  the basis before the removals are weighed; without that the cheapest to remove are the
+  newcomers themselves), then the removal of the function whose
   removal raises the energy least (eigen.root_without_each), one per step back to the size,
   the function that overlapped it most then refined with its partners to take over its part
   (H2 with 500 ECG-GVR functions at 1.2e-8 Eh above, 12 grown and removed: the net gain 6.3–9.5e-11
@@ -23,8 +24,8 @@ phase of the cursor names the method (`methods`).
   removal"): pruning a basis grown past its size keeps the functions that matter and moves the
   basis out of the basin refinement has settled in (benchmarks/README, "Grow and prune").
 - `PrunePass` ("prune", a schedule whose pruning is one step, `whole_pruning`): a whole pruning,
-  growth steps up to the cursor's target and the removals back to N_b, in one step, undone unless the energy fell: the schedule's size is a cap
-  at every step and its energy never rises.
+  growth steps up to the cursor's target and the removals back to N_b, in one step, undone
+  unless the energy fell: the schedule's size is a cap at every step and its energy never rises.
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed, or with the
   functions it overlaps most (`refine_group`; refine.py), as `Minimiser` says.
 - A sweep's step (`Replace`, `Refine`) can take a batch of functions at once (`together`): each
