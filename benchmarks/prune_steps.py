@@ -50,7 +50,7 @@ def main() -> None:
             steps = []
             for _ in range(a.grow):
                 before, ts = ex.energy, time.perf_counter()
-                prune.step(run, Cursor("prune", index=0))
+                prune.add(run, Cursor("prune"))
                 steps.append(f"{before - ex.energy:.1e} ({time.perf_counter() - ts:.1f} s)")
             print(f"seed {seed}: growth steps {', '.join(steps)}")
             grown, t1, costs = E0 - ex.energy, time.perf_counter() - t0, []

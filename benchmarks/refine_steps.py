@@ -53,7 +53,7 @@ from prebo.optimise.sampler import Sampler
 
 def survey(ex: Expansion, group: int, stride: int) -> None:
     """Print each sampled group's independence (rest solve, eigen-solution) and offset."""
-    H, S = ex.m["T_ti"] + ex.m["V"], ex.m["S"]
+    H, S = ex.m.H, ex.m.S
     below = []
     for i in range(0, len(ex.basis), stride):
         idx = [i] + partners(ex, i, group - 1)

@@ -36,7 +36,7 @@ def main() -> None:
     d, system, opts = load_checkpoint(a.checkpoint)
     basis, *_ = resumed(d, opts, np.random.default_rng(0), a.checkpoint)
     ex = Expansion(basis, laboratory(system), opts.threshold)
-    H, S = ex.m["T_ti"] + ex.m["V"], ex.m["S"]
+    H, S = ex.m.H, ex.m.S
     d = 1.0 / np.sqrt(np.diag(S))
     Ss, Hs = S * np.outer(d, d), H * np.outer(d, d)
     with threadpool_limits(1, user_api="blas"):

@@ -1,5 +1,6 @@
 import itertools
 import json
+import time
 from pathlib import Path
 
 import numpy as np
@@ -77,3 +78,46 @@ def random_centres(system, nb, rng, cm_free=False, scale=0.5) -> np.ndarray:
     if cm_free:
         s -= np.einsum("i,bic->bc", system.cm_vector, s)[:, None, :]
     return s
+
+
+#: a short fixed-schedule run of H⁻ (ECG-GVR functions, every kind of step) to kill and resume
+#: (test_optimise.py, test_mpi.py)
+INPUT = """
+[system]
+particles = ["p", "e", "e"]
+[state]
+spin = { e = 0 }
+[basis]
+type = "ecg-gvr"
+size = 10
+K_max = 3
+[optimiser]
+trials = 6
+sweeps = 1
+refine = 1
+refine_evaluations = 30
+refine_group = 2
+polish = 2
+polish_iterations = 5
+cycles = 2
+seed = 7
+channels = "all"
+"""
+
+
+def functions(folder):
+    return json.loads((folder / "basis.json").read_text())["functions"]
+
+
+def mid_schedule(folder, seconds: float = 120) -> None:
+    """Wait, at most `seconds`, until the run writing folder/basis.json has left growth or holds six
+    functions: a point in the middle of INPUT's schedule to kill it at."""
+    deadline = time.time() + seconds
+    while time.time() < deadline:
+        try:
+            progress = json.loads((folder / "basis.json").read_text())["progress"]
+            if progress["phase"] != "grow" or len(functions(folder)) >= 6:
+                return
+        except (OSError, json.JSONDecodeError, KeyError):
+            pass
+        time.sleep(0.01)

@@ -60,11 +60,11 @@ def test_a_crossing_in_a_group_refinement_keeps_the_target():
     c_before = ex.eig.vectors[:, 1]
     moved = [hydrogen_s([a])[0] for a in (0.03, 2e-4)]
     assert ex.put_group([6, 7], moved)
-    assert ex.followed == ((1,), (2,)) and ex.objective.roots == (2,)
+    assert (ex.followed.before, ex.followed.after) == ((1,), (2,)) and ex.objective.roots == (2,)
     assert ex.energy == ex.eig.energies[2] and before - 2e-3 < ex.energy < before - 1e-3
     naive = Expansion(ex.basis, rep, 4 * 2.0**-53, objective=Levels((1,)))
     assert naive.energy < before - 0.08  # what the index alone would have taken for a gain
-    S = ex.m["S"]
+    S = ex.m.S
     overlap = (np.concatenate([c_before[:6], [0, 0]]) @ S @ ex.eig.vectors[:, :3]) ** 2
     assert np.argmax(overlap) == 2 and overlap[2] > 0.5
     basis, _ = hydrogen_s(tight + idle)  # put_group changed the first in place
@@ -78,7 +78,7 @@ def test_a_level_is_never_followed_below_its_target():
     basis, _ = hydrogen_s([0.2, 0.6, 1.8, 5.4, 16.0, 4e-4, 0.03])
     ex = Expansion(basis, laboratory(basis.system), 4 * 2.0**-53, objective=Levels((1,), threshold=0.0))
     vectors = ex.eig.vectors[:, [0]]  # a level that looks like root 0 in every respect
-    assert ex.objective.follow((vectors, ex.eig.energies[[0]]), ex.m["S"], ex.eig) == (1,)
+    assert ex.objective.follow((vectors, ex.eig.energies[[0]]), ex.m.S, ex.eig) == (1,)
 
 
 @pytest.mark.parametrize("state, message", [

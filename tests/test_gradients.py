@@ -104,7 +104,7 @@ def test_independence_from_the_eigen_solution_matches_the_schur_complement_of_th
     p = Parametrisation.of(basis.subset([0]))
     basis.append(p.function(p.theta() + 1e-5 * np.random.default_rng(1).standard_normal(len(p.theta()))))
     st = Expansion(basis, laboratory(system), 1e-14)
-    S = st.m["S"]
+    S = st.m.S
     for idx in ([3, 5], [0, len(basis) - 1], [2]):
         rest = np.setdiff1d(np.arange(len(basis)), idx)
         O = S[np.ix_(idx, idx)] - S[np.ix_(idx, rest)] @ np.linalg.solve(S[np.ix_(rest, rest)], S[np.ix_(rest, idx)])
@@ -121,7 +121,7 @@ def test_independence_from_the_eigen_solution_matches_the_schur_complement_of_th
 def test_partners_are_the_functions_of_largest_normalised_overlap():
     system, basis, _, _ = setup("gvr-H2+", nb=15)
     st = Expansion(basis, laboratory(system), 1e-13)
-    S = st.m["S"]
+    S = st.m.S
     assert partners(st, 3, 2) == [int(j) for j in np.argsort(-np.abs(S[3]) / np.sqrt(S[3, 3] * np.diag(S)))[1:3]]
 
 
@@ -155,7 +155,7 @@ def assert_matrices_exact(st):
     """The expansion's matrices have the bits of a rebuild and its energy is their eigenvalue."""
     fresh = st.rep.matrices(st.basis)
     for k in fresh:
-        assert np.array_equal(fresh[k], st.m[k]), k
+        assert np.array_equal(fresh[k], getattr(st.m, k)), k
     assert st.energy == eigen.solve(fresh["T_ti"] + fresh["V"], fresh["S"], 1e-13).energies[0]
 
 
@@ -216,7 +216,7 @@ def test_extreme_parameters_are_refused_not_collapsed():
     obj = FunctionEnergy(st, len(basis) - 1)
     assert obj.energy(extreme) == obj.worse and obj.energy_and_gradient(extreme)[0] == obj.worse
     rows, diag = st.rep.rows(p.function(theta), basis.subset(range(6)))
-    S_b = np.diag(st.m["S"])[:6]
+    S_b = np.diag(st.m.S)[:6]
     assert st.rep.plausible(rows, diag, S_b)[0]
     for k, bad in [(0, 3.0), (1, -1.0), (2, -1e-3)]:  # S_nn above Σ|c_P| = 2, negative kinetic energies
         d = diag.copy()

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from test_optimise import INPUT, functions, mid_schedule
+from conftest import INPUT, functions, mid_schedule
 
 pytest.importorskip("mpi4py")
 MPIEXEC = shutil.which("mpiexec") or pytest.skip("no mpiexec on the PATH", allow_module_level=True)

@@ -14,10 +14,11 @@ from prebo import eigen
 from prebo.basis import Basis
 from prebo.optimise import Cursor, Optimiser, resume_from
 from prebo.optimise.convergence import convergence
-from prebo.optimise.defaults import GROUP, TRIALS, resolved
+from prebo.optimise.defaults import resolved
+from prebo.optimise.schedule import kind_of
 from prebo.optimise.sampler import pair_lengths
 from prebo.optimise.momentum import EVERY
-from prebo.optimise.adaptive import CHUNK, PRUNE, RATIO, REVISIT, Adaptive, Pass, pruned
+from prebo.optimise.adaptive import CHUNK, GROUP, PRUNE, RATIO, REVISIT, TRIALS, Adaptive, Pass, pruned
 from prebo.optimise.fixed import Fixed
 from prebo.optimise.history import Step
 
@@ -65,10 +66,10 @@ def test_explicit_settings_override_and_any_schedule_setting_fixes_the_schedule(
     h2 = prebo.System(["p", "p", "e", "e"])
     opts = resolved(Optimiser(kind="pecg", channels="pairs", trials=7, K_max=2), h2)
     assert (opts.kind, opts.channels, opts.trials, opts.K_max) == ("pecg", "pairs", 7, 2)
-    assert opts.adaptive and opts.refine_evaluations == 30 and opts.sweeps is None
+    assert kind_of(opts) is Adaptive and opts.refine_evaluations == 30 and opts.sweeps is None
     assert opts.refine_group == GROUP > 1  # the adaptive refinement passes move groups
     fixed = resolved(Optimiser(refine=2), h2)
-    assert not fixed.adaptive and (fixed.sweeps, fixed.refine, fixed.polish, fixed.cycles) == (0, 2, 0, 1)
+    assert kind_of(fixed) is Fixed and (fixed.sweeps, fixed.refine, fixed.polish, fixed.cycles) == (0, 2, 0, 1)
     assert fixed.refine_evaluations == 200 and fixed.refine_group == 1
     assert resolved(Optimiser(refine_group=1), h2).refine_group == 1  # given, it stays
     assert resolved(fixed, h2) == fixed and resolved(opts, h2) == opts  # a checkpoint's settings stay
@@ -128,29 +129,29 @@ def now(schedule):
 
 def test_growth_first_then_every_kind_once_then_the_best_rate():
     s = Adaptive(resolved(Optimiser(size=100), prebo.System(["alpha", "e", "e"])))
-    assert s.first() == Cursor("grow", sweep=8)
+    assert s.first() == Cursor("grow", target=8)
     assert s.choose(0, np.inf, now(s)) == "grow"
     E = passes(s, ("grow", 8, None, 1.0))
-    assert [s.choose(8, E, now(s)), s.begin("refine", 8, 1)] == ["refine", Cursor("refine", cycle=1)]
+    assert [s.choose(8, E, now(s)), s.begin("refine", 8, 1)] == ["refine", Cursor("refine", number=1)]
     E = passes(s, ("refine", 8, 1e-3, 1.0), ("sweep", 8, 1e-3, 2.0), ("polish", 8, 1e-4, 1.0))
     assert s.choose(8, E, now(s)) == "grow"  # the first growth pass: no energy before it, an unbounded rate
     E = passes(s, ("grow", 16, 1e-4, 1.0))  # growth slows: refinement (1e-3 Eh/s) pays best now
     assert s.choose(16, E, now(s)) == "refine"
-    assert s.begin("grow", 80, 9) == Cursor("grow", sweep=100, cycle=9)  # a quarter, capped at size
+    assert s.begin("grow", 80, 9) == Cursor("grow", target=100, number=9)  # a quarter, capped at size
 
 
 def test_a_pass_ends_after_a_chunk_and_the_next_sweep_goes_on_where_it_stopped():
     opts = resolved(Optimiser(size=120), prebo.System(["alpha", "e", "e"]))
     s = Adaptive(opts)
     passes(s, ("grow", 120, None, 1.0), ("refine", 120, 1e-3, 1.0), ("sweep", 120, 1e-3, 1.0), ("polish", 120, 1, 1))
-    c = Cursor("refine", index=100, cycle=4)
+    c = Cursor("refine", index=100, number=4)
     for k in range(CHUNK - 1):
         c = s.advance(c, 120, -3.0, 20.0)
-        assert (c.phase, c.sweep, c.index) == ("refine", k + 1, (101 + k) % 120)
+        assert (c.phase, c.visited, c.index) == ("refine", k + 1, (101 + k) % 120)
     c = s.advance(c, 120, -3.0, 20.0)
-    assert s.passes[-1].kind == "refine" and s.passes[-1].functions == CHUNK and c.cycle == 5
+    assert s.passes[-1].kind == "refine" and s.passes[-1].functions == CHUNK and c.number == 5
     assert s.next["refine"] == (100 + CHUNK) % 120 and s.begin("refine", 120, 6).index == 30
-    grow = Cursor("grow", sweep=10, cycle=7)
+    grow = Cursor("grow", target=10, number=7)
     assert s.advance(grow, 9, -3.0, 21.0) == grow  # growth goes on to its target size
 
 
@@ -160,13 +161,13 @@ def test_a_batch_of_refinements_moves_a_sweep_on_by_the_functions_it_visited():
     opts = resolved(Optimiser(size=120), prebo.System(["alpha", "e", "e"]))
     s = Adaptive(opts)
     passes(s, ("grow", 120, None, 1.0), ("refine", 120, 1e-3, 1.0), ("sweep", 120, 1e-3, 1.0), ("polish", 120, 1, 1))
-    c = s.advance(Cursor("refine", index=100, cycle=4), 120, -3.0, 20.0, functions=20)
-    assert (c.phase, c.sweep, c.index) == ("refine", 20, 0)
+    c = s.advance(Cursor("refine", index=100, number=4), 120, -3.0, 20.0, functions=20)
+    assert (c.phase, c.visited, c.index) == ("refine", 20, 0)
     c = s.advance(c, 120, -3.0, 20.0, functions=CHUNK - 20)
-    assert s.passes[-1].functions == CHUNK and s.next["refine"] == CHUNK - 20 and c.cycle == 5
+    assert s.passes[-1].functions == CHUNK and s.next["refine"] == CHUNK - 20 and c.number == 5
     fixed = Fixed(resolved(Optimiser(size=5, refine=2), prebo.System(["p", "e"])))
-    assert fixed.advance(Cursor("refine", 0, 0), 5, -0.5, 1.0, functions=3) == Cursor("refine", 0, 3)
-    assert fixed.advance(Cursor("refine", 0, 3), 5, -0.5, 1.0, functions=2) == Cursor("refine", 1, 0)
+    assert fixed.advance(Cursor("refine"), 5, -0.5, 1.0, functions=3) == Cursor("refine", index=3)
+    assert fixed.advance(Cursor("refine", index=3), 5, -0.5, 1.0, functions=2) == Cursor("refine", sweep=1)
 
 
 def test_a_pruning_is_one_pass_of_one_step_at_full_size():
@@ -176,7 +177,7 @@ def test_a_pruning_is_one_pass_of_one_step_at_full_size():
     assert pruned(120) == 12 and pruned(500) == PRUNE and pruned(5) == 1
     c = s.advance(s.begin("prune", 120, 4), 120, -3.5, 6.0)
     p = s.passes[-1]
-    assert (p.kind, p.size, p.after, p.end, p.functions) == ("prune", 120, -3.5, 6.0, 120) and c.cycle == 5  # visits every function
+    assert (p.kind, p.size, p.after, p.end, p.functions) == ("prune", 120, -3.5, 6.0, 120) and c.number == 5  # visits every function
 
 
 def test_at_full_size_the_basis_moves_on_after_every_EVERY_passes_that_moved_functions_since_a_move_or_pruning():

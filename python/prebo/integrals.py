@@ -9,7 +9,7 @@
 - `translationally_invariant(system, coords)`: TICC of a coordinate set x, kinetic
   matrix μ, exponents 𝒜 (possible only when every function shares one c_A).
 
-Each representation returns dict(S, T, T_ti, V) of normalised functions (hartree atomic units)
+Each representation returns dict(S, T, T_ti, V) (matrices.NAMES) of normalised functions (hartree atomic units)
 from the engine of the basis's family (`Family.engine`, one per family and N); under MPI the
 ranks share a build's or a row's elements (parallel.py), with the bits of one process.
 
@@ -33,6 +33,7 @@ import numpy as np
 
 from .coordinates import CoordinateSet, jacobi
 from .errors import CancellationError, SeparabilityError
+from .matrices import NAMES
 from .parallel import Ranks, world
 from .system import System
 
@@ -163,7 +164,7 @@ class Representation:
     @staticmethod
     def diagonal(m: dict) -> np.ndarray:
         """The diagonal [S, T, T_ti, V] of matrices `m`, one row per function (what `resolved` reads)."""
-        return np.stack([np.diag(m[k]) for k in ("S", "T", "T_ti", "V")], axis=1)
+        return np.stack([np.diag(m[k]) for k in NAMES], axis=1)
 
     def require_resolved(self, m: dict) -> None:
         """Refuse (CancellationError, naming the first such function) matrices `m` of a basis with a

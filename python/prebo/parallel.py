@@ -16,7 +16,7 @@ among the ranks and gathered, so that every rank goes on with the same bits:
 Every element is evaluated by the core exactly as in one process, so the matrices and rows of R
 ranks equal one rank's bit for bit; what is done with them (eigen-solutions, objectives,
 minimisers) is repeated on every rank from the same bits. The run's clock is rank 0's (`agreed`),
-so that decisions taken by time (budget, adaptive schedule) are the same on every rank.
+so that decisions taken by time (budget, the choices of a schedule by rates) are the same on every rank.
 
 Threads: unless RAYON_NUM_THREADS is set, each rank's core uses its node's cores divided by the
 node's ranks, so that ranks x threads does not oversubscribe it; LAPACK stays on one thread below
@@ -37,6 +37,7 @@ from functools import lru_cache
 import numpy as np
 
 from .errors import NotPositiveDefiniteError, RanksDivergedError, UnsupportedError
+from .matrices import NAMES
 
 #: environment variables by which MPI launchers (MPICH/Hydra and Slurm's PMI, Open MPI, PMIx) give
 #: the number of ranks
@@ -205,7 +206,7 @@ def refusing(engine, trials: tuple, params: tuple, position: int | None) -> tupl
     except NotPositiveDefiniteError:
         k, nb = len(trials[0]), len(params[0])
         if k == 1:
-            return {name: np.full((1, nb), np.nan) for name in ("S", "T", "T_ti", "V")}, np.full((1, 4), np.nan)
+            return {name: np.full((1, nb), np.nan) for name in NAMES}, np.full((1, len(NAMES)), np.nan)
     parts = [refusing(engine, take(trials, slice(i, i + 1)), params, position) for i in range(k)]
     return joined([rows for rows, _ in parts], axis=0), np.concatenate([diag for _, diag in parts])
 

@@ -49,7 +49,7 @@ KEYS = ("format", "version", "conventions", "system", "symmetry", "basis_type", 
 #: every function's arrays beside its family's extras (name -> shape, "n": particles); and a channel
 COMMON = {"A": ("n", "n"), "c_A": ()}
 #: bytes allowed per function (twice a checkpoint's two copies of a function of 8 particles) and
-#: for a run's history (2.8 million rows, 50 days of an adaptive run of H2)
+#: for a run's history (2.8 million rows, 50 days of one run of H2)
 FUNCTION_BYTES, HISTORY_BYTES = 8 << 10, 128 << 20
 #: the largest file `read_text` reads: MAX_SIZE functions and a history
 MAX_BYTES = MAX_SIZE * FUNCTION_BYTES + HISTORY_BYTES

@@ -3,8 +3,8 @@
 settings (Optimiser, SETTINGS) → sampler (random functions) → expansion (the basis with its
 matrices and eigen-solution; objective: the roots the methods lower, and their following) → methods (grow, replace,
 refine, prune, polish, momentum: small configs, each one unit of work) run by the one driver
-(`optimise`) where the schedule says (schedule: the interface; fixed and adaptive: its two
-kinds; cursor: the next unit of work) → history and convergence (the report), checkpoint (the
+(`optimise`) where the schedule says (schedule: the interface and its kinds, a module each;
+cursor: the next unit of work) → history and convergence (the report), checkpoint (the
 run's files), resume (a run read back), lowest (the lowest state passed through) and report
 (the live line). parametrisation, refine and polish hold the θ ↔ function mapping and the local
 and joint minimisers the methods use; momentum the move along the basis's displacement.

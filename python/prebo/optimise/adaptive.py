@@ -49,7 +49,7 @@ benchmarks/README, "Trials in the adaptive schedule"); a fixed schedule (any of 
 polish, cycles given) repeats bit for bit.
 
 The passes (`Pass`: stored as [kind, n_b, E before, E after, seconds before, seconds after,
-functions]), the start of the pass in flight, [E, seconds], where each sweep goes on and the size
+functions]), the start of the pass in flight (`Start`, stored as [E, seconds]), where each sweep goes on and the size
 at which growth stalled (None) are kept in the checkpoint, so a resumed run goes on with what it
 had learned (`check` reads them back).
 
@@ -64,9 +64,9 @@ The run still returns the lowest state it passed through (lowest.Lowest).
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from dataclasses import astuple, dataclass, fields
 
-from .cursor import Cursor
+from .cursor import OLD, Cursor
 from .momentum import EVERY
 from .settings import Optimiser
 
@@ -94,12 +94,32 @@ PRUNE = 20
 RESTART_AT = 20
 #: the most fresh starts of one run
 RESTARTS = 2
+#: competitive trials per step (defaults.py): a trial costs one row of N_b integrals and the winner's
+#: refinement EVALUATIONS energies with gradients, (1 + P) rows each, so a wider competition is nearly
+#: free and picks better functions (H2 with 300 functions after 600 s: 6.7e-7 and 7.2e-7 Eh above
+#: with 100 trials against 1.2e-6 and 2.4e-6 with 30; He with 400 in 300 s: 7.5e-10 and 8.7e-10
+#: against 1.3–2.1e-9 with 20; benchmarks/README, "Trials in the adaptive schedule")
+TRIALS = 100
+#: energies per refinement of one function: L-BFGS converges a function in 15–40 (benchmarks/README)
+EVALUATIONS = 30
+#: functions a refinement pass moves together: each with the GROUP − 1 it overlaps most
+#: (near-duplicate partners hold a lone function in place; benchmarks/README, "The H2 campaign" and
+#: issue 17's rows)
+GROUP = 3
+#: the share of an atom's growth trials that perturb functions of the basis at their own scale, its
+#: sweeps then trying moves of the function replaced only (sampler.py): He with 700 functions in
+#: 300 s, 5.1–6.0e-11 Eh above in three runs against 2.7–6.0e-10 with every trial drawn
+#: (benchmarks/README, "Trials near the basis"); 0 for molecules (H2⁺ from defaults ended at 5.5e-7
+#: with it, 5.6e-8 without: the perturbations keep u and K)
+NEAR = 0.5
 
 
-class Pass(NamedTuple):
+@dataclass(frozen=True, slots=True)
+class Pass:
     """One pass of the schedule: its `kind`, the basis `size` after it, the energy `before` it (Eh;
     None for the first, from no function) and `after` it, the run's seconds at its `start` and
-    `end`, and the `functions` it visited (every one for growth and a joint step)."""
+    `end`, and the `functions` it visited (every one for growth and a joint step); stored as the
+    list of its fields (`row`)."""
 
     kind: str
     size: int
@@ -119,6 +139,23 @@ class Pass(NamedTuple):
         """Energy gained per second."""
         return self.gain / max(self.end - self.start, 1e-3)
 
+    def row(self) -> list:
+        """The checkpoint's row of the pass."""
+        return list(astuple(self))
+
+
+@dataclass(frozen=True, slots=True)
+class Start:
+    """Where the pass in flight started: the `energy` (Eh; None before the first function) and the
+    run's `seconds`; stored as [E, seconds] (`row`)."""
+
+    energy: float | None
+    seconds: float
+
+    def row(self) -> list:
+        """The checkpoint's "start" of the schedule block."""
+        return [self.energy, self.seconds]
+
 
 def pruned(size: int) -> int:
     """The functions a pruning pass grows past `size` and removes: PRUNE, at most a tenth of the basis."""
@@ -129,12 +166,42 @@ class Adaptive:
     """The adaptive schedule of `opts` (module docstring; the interface of schedule.Schedule);
     `passes`, `start` and `next` (the function each sweep goes on with) from a checkpoint."""
 
-    def __init__(self, opts: Optimiser, passes: list | None = None, start: list | None = None,
+    #: the schedule's name, its [optimiser] schedule value
+    name = "adaptive"
+    #: a pruning is one unit of work, undone unless it gains (methods.PrunePass)
+    whole_pruning = True
+    #: the basis moves on along its displacement (momentum.py)
+    moves = True
+
+    def __init__(self, opts: Optimiser, passes: list | None = None, start: Start | None = None,
                  next: dict | None = None, stalled: int | None = None, restarts: int = 0):
         self.opts, self.stalled, self.stopped, self.restarts = opts, stalled, None, restarts
-        self.passes = [Pass(*p) for p in passes or []]
-        self.start = list(start) if start is not None else [None, 0.0]  # no energy before the first function
+        self.passes = list(passes or [])
+        self.start = start or Start(None, 0.0)  # no energy before the first function
         self.next = dict(next or {"refine": 0, "sweep": 0})
+
+    @staticmethod
+    def defaults(opts: Optimiser, molecule: bool) -> dict:
+        """The settings the schedule chooses where the input leaves them out (defaults.py): TRIALS,
+        EVALUATIONS, GROUP, and NEAR for an atom (0 for a `molecule`); no fixed-schedule settings."""
+        return {"trials": TRIALS, "refine_evaluations": EVALUATIONS, "refine_group": GROUP,
+                "near": 0.0 if molecule else NEAR}
+
+    @staticmethod
+    def refines_newcomers(opts: Optimiser) -> bool:
+        """Every grown and replacing function is refined first (methods.methods)."""
+        return True
+
+    @staticmethod
+    def beyond(opts: Optimiser) -> int:
+        """The functions a checkpoint may hold past the size: none, a pruning being one step
+        (methods.PrunePass; resume.py)."""
+        return 0
+
+    @staticmethod
+    def report(advantage: float | None) -> dict:
+        """The convergence report's schedule entries (convergence.py)."""
+        return {"adaptive": True, "advantage": advantage}
 
     @property
     def size(self) -> int:
@@ -161,11 +228,26 @@ class Adaptive:
         return self.begin("grow", 0, 0)
 
     def begin(self, kind: str, nb: int, number: int) -> Cursor:
-        """The cursor at the start of pass `number` of `kind` on a basis of `nb` functions: a growth
-        pass keeps its target size in `sweep`, a sweep pass its count of functions visited."""
+        """The cursor at the start of pass `number` of `kind` on a basis of `nb` functions: growth
+        targets a quarter more (at least GROWTH, at most the size), a pruning `pruned(nb)` functions
+        more, a sweep goes on where the last pass of its kind stopped."""
         if kind == "grow":
-            return Cursor("grow", sweep=min(self.size, nb + max(GROWTH, nb // 4)), cycle=number)
-        return Cursor(kind, index=self.next.get(kind, 0) % max(nb, 1), cycle=number)
+            return Cursor("grow", target=min(self.size, nb + max(GROWTH, nb // 4)), number=number)
+        if kind == "prune":
+            return Cursor("prune", target=nb + pruned(nb), number=number)
+        return Cursor(kind, index=self.next.get(kind, 0) % max(nb, 1), number=number)
+
+    def cursor(self, progress, nb: int) -> Cursor:
+        """The cursor of a checkpoint's "progress" block on a basis of `nb` functions (Cursor.to_dict),
+        also of one written before each field had one meaning (cursor.OLD: a growth pass's target
+        and a sweep pass's functions visited in `sweep`, the pass in `cycle`); TypeError or
+        InputError for one that is malformed."""
+        if not (isinstance(progress, dict) and set(progress) <= OLD):
+            return Cursor(**progress)
+        old = Cursor(**progress)
+        target = {"grow": old.sweep, "prune": nb + pruned(nb)}.get(old.phase, 0)
+        visited = old.sweep if old.phase in ("sweep", "refine") else 0
+        return Cursor(old.phase, target=target, index=old.index, number=old.cycle, visited=visited)
 
     def resume(self, cursor: Cursor, stopped: str | None, nb: int, energy: float,
                now: float) -> tuple[Cursor, str | None]:
@@ -188,18 +270,18 @@ class Adaptive:
         """The unit of work after the one at `cursor`, which visited `functions` functions of a
         sweep and left `nb` functions at `energy` after `now` seconds of the run; at the end of a
         pass it is recorded and the next one chosen."""
-        phase, visited = cursor.phase, cursor.sweep + functions
-        if phase == "grow" and nb < min(cursor.sweep, self.size):
+        phase, visited = cursor.phase, cursor.visited + functions
+        if phase == "grow" and nb < min(cursor.target, self.size):
             return cursor
         if phase in ("sweep", "refine"):
             self.next[phase] = (cursor.index + functions) % nb
             if visited < min(CHUNK, nb):
-                return Cursor(phase, visited, self.next[phase], cursor.cycle)
+                return Cursor(phase, index=self.next[phase], number=cursor.number, visited=visited)
         functions = visited if phase in ("sweep", "refine") else nb
-        self.passes.append(Pass(phase, nb, self.start[0], energy, self.start[1], now, functions))
-        self.start = [energy, now]
+        self.passes.append(Pass(phase, nb, self.start.energy, energy, self.start.seconds, now, functions))
+        self.start = Start(energy, now)
         kind = self.choose(nb, energy, now)
-        return Cursor("done") if kind is None else self.begin(kind, nb, cursor.cycle + 1)
+        return Cursor("done") if kind is None else self.begin(kind, nb, cursor.number + 1)
 
     def rates(self) -> dict:
         """Each kind's rate (Eh/s), that of its last pass with its share of the move after it
@@ -298,13 +380,13 @@ class Adaptive:
         in the pass (one step for a whole-basis pass)."""
         if cursor.phase == "grow":
             return "growing", nb, self.opts.size
-        done, total = (cursor.sweep + 1, min(CHUNK, nb)) if cursor.phase not in ("polish", "prune", "momentum") else (1, 1)
-        return f"{cursor.phase} (pass {cursor.cycle + 1})", done, total
+        done, total = (cursor.visited + 1, min(CHUNK, nb)) if cursor.phase not in ("polish", "prune", "momentum") else (1, 1)
+        return f"{cursor.phase} (pass {cursor.number + 1})", done, total
 
     def to_dict(self) -> dict:
         """The checkpoint's "schedule" block (a pass as the list of its fields)."""
-        return {"passes": self.passes, "start": self.start, "next": self.next, "stalled": self.stalled,
-                "restarts": self.restarts}
+        return {"passes": [p.row() for p in self.passes], "start": self.start.row(), "next": self.next,
+                "stalled": self.stalled, "restarts": self.restarts}
 
     @classmethod
     def check(cls, opts: Optimiser, block) -> "Adaptive":
@@ -322,8 +404,11 @@ class Adaptive:
         def seconds(t):
             return isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t) and t >= 0
 
+        def began(e, t):
+            return energy(e) and seconds(t)
+
         def one(p):
-            if not (isinstance(p, list) and len(p) == len(Pass._fields)):
+            if not (isinstance(p, list) and len(p) == len(fields(Pass))):
                 return False
             p = Pass(*p)
             return (p.kind in ("grow", "momentum") + IMPROVE and count(p.size) and energy(p.before)
@@ -334,10 +419,10 @@ class Adaptive:
                                         block.get("stalled")) if isinstance(block, dict) else (None,) * 4)
         restarts = block.get("restarts", 0) if isinstance(block, dict) else 0  # absent before session 21
         if not (isinstance(passes, list) and all(map(one, passes)) and isinstance(start, list) and len(start) == 2
-                and energy(start[0]) and seconds(start[1]) and isinstance(nxt, dict)
+                and began(*start) and isinstance(nxt, dict)
                 and set(nxt) == {"refine", "sweep"} and all(map(count, nxt.values()))
                 and (stalled is None or count(stalled)) and count(restarts)):
             raise ValueError("schedule must be {passes: [[kind, n_b, E before, E after, t before, t after, "
                              "functions], ...], start: [E, t], next: {refine: i, sweep: j}, stalled: n_b or null, "
                              "restarts: n}")
-        return cls(opts, passes, start, nxt, stalled, restarts)
+        return cls(opts, [Pass(*p) for p in passes], Start(*start), nxt, stalled, restarts)

@@ -2,13 +2,13 @@
 steps (history.Step), since the last pruning (a basis grown past its size and pruned
 back starts again from a higher energy; methods.PruneStep):
 
-- `stopped`: why the run ended, a key of STOPPED (the adaptive schedule's reasons are those of
-  adaptive.py) — and `seconds` of optimisation over every segment of the run;
-- `advantage`: in an adaptive run at full size, how many times faster than the best kind of pass
-  growth was gaining at the end (adaptive.Adaptive.advantage; above 1/RATIO a larger basis is
-  the better use of time), else None;
-- `stalled`: where growth of an adaptive schedule stopped short of `size` (every trial refused;
-  the basis kept the size it reached), with the settings to change, or None;
+- `stopped`: why the run ended, a key of STOPPED (each schedule's reasons, schedule.py) — and
+  `seconds` of optimisation over every segment of the run;
+- the kind of schedule and its `advantage` (the kind's `report`): where the schedule measures
+  rates, at full size, how many times faster than the best kind of pass growth was gaining at the
+  end (Schedule.advantage; above 1/RATIO a larger basis is the better use of time), else None;
+- `stalled`: where growth stopped short of `size` in a schedule that goes on (Schedule.stall:
+  every trial refused; the basis kept the size it reached), with the settings to change, or None;
 - `recent`: the energy gained by the last RECENT accepted steps, the seconds they span and the
   gain rate in Eh/s;
 - `extrapolation`: from the energies E₁, E₂, E₃ at three equally spaced times between the end of
@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from .history import Step
 from .methods import stalled
+from .schedule import kind_of
 from .settings import Optimiser
 
 RECENT = 10
@@ -43,14 +44,14 @@ def convergence(history: list[Step], opts: Optimiser, stopped: str | None, secon
                 stalled_at: int | None = None, advantage: float | None = None, condition: float = 0.0,
                 sigma: float = 0.0) -> dict:
     """The report of a run with `history` (module docstring); `stalled_at`: the size at which growth
-    stalled; `advantage`: that of the adaptive schedule; `condition`, `sigma`: the basis's overlap
+    stalled; `advantage`: the schedule's (Schedule.advantage); `condition`, `sigma`: the basis's overlap
     condition and energy uncertainty (Eh)."""
     steps = [h for h in history if h.seconds is not None]
     pruned = [k for k in range(1, len(steps)) if steps[k].size < steps[k - 1].size]
     steps = steps[pruned[-1]:] if pruned else steps
-    report = {"stopped": stopped, "seconds": seconds, "adaptive": opts.adaptive, "advantage": advantage,
-              "recent": None, "extrapolation": None,
-              "stalled": None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts, condition, sigma)}}
+    why = None if stalled_at is None else {"size": stalled_at, "why": stalled(stalled_at, opts, condition, sigma)}
+    report = ({"stopped": stopped, "seconds": seconds} | kind_of(opts).report(advantage)
+              | {"recent": None, "extrapolation": None, "stalled": why})
     if len(steps) >= 2:
         last = steps[-min(RECENT + 1, len(steps)):]
         gain, span = last[0].energy - last[-1].energy, last[-1].seconds - last[0].seconds

@@ -2,7 +2,7 @@
 the checkpoint's "progress" block."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, fields
 
 from ..errors import InputError
 
@@ -10,22 +10,40 @@ from ..errors import InputError
 PHASES = ("grow", "prune", "sweep", "refine", "polish", "momentum", "done")
 
 
-@dataclass
+@dataclass(frozen=True, slots=True)
 class Cursor:
-    """The next unit of work: one competitive step ("grow"); one step of growth past the size
-    (`index` 0) or one removal (1) ("prune"), function `index` of replacement sweep / refinement
-    sweep `sweep` ("sweep", "refine"), joint-refinement step `sweep` ("polish") of the
-    prune-sweep-refine-polish block `cycle`, a move along the basis's displacement ("momentum",
-    adaptive schedule only), or "done". The adaptive schedule keeps a growth pass's target size
-    in `sweep` and its pass number in `cycle` (adaptive.py)."""
+    """The next unit of work: its `phase` — one competitive step ("grow"), one step of a pruning
+    ("prune"), one step of a replacement or refinement sweep ("sweep", "refine"), a joint step
+    ("polish"), a move along the basis's displacement ("momentum", adaptive schedule only), or
+    "done" — and, each with one meaning, what the schedules keep of it:
+
+    - `target`: the size the basis heads for: growth adds functions up to it; a pruning grows
+      up to it and removes functions while the basis is larger (fixed.py), or grows by
+      `target` − N_b steps and removes as many again (methods.PrunePass);
+    - `index`: the function a sweep's step starts at;
+    - `sweep`: the sweep of its phase, or the joint step, within the cycle (fixed schedule);
+    - `cycle`: the prune-sweep-refine-polish block (fixed schedule);
+    - `number`: the pass of the adaptive schedule (adaptive.py);
+    - `visited`: the functions of the pass visited so far (adaptive schedule's sweeps)."""
 
     phase: str = "grow"
-    sweep: int = 0
+    target: int = 0
     index: int = 0
+    sweep: int = 0
     cycle: int = 0
+    number: int = 0
+    visited: int = 0
 
     def __post_init__(self):
-        counts = (self.sweep, self.index, self.cycle)
+        counts = [getattr(self, f.name) for f in fields(self)][1:]
         if self.phase not in PHASES or not all(type(k) is int and k >= 0 for k in counts):
-            raise InputError(f"progress {vars(self)}: phase must be one of {', '.join(PHASES)}, "
-                             "sweep, index and cycle non-negative integers")
+            raise InputError(f"progress {self.to_dict()}: phase must be one of {', '.join(PHASES)}, "
+                             f"{', '.join(f.name for f in fields(self)[1:])} non-negative integers")
+
+    def to_dict(self) -> dict:
+        """The checkpoint's "progress" block."""
+        return asdict(self)
+
+
+#: the fields of a "progress" block written before each had one meaning (read by the schedules' `cursor`)
+OLD = {"phase", "sweep", "index", "cycle"}

@@ -12,28 +12,14 @@ None), from the physics of the particles:
   the paper's tables were computed with (30); 0 for atoms;
 - channels: every coordinate set for molecules (functions drawn in Jacobi and heavy-particle
   coordinates reach the vibrating nuclei), the particle pairs otherwise;
-- trials per step: TRIALS in the adaptive schedule — a trial costs one row of N_b integrals and
-  the winner's refinement 30 energies with gradients, (1 + P) rows each, so a wider competition
-  is nearly free and picks better functions (H2 with 300 functions after 600 s: 6.7e-7 and
-  7.2e-7 Eh above with 100 trials against 1.2e-6 and 2.4e-6 with 30; He with 400 in 300 s:
-  7.5e-10 and 8.7e-10 against 1.3–2.1e-9 with 20;
-  benchmarks/README, "Trials in the adaptive schedule"); in a fixed one 20, or 30 for molecules;
-- near: NEAR of an atom's growth trials in the adaptive schedule perturb functions of the basis
-  at their own scale, and its sweeps try moves of the function replaced only (sampler.py): He
-  with 700 functions in 300 s, 5.1–6.0e-11 Eh above in three runs against 2.7–6.0e-10 with every
-  trial drawn (benchmarks/README, "Trials near the basis"); 0 for molecules (H2⁺ from defaults
-  ended at 5.5e-7 with it, 5.6e-8 without: the perturbations keep u and K) and in a fixed
-  schedule, whose runs are reproduced as they were measured;
-- refine_evaluations: 30 in the adaptive schedule (L-BFGS converges a function in 15–40
-  energies, benchmarks/README), 200 in a fixed one;
-- refine_group: GROUP in the adaptive schedule, whose refinement passes then move each function
-  with the GROUP − 1 it overlaps most (near-duplicate partners hold a lone function in place;
-  benchmarks/README, "The H2 campaign" and issue 17's rows), 1 in a fixed one;
+- trials per step, refinement energies and groups, trials near the basis: the kind of
+  schedule's (schedule.kind_of, its `defaults`), with their reasons beside them (fixed.py and
+  the other kind's module), each depending on whether the system is a molecule;
 - batch: the number of MPI ranks (parallel.py; 1 in one process), each working on one function
   of a sweep's batch; kept in the checkpoint, so a run resumed on another number of ranks goes on
   as it would have;
-- the schedule: adaptive (adaptive.py) when none of prune, sweeps, refine, polish, cycles is
-  given, else the fixed schedule with the missing ones at 0, 0, 0, 0 and 1.
+- the fixed schedule's own settings, when it is the kind: the missing ones at 0, 0, 0, 0 and 1
+  (fixed.SETTINGS).
 """
 from __future__ import annotations
 
@@ -45,14 +31,9 @@ import numpy as np
 from ..basis import family
 from ..parallel import world
 from ..system import System, reduced_mass
+from .schedule import kind_of
 from .settings import Optimiser
 
-#: functions an adaptive refinement pass moves together (module docstring)
-GROUP = 3
-#: competitive trials per step of the adaptive schedule (module docstring)
-TRIALS = 100
-#: the share of an atom's growth trials drawn near the basis in the adaptive schedule (module docstring)
-NEAR = 0.5
 #: a particle this many times heavier than the lightest one moves as a nucleus
 HEAVY = 100.0
 
@@ -67,13 +48,13 @@ def molecular_pair(system: System) -> tuple[int, int] | None:
     """The heaviest pair of nuclei of one charge sign (a molecule's bond), or None (an atom)."""
     m, q = system.masses, system.charges
     like = [(i, j) for i in nuclei(system) for j in nuclei(system) if i < j and q[i] * q[j] > 0]
-    return max(like, key=lambda p: reduced_mass(m[p[0]], m[p[1]]), default=None)
+    return max(like, key=lambda pair: reduced_mass(*m[list(pair)]), default=None)
 
 
 def resolved(opts: Optimiser, system: System) -> Optimiser:
-    """`opts` with every setting left at None chosen for `system` (module docstring); the schedule
-    settings stay None when the schedule is adaptive. Idempotent: a checkpoint's settings are
-    returned unchanged."""
+    """`opts` with every setting left at None chosen for `system` (module docstring); the fixed
+    schedule's settings stay None in another. Idempotent: a checkpoint's settings are returned
+    unchanged."""
     bond = molecular_pair(system)
     kind = opts.kind or ("ecg-gvr" if bond is not None or system.state.N > 0 else "pecg")
     K_max = opts.K_max
@@ -82,16 +63,9 @@ def resolved(opts: Optimiser, system: System) -> Optimiser:
         limit = family(kind).K_limit  # 0: a family without powers K
         if limit and bond is not None:
             m = system.masses
-            K_max = min(limit, math.ceil(np.sqrt(reduced_mass(m[bond[0]], m[bond[1]]) / m.min())))
+            K_max = min(limit, math.ceil(np.sqrt(reduced_mass(*m[list(bond)]) / m.min())))
     channels = opts.channels or ("all" if bond is not None else "pairs")
-    trials = opts.trials or (TRIALS if opts.adaptive else 30 if bond is not None else 20)
-    schedule = {}
-    if not opts.adaptive:
-        schedule = {k: (v if (v := getattr(opts, k)) is not None else d)
-                    for k, d in (("prune", 0), ("sweeps", 0), ("refine", 0), ("polish", 0), ("cycles", 1))}
-    evaluations = opts.refine_evaluations or (30 if opts.adaptive else 200)
-    group = opts.refine_group or (GROUP if opts.adaptive else 1)
+    chosen = kind_of(opts).defaults(opts, bond is not None)
     batch = opts.batch or world().size
-    near = opts.near if opts.near is not None else (NEAR if opts.adaptive and bond is None else 0.0)
-    return replace(opts, kind=kind, K_max=K_max, channels=channels, trials=trials, refine_evaluations=evaluations,
-                   refine_group=group, batch=batch, near=near, **schedule)
+    return replace(opts, kind=kind, K_max=K_max, channels=channels, batch=batch,
+                   **{k: v if (v := getattr(opts, k)) is not None else d for k, d in chosen.items()})

@@ -1,5 +1,5 @@
 """The one driver: `optimise` runs the methods (methods.py) one unit of work at a time, where the
-schedule (schedule.py: the fixed one of the settings or the adaptive one) says, tells the
+schedule (schedule.py: its kinds, the fixed one of the settings and the one that chooses by rates) says, tells the
 schedule what each left, keeps the history (history.py), stops at the wall-time budget, writes
 the checkpoint (checkpoint.py) and leaves the convergence report (convergence.py) on the basis
 it returns; `resume_from` continues a run (resume.py).
@@ -47,9 +47,9 @@ from .settings import Optimiser
 
 def optimise(system: System, opts: Optimiser, out: Path | None = None, progress: bool = True,
              resume: dict | None = None) -> Basis:
-    """Optimise a basis of `opts.kind` for the state of `system`: with the adaptive schedule
-    (adaptive.py), growth to `opts.size` and refinement, replacement and joint passes chosen by
-    the energy each gains per second until the basis has converged or is exhausted; with a fixed
+    """Optimise a basis of `opts.kind` for the state of `system`, with the schedule of `opts`
+    (schedule.kind_of): growth to `opts.size` and refinement, replacement and joint passes chosen by
+    the energy each gains per second until the basis has converged or is exhausted; or a fixed
     one (fixed.py), growth to `opts.size` by competitive selection, then `opts.cycles` times growth
     by `opts.prune` functions and pruning back to the size, `opts.sweeps` random replacement
     sweeps, `opts.refine` refinement sweeps and `opts.polish` joint steps (methods.py). Either stops
@@ -68,7 +68,7 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     state's coefficients and `convergence`, the report of convergence.py; its energy (hartree)
     is prebo.evaluate(basis)["energy"]. InputError for
     arguments of the wrong type, StalledError when growth rejects every trial for STALL_STEPS
-    steps in a fixed schedule (the adaptive one keeps the size reached), BasisFileError for a
+    steps in a fixed schedule (one that goes on keeps the size reached: Schedule.stall), BasisFileError for a
     `resume` that does not fit."""
     if not isinstance(system, System):
         raise InputError(f"optimise: system = {system!r}: must be a prebo.System")
@@ -136,11 +136,11 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         if out is not None:
             objective = ex.energy if np.isfinite(ex.energy) else None  # inf before the first function
             ex.basis.save(Path(out) / CHECKPOINT, {
-                "energy": ex.lowest_root, "optimiser": opts.to_dict(), "progress": vars(cursor),
-                "rng": rng.bit_generator.state, "history": history, "elapsed": seconds,
+                "energy": ex.lowest_root, "optimiser": opts.to_dict(), "progress": cursor.to_dict(),
+                "rng": rng.bit_generator.state, "history": [step.row() for step in history], "elapsed": seconds,
                 "schedule": schedule.to_dict(), "stopped": stopped, "momentum": run.momentum.to_dict()}
                 | ({} if ex.objective.lowest else {"objective": objective, "levels": list(ex.objective.roots),
-                                                   "followed": followed}))
+                                                   "followed": [f.row() for f in followed]}))
 
     with run.report, eigen.lapack_threads(opts.size):
         while cursor.phase != "done":
@@ -156,8 +156,8 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                     raise
                 run.stalled = 0
             if ex.followed is not None:  # a targeted level moved to another root (objective.py, following)
-                followed.append([wall(), *map(list, ex.followed)])
-                run.report.followed(*ex.followed)
+                followed.append(replace(ex.followed, seconds=wall()))
+                run.report.followed(ex.followed.before, ex.followed.after)
                 ex.followed = None
             if ex.energy < old:
                 history.append(Step(len(ex.basis), ex.energy, cursor.phase, wall()))
@@ -168,7 +168,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                 stopped = schedule.stopped
             ground = ex.eig.energies[0] if ex.eig is not None else np.inf  # the lowest root: bound or not
             fresh = schedule.restart(phase, len(ex.basis), ground, threshold - ex.sigma)
-            if fresh is not None:  # a fresh start (adaptive.py)
+            if fresh is not None:  # a fresh start (Schedule.restart)
                 schedule, cursor, stopped = fresh, fresh.first(), None
                 ex = run.expansion = expansion(Basis.empty(system, opts.kind), start)
                 run.momentum = Momentum()
@@ -182,7 +182,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     best.convergence = convergence(history, opts, stopped, wall(), schedule.stalled, schedule.advantage(len(ex.basis)),
                                    ex.eig.overlap_condition, ex.sigma)
     if not ex.objective.lowest:
-        best.convergence |= {"levels": list(ex.objective.roots), "followed": followed}
+        best.convergence |= {"levels": list(ex.objective.roots), "followed": [f.row() for f in followed]}
     return best
 
 

@@ -10,28 +10,45 @@ apart from prebo.State, the quantum numbers of a system.)
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 
 import numpy as np
 
 from .. import eigen
 from ..basis import Basis
 from ..errors import LinearDependenceError
-from .objective import Levels
+from ..matrices import Matrices
+from .objective import Followed, Levels, Objective
 
 
 #: how many times what a change adds to the uncertainty it must gain (`Expansion.keep_if_lower`)
 SIGMA_PRICE = 100.0
 
 
+@dataclass(frozen=True, slots=True)
+class Snapshot:
+    """The state of an expansion to restore if a change does not pay (Expansion.keep_if_lower):
+    its basis, matrices, eigen-solution, energy and uncertainty (Eh), objective and the
+    re-assignment `followed` not yet taken."""
+
+    basis: Basis
+    m: Matrices
+    eig: eigen.Eigen | None
+    energy: float
+    sigma: float
+    objective: Objective
+    followed: Followed | None
+
+
 class Expansion:
-    """The basis `basis` with its matrices `m` (S, T, T_ti, V; hartree), eigen-solution `eig`, the
+    """The basis `basis` with its matrices `m` (matrices.Matrices: S, T, T_ti, V; hartree), eigen-solution `eig`, the
     `energy` (hartree) of the `objective` (objective.py: the lowest root, or a weighted sum of
     targeted levels) and `sigma`, the energy's numerical uncertainty (module docstring; inf beyond
     eigen.FIRST_ORDER, where no change is kept: the optimiser does not take the basis where its
     first-order uncertainty fails). After a change of several functions at once (`put_group`,
     `replace_basis`) the targeted levels are followed by overlap (Levels.follow; one function
     added, replaced or removed never moves a level up and lowers it, objective.py); `followed`
-    holds the (before, after) root indices of the last change that moved a level to another root,
+    holds the re-assignment (objective.Followed) of the last change that moved a level to another root,
     until the driver takes it; `drafted`: a `draft`, which places changes without solving.
 
     rep: the integrals' Representation (integrals.laboratory); threshold: eigen.solve's relative
@@ -39,14 +56,11 @@ class Expansion:
     linear-dependence guard of `candidates` (Optimiser settings of the same names)."""
 
     def __init__(self, basis: Basis, rep, threshold: float, min_norm: float = 1e-8, max_overlap: float = 0.99,
-                 objective: Levels = Levels()):
+                 objective: Objective = Levels()):
         self.basis, self.rep, self.threshold = basis, rep, threshold
         self.min_norm, self.max_overlap, self.objective = min_norm, max_overlap, objective
         self.followed, self.drafted = None, False
-        if len(basis):
-            self.m = rep.matrices(basis)
-        else:
-            self.m = {k: np.zeros((0, 0)) for k in ("S", "T", "T_ti", "V")}
+        self.m = Matrices.of(rep.matrices(basis)) if len(basis) else Matrices.empty()
         self.solve()
 
     def solve(self, before: tuple | None = None) -> None:
@@ -56,16 +70,16 @@ class Expansion:
         if len(self.basis) == 0:
             self.eig, self.energy, self.sigma = None, np.inf, 0.0
             return
-        H = self.m["T_ti"] + self.m["V"]
-        self.eig = self.objective.solve(H, self.m["S"], self.threshold)
+        H = self.m.H
+        self.eig = self.objective.solve(H, self.m.S, self.threshold)
         if before is not None and self.objective.holds(self.eig):
-            roots = self.objective.follow(before, self.m["S"], self.eig)
+            roots = self.objective.follow(before, self.m.S, self.eig)
             if roots != self.objective.roots:
-                self.followed = (self.objective.roots, roots)
+                self.followed = Followed(self.objective.roots, roots)
                 self.objective = self.objective.to(roots)
-                self.eig = self.objective.solve(H, self.m["S"], self.threshold)
+                self.eig = self.objective.solve(H, self.m.S, self.threshold)
         self.energy = self.objective.value(self.eig)
-        self.sigma = self.objective.uncertainty(self.eig, self.m["S"], self.m["T_ti"], self.m["V"])
+        self.sigma = self.objective.uncertainty(self.eig, self.m)
 
     @staticmethod
     def prior(eig, objective: Levels, mapping: np.ndarray) -> tuple | None:
@@ -91,40 +105,47 @@ class Expansion:
         """The state's coefficients c, S-normalised (the objective's eigenvector)."""
         return self.objective.vector(self.eig)
 
+    @property
+    def vectors(self) -> np.ndarray:
+        """The eigenvectors of every targeted level (nb x levels, in the order of the objective's
+        `roots`), S-normalised."""
+        return self.objective.vectors(self.eig)
+
     def sound(self) -> bool:
         """Whether every targeted level's internal kinetic energy c^T T_ti c is positive beyond the
         energy's uncertainty, as that of any wave function is: rounding that dominates an
         ill-conditioned basis's elements (integrals.py, cancellation) can make it negative, and
         its energy then means nothing (two electrons "bound" at -0.13 Eh)."""
-        return all(lv.c @ self.m["T_ti"] @ lv.c > self.sigma for lv in self.objective.levels(self.eig))
+        return all(lv.c @ self.m.T_ti @ lv.c > self.sigma for lv in self.objective.levels(self.eig))
 
     def gains(self, energy: float) -> bool:
         """Whether `energy` lies below the current energy by more than its uncertainty."""
         return energy < self.energy - self.sigma
 
-    def snapshot(self) -> tuple:
+    def snapshot(self) -> Snapshot:
         """The state to restore if a change does not pay (`keep_if_lower`)."""
-        return (self.basis.subset(slice(None)), {k: v.copy() for k, v in self.m.items()}, self.eig, self.energy,
-                self.sigma, self.objective, self.followed)
+        return Snapshot(self.basis.subset(slice(None)), self.m.map(np.copy), self.eig, self.energy, self.sigma,
+                        self.objective, self.followed)
 
-    def restore(self, before: tuple) -> None:
+    def restore(self, before: Snapshot) -> None:
         """Go back to the state `before` (`snapshot`)."""
-        self.basis, self.m, self.eig, self.energy, self.sigma, self.objective, self.followed = before
+        self.basis, self.m, self.eig, self.energy = before.basis, before.m, before.eig, before.energy
+        self.sigma, self.objective, self.followed = before.sigma, before.objective, before.followed
 
-    def keep_if_lower(self, before: tuple) -> bool:
+    def keep_if_lower(self, before: Snapshot) -> bool:
         """After a change: keep it if the energy fell by more than the uncertainty before and after
         it and by SIGMA_PRICE times what it added to the uncertainty; otherwise restore the state
         `before` (`snapshot`). True if kept. Every later change must beat the uncertainty: a
         near-duplicate pair with large coefficients that gains 1e-11 Eh but raises σ from 1e-15 to
         1e-11 locks the run (He, 700 functions: 8.5e-12, no change kept for the last 200 s)."""
-        gain = before[3] - self.energy
-        if self.sound() and (before[3] == np.inf or (gain > max(self.sigma, before[4])
-                                                    and gain > SIGMA_PRICE * (self.sigma - before[4]))):
+        gain = before.energy - self.energy
+        if self.sound() and (before.energy == np.inf or (gain > max(self.sigma, before.sigma)
+                                                         and gain > SIGMA_PRICE * (self.sigma - before.sigma))):
             return True
         self.restore(before)
         return False
 
-    def solve_and_keep_if_lower(self, before: tuple, mapping: np.ndarray | None = None) -> bool:
+    def solve_and_keep_if_lower(self, before: Snapshot, mapping: np.ndarray | None = None) -> bool:
         """Solve after a change and `keep_if_lower`; a change whose lowest root the extended-precision
         refinement cannot resolve (eigen.refine: LinearDependenceError, at an overlap condition
         where double precision runs out) is undone like one that does not gain. `mapping`: function
@@ -134,7 +155,7 @@ class Expansion:
         if self.drafted:  # the expansion the draft is of puts its change (`draft`)
             return True
         try:
-            self.solve(None if mapping is None else self.prior(before[2], before[5], mapping))
+            self.solve(None if mapping is None else self.prior(before.eig, before.objective, mapping))
         except LinearDependenceError:
             self.restore(before)
             return False
@@ -145,7 +166,7 @@ class Expansion:
         (`resolved`) and it lowers the energy beyond the uncertainty."""
         before = self.snapshot()
         self.basis = basis
-        self.m = self.rep.matrices(basis)
+        self.m = Matrices.of(self.rep.matrices(basis))
         if not self.resolved():
             self.restore(before)
             return False
@@ -157,7 +178,7 @@ class Expansion:
         (trials, refinements and joint steps are: Representation.plausible), is what could have
         carried a function where the symmetriser nearly annihilates it into a He 2³S run with 150
         functions, whose result was then refused."""
-        return bool(self.rep.resolved(self.rep.diagonal(self.m)).all())
+        return bool(self.rep.resolved(self.m.diagonal()).all())
 
     def without(self, i):
         """The eigen-solution of the basis without function i, or without the functions of the
@@ -166,8 +187,7 @@ class Expansion:
         keep[i] = False
         if not keep.any():
             return None
-        H = self.m["T_ti"] + self.m["V"]
-        return self.objective.solve(H[np.ix_(keep, keep)], self.m["S"][np.ix_(keep, keep)], self.threshold)
+        return self.objective.solve(self.m.H[np.ix_(keep, keep)], self.m.S[np.ix_(keep, keep)], self.threshold)
 
     def independence(self, idx: list[int]) -> float:
         """The smallest eigenvalue of the part of functions `idx` orthogonal to the others, scaled
@@ -177,7 +197,7 @@ class Expansion:
         i in idx — O(N_b k^2), no solve. NaN when directions were dropped."""
         if self.eig is None or self.eig.kept < len(self.basis):
             return np.nan
-        W = self.eig.vectors[idx] * np.sqrt(np.diag(self.m["S"])[idx])[:, None]
+        W = self.eig.vectors[idx] * np.sqrt(np.diag(self.m.S)[idx])[:, None]
         return float(1.0 / np.linalg.eigvalsh(W @ W.T)[-1])
 
     def remove(self, i: int) -> None:
@@ -185,13 +205,13 @@ class Expansion:
         are the bits of a rebuild: an element depends on its two functions and their order)."""
         keep = np.arange(len(self.basis)) != i
         self.basis = self.basis.subset(np.flatnonzero(keep))
-        self.m = {k: v[np.ix_(keep, keep)] for k, v in self.m.items()}
+        self.m = self.m.map(lambda M: M[np.ix_(keep, keep)])
         self.solve()
 
     def virial(self) -> float:
         """|1 + <V>/(2<T_ti>)| of the state: 0 for an exact Coulomb eigenstate (virial theorem)."""
         c = self.coefficients
-        return abs(1.0 + (c @ self.m["V"] @ c) / (2.0 * (c @ self.m["T_ti"] @ c)))
+        return abs(1.0 + (c @ self.m.V @ c) / (2.0 * (c @ self.m.T_ti @ c)))
 
     def candidates(self, trials: Basis, exclude: int | None = None, eig=None):
         """The energy with each trial added (to the basis without `exclude`, where the trial
@@ -201,21 +221,20 @@ class Expansion:
         trial whose elements fail `Representation.plausible`."""
         position = len(self.basis) if exclude is None else exclude
         rows, diag = self.rep.rows(trials, self.basis, position)
-        H = rows["T_ti"] + rows["V"]
-        S = rows["S"]
+        r, d = Matrices.of(rows), Matrices.columns(diag)
+        H, S = r.H, r.S
         keep = np.ones(len(self.basis), bool)
         if exclude is not None:
             keep[exclude] = False
         if eig is None:
             eig = self.eig if exclude is None else self.without(exclude)
         E, C = (eig.energies, eig.vectors) if eig is not None else (np.zeros(0), np.zeros((0, 0)))
-        energies = self.objective.with_added_many(E, C, H[:, keep], S[:, keep], diag[:, 2] + diag[:, 3],
-                                                  diag[:, 0], self.min_norm)
+        energies = self.objective.with_added_many(E, C, H[:, keep], S[:, keep], d.H, d.S, self.min_norm)
         if keep.any():
             with np.errstate(invalid="ignore", divide="ignore"):  # S_nn ≤ 0: refused as implausible below
-                overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(diag[:, 0], np.diag(self.m["S"])[keep]))
+                overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(d.S, np.diag(self.m.S)[keep]))
             energies[overlap.max(axis=1) > self.max_overlap] = np.inf
-        energies[~self.rep.plausible({"S": S[:, keep]}, diag, np.diag(self.m["S"])[keep])] = np.inf
+        energies[~self.rep.plausible({"S": S[:, keep]}, diag, np.diag(self.m.S)[keep])] = np.inf
         return energies, rows, diag
 
     def put(self, i: int, f: Basis, row: dict | None = None, d=None) -> bool:
@@ -244,8 +263,8 @@ class Expansion:
         (`changes`, methods.together): a copy, its basis and matrices its own, whose integrals
         this process evaluates by itself, without the other MPI ranks, and which places a change
         without solving (`solve_and_keep_if_lower`: the expansion re-checks it)."""
-        twin = copy.copy(self)
-        twin.basis, twin.m = self.snapshot()[:2]
+        twin, snapshot = copy.copy(self), self.snapshot()
+        twin.basis, twin.m = snapshot.basis, snapshot.m
         twin.rep, twin.drafted = self.rep.alone(), True
         return twin
 
@@ -263,21 +282,24 @@ class Expansion:
         else:
             self.basis.replace(i, f)
         if row is None or not self.rep.oriented(self.basis):
-            self.m = self.rep.matrices(self.basis)
-        else:
-            values = {"S": d[0], "T": d[1], "T_ti": d[2], "V": d[3]}
-            for k in self.m:
-                r = np.array(row[k], copy=True)
-                if i == nb:
-                    M = np.zeros((nb + 1, nb + 1))
-                    M[:nb, :nb] = self.m[k]
-                    M[nb, :nb] = M[:nb, nb] = r
-                    M[nb, nb] = values[k]
-                    self.m[k] = M
-                else:
-                    r[i] = values[k]
-                    self.m[k][i, :] = r
-                    self.m[k][:, i] = r
+            self.m = Matrices.of(self.rep.matrices(self.basis))
+            return
+        rows, values = Matrices.of(row).to_dict(), Matrices.columns(d).to_dict()
+        patched = {}
+        for k, M in self.m.to_dict().items():
+            r = np.array(rows[k], copy=True)
+            if i == nb:
+                grown = np.zeros((nb + 1, nb + 1))
+                grown[:nb, :nb] = M
+                grown[nb, :nb] = grown[:nb, nb] = r
+                grown[nb, nb] = values[k]
+                M = grown
+            else:
+                r[i] = values[k]
+                M[i, :] = r
+                M[:, i] = r
+            patched[k] = M
+        self.m = Matrices.of(patched)
 
 
 def moved(nb: int, new: list[int]) -> np.ndarray:

@@ -13,18 +13,19 @@ phase of the cursor names the method (`methods`).
   perturbed at its own scale, or random functions with `near` = 0 (Sampler.replacements);
   with `newcomer`, the winner is refined and kept only if it then beats the incumbent, which is
   refined otherwise (refine.regenerate_function).
-- `PruneStep` ("prune", fixed schedule): growth past the size (as `Grow`, each grown function then refined with the functions
-  it overlaps most, so that it joins the basis before the removals are weighed; without that the
-  cheapest to remove are the newcomers themselves), then the removal of the function whose
+- `PruneStep` ("prune", fixed schedule): growth past the size up to the cursor's target (as
+  `Grow`, each grown function then refined with the functions it overlaps most, so that it joins
+  the basis before the removals are weighed; without that the cheapest to remove are the
+  newcomers themselves), then the removal of the function whose
   removal raises the energy least (eigen.root_without_each), one per step back to the size,
   the function that overlapped it most then refined with its partners to take over its part
   (H2 with 500 ECG-GVR functions at 1.2e-8 Eh above, 12 grown and removed: the net gain 6.3–9.5e-11
   Eh against −1.5e-11 … 7.7e-11 without; benchmarks/README, "Pruning that refines after each
   removal"): pruning a basis grown past its size keeps the functions that matter and moves the
   basis out of the basin refinement has settled in (benchmarks/README, "Grow and prune").
-- `PrunePass` ("prune", adaptive schedule): a whole pruning, `pruned(N_b)` growth steps and the
-  removals back to N_b, in one step, undone unless the energy fell: the schedule's size is a cap
-  at every step and its energy never rises.
+- `PrunePass` ("prune", a schedule whose pruning is one step, `whole_pruning`): a whole pruning,
+  growth steps up to the cursor's target and the removals back to N_b, in one step, undone
+  unless the energy fell: the schedule's size is a cap at every step and its energy never rises.
 - `Refine`: one step of a refinement sweep, function i refined with all others fixed, or with the
   functions it overlaps most (`refine_group`; refine.py), as `Minimiser` says.
 - A sweep's step (`Replace`, `Refine`) can take a batch of functions at once (`together`): each
@@ -32,10 +33,10 @@ phase of the cursor names the method (`methods`).
   gains.
 - `Polish`: one joint L-BFGS step over every parameter (polish.py).
 - `MomentumMove` ("momentum"): the basis moved on along its displacement since the last move
-  (momentum.py; adaptive schedule).
+  (momentum.py; a schedule that `moves`).
 Replacements and pruning reach new basins, joint refinement converges within one; the
-prune-sweep-refine-polish block is repeated `cycles` times (fixed.py), or the adaptive schedule
-chooses among grow, sweep, refine, polish and prune and moves the basis on (adaptive.py).
+prune-sweep-refine-polish block is repeated `cycles` times (fixed.py), or the schedule chooses
+among grow, sweep, refine, polish and prune by their rates and moves the basis on (schedule.py).
 """
 from __future__ import annotations
 
@@ -45,7 +46,6 @@ import numpy as np
 
 from ..errors import StalledError, UnsupportedError
 from ..parallel import world
-from .adaptive import pruned
 from .cursor import Cursor
 from .expansion import SIGMA_PRICE, Expansion
 from .momentum import Momentum
@@ -53,6 +53,7 @@ from .polish import polish
 from .refine import partners, refine_group, refine_newcomer, regenerate_function
 from .report import Reporter
 from .sampler import Sampler
+from .schedule import kind_of
 from .settings import C_A, Optimiser
 
 STALL_STEPS = 100  # growth steps in a row without an accepted trial before the run stops (StalledError)
@@ -187,23 +188,28 @@ class Replace:
 
 @dataclass(frozen=True)
 class PruneStep:
-    """At `cursor.index` 0 a `grow` step past the size, the grown function then refined with its
-    partners by `minimiser`; at 1 the removal of the function whose removal raises the energy
-    least, the function it overlapped most then refined with its partners (module docstring)."""
+    """Below the cursor's `target` size a `grow` step past the size, the grown function then
+    refined with its partners by `minimiser`; at or above it the removal of the function whose
+    removal raises the energy least, the function it overlapped most then refined with its
+    partners (module docstring)."""
 
     grow: Grow
     minimiser: Minimiser
 
     def step(self, run: Run, cursor: Cursor) -> None:
         """One unit of work on `run` at `cursor` (class docstring)."""
+        if len(run.expansion.basis) < cursor.target:
+            self.add(run, cursor)
+        else:
+            self.remove(run)
+
+    def add(self, run: Run, cursor: Cursor) -> None:
+        """A `grow` step, the grown function then refined with its partners."""
         ex = run.expansion
-        if cursor.index == 0:
-            nb = len(ex.basis)
-            self.grow.step(run, cursor)
-            if len(ex.basis) > nb:
-                refine_group(ex, nb, self.minimiser.group, self.minimiser.evaluations, self.minimiser.method)
-            return
-        self.remove(run)
+        nb = len(ex.basis)
+        self.grow.step(run, cursor)
+        if len(ex.basis) > nb:
+            refine_group(ex, nb, self.minimiser.group, self.minimiser.evaluations, self.minimiser.method)
 
     def remove(self, run: Run) -> int:
         """Remove the function whose removal raises the energy least, then refine the function
@@ -220,8 +226,9 @@ class PruneStep:
 
 @dataclass(frozen=True)
 class PrunePass:
-    """`prune`'s growth by `pruned(N_b)` functions (fewer if growth stalls) and its removals back to
-    N_b as one step, kept only if the energy fell beyond its uncertainty (module docstring)."""
+    """`prune`'s growth by the cursor's `target` − N_b steps (fewer if growth stalls) and its
+    removals back to N_b as one step, kept only if the energy fell beyond its uncertainty (module
+    docstring)."""
 
     prune: PruneStep
 
@@ -231,8 +238,8 @@ class PrunePass:
         before, nb = ex.snapshot(), len(ex.basis)
         origin = list(range(nb))  # where each function was before the pruning (None: grown)
         try:
-            for _ in range(pruned(nb)):
-                self.prune.step(run, Cursor("prune", index=0))
+            for _ in range(cursor.target - nb):
+                self.prune.add(run, cursor)
                 origin += [None] * (len(ex.basis) - len(origin))
         except StalledError:
             run.stalled = 0
@@ -306,14 +313,14 @@ class MomentumMove:
 
 
 def methods(opts: Optimiser) -> dict:
-    """The method of each phase of the schedule, configured by `opts` (defaults.resolved): in an
-    adaptive schedule, and in a fixed one with `refine`, every grown and replacing function is
-    refined; an adaptive schedule prunes a whole pass in one step and moves the basis on along its
-    displacement (momentum.py)."""
+    """The method of each phase of the schedule, configured by `opts` (defaults.resolved) and its
+    kind (schedule.kind_of): whether every grown and replacing function is refined, whether a
+    pruning is one step, whether the basis moves on along its displacement (momentum.py)."""
+    kind = kind_of(opts)
     minimiser = Minimiser(opts.refine_evaluations, opts.refine_method, opts.refine_group)
-    newcomer = Minimiser(opts.refine_evaluations, opts.refine_method) if opts.adaptive or opts.refine else None
+    newcomer = Minimiser(opts.refine_evaluations, opts.refine_method) if kind.refines_newcomers(opts) else None
     prune = PruneStep(Grow(opts.trials, newcomer), minimiser)
-    return {"grow": Grow(opts.trials, newcomer), "prune": PrunePass(prune) if opts.adaptive else prune,
+    return {"grow": Grow(opts.trials, newcomer), "prune": PrunePass(prune) if kind.whole_pruning else prune,
             "sweep": Replace(opts.trials, newcomer, opts.batch),
             "refine": Refine(minimiser, opts.batch), "polish": Polish(opts.polish_iterations)} | (
-                {"momentum": MomentumMove()} if opts.adaptive else {})
+                {"momentum": MomentumMove()} if kind.moves else {})

@@ -3,7 +3,7 @@
 Refinement of groups (refine.py) is coordinate descent. Near the optimum of a large basis it
 moves every function a little along a narrow valley, which it crosses slowly; most of the gain of
 such a move needs all functions together. So, every EVERY passes at full size that move
-functions (adaptive.Adaptive.due), the basis is moved on to θ + α d, d = θ − θ_ref over all
+functions (the schedule's `due`, schedule.py), the basis is moved on to θ + α d, d = θ − θ_ref over all
 functions, θ_ref the basis before the last move (heavy-ball momentum: the moves accumulate), α the
 vertex of the parabola through the energies at α = 0, ½, 1 (else the lowest of those), and kept
 only if the energy falls (Expansion.replace_basis). A function whose channel or K differs from its reference, or that
@@ -24,7 +24,7 @@ from .checkpoint import of_this_run
 from .expansion import Expansion
 from .parametrisation import Parametrisation
 
-#: passes at full size that move functions between two moves (adaptive.Adaptive.due)
+#: passes at full size that move functions between two moves (the schedule's `due`)
 EVERY = 2
 #: a function that moved this far in θ since its reference was replaced: it does not move on
 MAX_STEP = 0.5

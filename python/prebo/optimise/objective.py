@@ -1,6 +1,16 @@
 """The objective: the quantity the optimisation methods lower, and the levels it belongs to.
 
-It is the weighted sum Σ_k w_k E_k of the targeted roots k of H c = E S c — the lowest root E_0
+`Objective` is the interface: what the driver, the expansion and the methods ask of it — its
+value from an eigen-solution of the basis's matrices (`solve`, `holds`, `value`, `uncertainty`,
+`levels`, `vector(s)`), its value with functions added or removed without a new solve
+(`with_added`, `with_added_gradient`, `with_added_many`, `with_block`, `without_each`: the
+secular-equation updates of the eigen module), its update after a change of the basis
+(`follow`, `to`: the root indices it stands at, `roots`) and what a run reports and stores
+(`lowest`: nothing to follow, the checkpoint's "levels" and "followed" absent). `Levels` is one
+implementation; another objective — a response functional such as the Hylleraas functional
+J[ψ1] — implements the same methods and runs through the same driver (driver.optimise).
+
+`Levels` is the weighted sum Σ_k w_k E_k of the targeted roots k of H c = E S c — the lowest root E_0
 alone by default — each an upper bound to the exact level k of the symmetry the basis is
 projected on (Hylleraas–Undheim–MacDonald: J. K. L. MacDonald, Phys. Rev. 43, 830 (1933)), so
 the sum of positive weights is an upper bound to the same sum of exact levels. Everything that
@@ -28,18 +38,21 @@ by the sum over the targeted roots the grown basis holds (`with_added_many`).
 """
 from __future__ import annotations
 
-from typing import NamedTuple
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
 
 import numpy as np
 
 from .. import eigen
+from ..matrices import Matrices
 
 
 #: the smallest squared overlap with a root by which a level is followed to it (`Levels.follow`)
 FOLLOW = 0.5
 
 
-class Level(NamedTuple):
+@dataclass(frozen=True, slots=True)
+class Level:
     """One targeted level of an eigen-solution: its `weight`, `root` index, energy `E` (Eh) and
     S-normalised eigenvector `c`."""
 
@@ -49,7 +62,113 @@ class Level(NamedTuple):
     c: np.ndarray
 
 
-class Levels:
+@dataclass(frozen=True, slots=True)
+class Followed:
+    """A re-assignment of the targeted levels by following (module docstring): their root indices
+    `before` and `after` it, and the run's `seconds` at it (None until the driver records it);
+    stored as [seconds, roots before, roots after] (`row`, `of`)."""
+
+    before: tuple
+    after: tuple
+    seconds: float | None = None
+
+    def row(self) -> list:
+        """The row of a checkpoint's or a result's "followed"."""
+        return [self.seconds, list(self.before), list(self.after)]
+
+    @classmethod
+    def of(cls, row: list) -> Followed:
+        """The re-assignment of a stored row (`row`)."""
+        seconds, before, after = row
+        return cls(tuple(before), tuple(after), seconds)
+
+
+@dataclass(frozen=True, slots=True)
+class BlockLevel:
+    """One level of an objective with a block of functions added (`with_block`): its `weight`,
+    energy `e` (Eh) and eigenvector (C `a`, `beta`) in the basis and the block, of squared norm
+    `norm2` = c^T S c."""
+
+    weight: float
+    e: float
+    a: np.ndarray
+    beta: np.ndarray
+    norm2: float
+
+
+class Objective(ABC):
+    """What the driver, the expansion and the methods ask of an objective (module docstring). (E,
+    C): the eigenvalues and S-orthonormal eigenvectors of the basis functions are added to or
+    removed from; h, s: the new functions' rows, h_nn, s_nn their diagonals (H = T_ti + V)."""
+
+    #: the root indices the objective stands at (the checkpoint's "levels")
+    roots: tuple
+
+    @property
+    @abstractmethod
+    def lowest(self) -> bool:
+        """Whether the objective is the lowest root alone: nothing to follow or to store beside it."""
+
+    @abstractmethod
+    def to(self, roots: tuple) -> Objective:
+        """The objective standing at the root indices `roots`."""
+
+    @abstractmethod
+    def solve(self, H: np.ndarray, S: np.ndarray, threshold: float) -> eigen.Eigen:
+        """The eigen-solution of (H, S) the objective needs."""
+
+    @abstractmethod
+    def holds(self, eig: eigen.Eigen) -> bool:
+        """Whether the eigen-solution holds what the objective needs (else its value is inf)."""
+
+    @abstractmethod
+    def levels(self, eig: eigen.Eigen) -> list[Level]:
+        """The levels the objective is made of, as the solution holds them (reported, checked sound)."""
+
+    @abstractmethod
+    def value(self, eig: eigen.Eigen) -> float:
+        """The objective (Eh) of an eigen-solution; inf where it does not hold it."""
+
+    @abstractmethod
+    def vector(self, eig: eigen.Eigen) -> np.ndarray:
+        """The coefficients a basis stores (S-normalised)."""
+
+    @abstractmethod
+    def vectors(self, eig: eigen.Eigen) -> np.ndarray:
+        """The eigenvectors of every level (nb x levels), in the order of `roots`."""
+
+    @abstractmethod
+    def uncertainty(self, eig: eigen.Eigen, m: Matrices) -> float:
+        """The objective's numerical uncertainty (Eh) for the basis's matrices `m`."""
+
+    @abstractmethod
+    def with_added(self, E, C, h, s, h_nn, s_nn, min_norm: float) -> float:
+        """The objective with one function added."""
+
+    @abstractmethod
+    def with_added_gradient(self, E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float):
+        """`with_added` and its gradient along the function's parameters (rows dh, ds, dh_nn, ds_nn)."""
+
+    @abstractmethod
+    def with_added_many(self, E, C, H, S, h_nn, s_nn, min_norm: float) -> np.ndarray:
+        """`with_added` for each of many functions."""
+
+    @abstractmethod
+    def with_block(self, E, C, h, s, H_ff, S_ff, min_norm: float,
+                   near: np.ndarray | None = None) -> tuple[float, list[BlockLevel]]:
+        """The objective with a block of functions added, and its levels for the gradient."""
+
+    @abstractmethod
+    def without_each(self, E: np.ndarray, C: np.ndarray) -> np.ndarray:
+        """The objective without each function in turn."""
+
+    @abstractmethod
+    def follow(self, before: tuple, S: np.ndarray, eig: eigen.Eigen) -> tuple:
+        """The root indices the objective stands at after a change of the basis (`before`: its
+        vectors before it, in the changed basis's functions, and their energies)."""
+
+
+class Levels(Objective):
     """The weighted sum of the `targets` (root indices, ascending; default the lowest) with
     `weights` (positive; default 1 each), the levels standing at the root indices `roots` (default
     the targets; each at or above its target) and followed while below `threshold` (Eh, the lowest
@@ -93,16 +212,22 @@ class Levels:
         return sum(lv.weight * lv.E for lv in self.levels(eig))
 
     def vector(self, eig: eigen.Eigen) -> np.ndarray:
-        """The eigenvector of the first targeted level the solution holds, S-normalised (the
-        coefficients a basis stores)."""
+        """The eigenvector of the first targeted level, S-normalised (the coefficients a basis
+        stores; while the basis holds fewer roots, its highest)."""
         return eig.vectors[:, min(self.roots[0], eig.kept - 1)]
 
-    def uncertainty(self, eig: eigen.Eigen, S: np.ndarray, T_ti: np.ndarray, V: np.ndarray) -> float:
-        """Σ w_k σ_k (hartree): the levels' first-order uncertainties (eigen.energy_uncertainty),
-        added as if fully correlated (an upper bound); inf where first order fails (eigen.FIRST_ORDER)."""
+    def vectors(self, eig: eigen.Eigen) -> np.ndarray:
+        """The eigenvectors of every targeted level (nb x levels, in the order of the targets; each
+        as `vector`), S-normalised."""
+        return eig.vectors[:, [min(r, eig.kept - 1) for r in self.roots]]
+
+    def uncertainty(self, eig: eigen.Eigen, m: Matrices) -> float:
+        """Σ w_k σ_k (hartree): the levels' first-order uncertainties (eigen.energy_uncertainty) for
+        the matrices `m`, added as if fully correlated (an upper bound); inf where first order
+        fails (eigen.FIRST_ORDER)."""
         if not eigen.first_order(eig):
             return np.inf
-        return sum(lv.weight * eigen.energy_uncertainty(lv.c, lv.E, S, T_ti, V) for lv in self.levels(eig))
+        return sum(lv.weight * eigen.energy_uncertainty(lv.c, lv.E, m.S, m.T_ti, m.V) for lv in self.levels(eig))
 
     def held(self, n: int) -> list[tuple[int, float]]:
         """The (root, weight) of the targeted levels a basis of `n` directions holds."""
@@ -135,11 +260,12 @@ class Levels:
             total += w * e_r
         return total
 
-    def with_block(self, E, C, h, s, H_ff, S_ff, min_norm: float, near: np.ndarray | None = None):
-        """The objective with a block of functions added (eigen.roots_with_block), and for each
-        level (weight, e, a, β, c^T S c), its eigenvector (C a, β); (inf, []) where a root is not
-        lowered or the block is linearly dependent. `near`: the eigenvalues before the block
-        changed, where each root's search starts."""
+    def with_block(self, E, C, h, s, H_ff, S_ff, min_norm: float,
+                   near: np.ndarray | None = None) -> tuple[float, list[BlockLevel]]:
+        """The objective with a block of functions added (eigen.roots_with_block), and each level
+        (BlockLevel: its eigenvector (C a, β)); (inf, []) where a root is not lowered or the block
+        is linearly dependent. `near`: the eigenvalues before the block changed, where each root's
+        search starts."""
         held = self.held(len(E) + len(H_ff))
         starts = [near[r] if near is not None and r < len(near) else None for r, _ in held]
         found = eigen.roots_with_block(E, C, h, s, H_ff, S_ff, min_norm, starts, [r for r, _ in held])
@@ -147,7 +273,7 @@ class Levels:
         for (_, w), (e, a, beta, norm2) in zip(held, found):
             if not np.isfinite(e):
                 return np.inf, []
-            total, parts = total + w * e, parts + [(w, e, a, beta, norm2)]
+            total, parts = total + w * e, parts + [BlockLevel(w, e, a, beta, norm2)]
         return total, parts
 
     def without_each(self, E: np.ndarray, C: np.ndarray) -> np.ndarray:

@@ -22,6 +22,7 @@ from scipy.optimize import minimize
 
 from ..basis import Basis
 from ..errors import PreboError
+from ..matrices import Matrices
 from .parametrisation import Parametrisation
 
 
@@ -52,15 +53,21 @@ class Joint:
                      for i, (p, a, b) in enumerate(zip(self.ps, self.cut[:-1], self.cut[1:]))]
         except PreboError:
             return fail
-        M = {k: np.array([rows[k][0] for rows, _ in parts]) for k in ("S", "T_ti", "V")}
-        diag = np.array([d[0] for _, d in parts])  # (nb, 4): S, T, T_ti, V
-        for k, col in (("S", 0), ("T_ti", 2), ("V", 3)):
-            M[k][np.diag_indices(nb)] = diag[:, col]
-            M[k] = 0.5 * (M[k] + M[k].T)  # i as bra and j as bra agree to rounding
-        if not st.rep.plausible({"S": M["S"]}, diag, np.diag(M["S"])).all():
+        rows = [Matrices.of(r) for r, _ in parts]  # function i's row (the values, then the derivatives)
+        derivatives = [Matrices.columns(d[1:]) for _, d in parts]  # and those of its diagonal
+        diag = np.array([d[0] for _, d in parts])  # (nb, 4): the diagonals, matrices.NAMES
+
+        def matrix(name: str) -> np.ndarray:
+            """The matrix `name` of the rows and diagonals."""
+            M = np.array([getattr(r, name)[0] for r in rows])
+            M[np.diag_indices(nb)] = getattr(Matrices.columns(diag), name)
+            return 0.5 * (M + M.T)  # i as bra and j as bra agree to rounding
+
+        S, T_ti, V = matrix("S"), matrix("T_ti"), matrix("V")
+        if not st.rep.plausible({"S": S}, diag, np.diag(S)).all():
             return fail
         try:
-            eig = st.objective.solve(M["T_ti"] + M["V"], M["S"], st.threshold)
+            eig = st.objective.solve(T_ti + V, S, st.threshold)
         except PreboError:
             return fail
         if eig.kept < nb or eig.overlap_condition > self.max_condition:
@@ -69,13 +76,13 @@ class Joint:
         if not np.isfinite(total):
             return fail
         gradient = 0.0
-        for w, _, E, c in st.objective.levels(eig):  # Σ_levels w ∂E/∂θ
-            grad = []
-            for i, (rows, d) in enumerate(parts):
-                dH, dS = rows["T_ti"][1:] + rows["V"][1:], rows["S"][1:]
+        for level in st.objective.levels(eig):  # Σ_levels w ∂E/∂θ
+            E, c, grad = level.E, level.c, []
+            for i, (r, d) in enumerate(zip(rows, derivatives)):
+                dH, dS = r.T_ti[1:] + r.V[1:], r.S[1:]
                 off = (dH - E * dS) @ c - (dH[:, i] - E * dS[:, i]) * c[i]  # Σ_{j≠i}
-                grad.append(2.0 * c[i] * off + c[i] ** 2 * ((d[1:, 2] + d[1:, 3]) - E * d[1:, 0]))
-            gradient = gradient + w * np.concatenate(grad)
+                grad.append(2.0 * c[i] * off + c[i] ** 2 * ((d.T_ti + d.V) - E * d.S))
+            gradient = gradient + level.weight * np.concatenate(grad)
         if total < self.best_E:
             self.best_E, self.best = total, basis
         return total, gradient

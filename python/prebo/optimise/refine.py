@@ -23,6 +23,7 @@ from scipy.optimize import minimize
 
 from ..basis import Basis
 from ..errors import PreboError
+from ..matrices import Matrices
 from .parametrisation import Parametrisation
 
 
@@ -43,7 +44,7 @@ class FunctionEnergy:
         sub = rest
         self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
         self.rest = basis.subset(np.flatnonzero(self.keep))
-        self.S_rest = np.diag(expansion.m["S"])[self.keep]
+        self.S_rest = np.diag(expansion.m.S)[self.keep]
         self.p = Parametrisation.of(basis.subset([i]) if f is None else f)
         self.worse = expansion.energy + 1.0
         self.best_E, self.best_f = expansion.energy, None
@@ -67,8 +68,8 @@ class FunctionEnergy:
             return self.worse
         if not st.rep.plausible({"S": rows["S"][:, self.keep]}, diag, self.S_rest)[0]:
             return self.worse
-        e = st.objective.with_added(self.E, self.C, (rows["T_ti"] + rows["V"])[0, self.keep],
-                                    rows["S"][0, self.keep], diag[0, 2] + diag[0, 3], diag[0, 0], st.min_norm)
+        r, d = Matrices.of(rows), Matrices.columns(diag[0])
+        e = st.objective.with_added(self.E, self.C, r.H[0, self.keep], r.S[0, self.keep], d.H, d.S, st.min_norm)
         if not np.isfinite(e):
             return self.worse
         self._seen(e, f)
@@ -85,8 +86,8 @@ class FunctionEnergy:
             return self.worse, np.zeros_like(theta)
         if not st.rep.plausible({"S": rows["S"][:1]}, diag[:1], self.S_rest)[0]:
             return self.worse, np.zeros_like(theta)
-        H, S = rows["T_ti"] + rows["V"], rows["S"]
-        h_nn, s_nn = diag[:, 2] + diag[:, 3], diag[:, 0]
+        r, d = Matrices.of(rows), Matrices.columns(diag)
+        H, S, h_nn, s_nn = r.H, r.S, d.H, d.S
         e, g = st.objective.with_added_gradient(self.E, self.C, H[0], S[0], h_nn[0], s_nn[0], H[1:], S[1:],
                                                 h_nn[1:], s_nn[1:], st.min_norm)
         if not (np.isfinite(e) and np.all(np.isfinite(g))):
@@ -109,7 +110,7 @@ class GroupEnergy:
         sub = expansion.without(self.idx)
         self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
         self.rest = basis.subset(np.flatnonzero(keep))
-        self.S_rest = np.diag(expansion.m["S"])[keep]
+        self.S_rest = np.diag(expansion.m.S)[keep]
         self.p = [Parametrisation.of(basis.subset([i])) for i in self.idx]
         self.split = np.cumsum([len(p.theta()) for p in self.p])[:-1]
         self.worse = expansion.energy + 1.0
@@ -133,30 +134,35 @@ class GroupEnergy:
             return self.worse, np.zeros_like(theta)
         if not all(st.rep.plausible({"S": r["S"][:1, :nr]}, d[:1], self.S_rest)[0] for r, d in rows):
             return self.worse, np.zeros_like(theta)
-        X = [({"H": r["T_ti"] + r["V"], "S": r["S"]}, {"H": d[:, 2] + d[:, 3], "S": d[:, 0]}) for r, d in rows]
-        h = np.array([x["H"][0, :nr] for x, _ in X])
-        s = np.array([x["S"][0, :nr] for x, _ in X])
+        # member m's rows (the values, then the derivatives) against the rest, then the others, and its diagonal
+        full, diag = [Matrices.of(r) for r, _ in rows], [Matrices.columns(d) for _, d in rows]
+        H, S, H_nn, S_nn = [x.H for x in full], [x.S for x in full], [d.H for d in diag], [d.S for d in diag]
+        h = np.array([x[0, :nr] for x in H])
+        s = np.array([x[0, :nr] for x in S])
         others = [[o for o in range(k) if o != m] for m in range(k)]  # column nr + c of member m is others[m][c]
-        block = {}
-        for key in ("H", "S"):
-            B = np.diag([dg[key][0] for _, dg in X])
+
+        def block(M: list, M_nn: list) -> np.ndarray:
+            """The group's own matrix (k x k) of the members' rows M and diagonals M_nn."""
+            B = np.diag([x[0] for x in M_nn])
             for m in range(k):
                 for c, o in enumerate(others[m]):
                     if m < o:
-                        B[m, o] = B[o, m] = X[m][0][key][0, nr + c]
-            block[key] = B
-        total, levels = st.objective.with_block(self.E, self.C, h, s, block["H"], block["S"], st.min_norm,
+                        B[m, o] = B[o, m] = M[m][0, nr + c]
+            return B
+
+        total, levels = st.objective.with_block(self.E, self.C, h, s, block(H, H_nn), block(S, S_nn), st.min_norm,
                                                 near=st.eig.energies)
         if not np.isfinite(total):
             return self.worse, np.zeros_like(theta)
         grad = 0.0
-        for w, e, a, beta, norm2 in levels:  # Σ_levels w ∂e/∂θ (eigen module docstring, block update)
-            c_rest, g_level = self.C @ a, []
-            for m, (x, dg) in enumerate(X):
-                dX = x["H"][1:] - e * x["S"][1:]
+        for level in levels:  # Σ_levels w ∂e/∂θ (eigen module docstring, block update)
+            e, beta = level.e, level.beta
+            c_rest, g_level = self.C @ level.a, []
+            for m in range(k):
+                dX = H[m][1:] - e * S[m][1:]
                 g = 2.0 * beta[m] * (dX[:, :nr] @ c_rest + dX[:, nr:] @ beta[others[m]])
-                g_level.append((g + beta[m] ** 2 * (dg["H"][1:] - e * dg["S"][1:])) / norm2)
-            grad = grad + w * np.concatenate(g_level)
+                g_level.append((g + beta[m] ** 2 * (H_nn[m][1:] - e * S_nn[m][1:])) / level.norm2)
+            grad = grad + level.weight * np.concatenate(g_level)
         if not np.all(np.isfinite(grad)):
             return self.worse, np.zeros_like(theta)
         if total < self.best_E:
@@ -167,7 +173,7 @@ class GroupEnergy:
 def partners(expansion, i: int, count: int) -> list[int]:
     """The `count` functions with the largest normalised overlap |S_ij| / (S_ii S_jj)^½ with
     function i (a function of the basis alone)."""
-    S = expansion.m["S"]
+    S = expansion.m.S
     overlap = np.abs(S[i]) / np.sqrt(S[i, i] * np.diag(S))
     overlap[i] = -1.0
     return [int(j) for j in np.argsort(-overlap, kind="stable")[:count]]

@@ -19,12 +19,11 @@ from ..system import System
 from ..validation import number
 from .checkpoint import CHECKPOINT
 from .convergence import STOPPED
-from .cursor import Cursor
 from .expansion import Expansion
 from .history import Step, check_history
 from .momentum import Momentum
-from .objective import Levels
-from .schedule import schedule_of
+from .objective import Followed, Levels
+from .schedule import kind_of, schedule_of
 from .settings import Optimiser
 
 
@@ -36,37 +35,30 @@ def resumed(d: dict, opts: Optimiser, rng: np.random.Generator, where: str) -> t
     if basis.kind != opts.kind:
         raise BasisFileError(f"{where}: a {basis.kind} basis, but the optimiser's kind is {opts.kind}")
     try:
-        cursor = Cursor(**d["progress"])
+        schedule, stopped = schedule_of(opts, d.get("schedule")), d.get("stopped")
+        cursor = schedule.cursor(d["progress"], len(basis))
         rng.bit_generator.state = check_rng(d["rng"])
         history, elapsed = [Step(*row) for row in check_history(d["history"])], number(d.get("elapsed", 0.0), "elapsed")
         if elapsed < 0:
             raise ValueError(f"elapsed = {elapsed!r}: must be the seconds of the run so far (≥ 0)")
-        schedule, stopped = schedule_of(opts, d.get("schedule")), d.get("stopped")
         if stopped not in STOPPED:
             raise ValueError(f"stopped = {reprlib.repr(stopped)}: must be one of {tuple(STOPPED)}")
     except (KeyError, TypeError, ValueError) as exc:
         raise BasisFileError(f"{where}: malformed run state ({exc})") from exc
     nb = len(basis)
     if (cursor.phase != "grow" and nb == 0) or (cursor.phase in ("sweep", "refine") and cursor.index >= nb):
-        raise BasisFileError(f"{where}: progress {vars(cursor)} does not fit a basis of {nb} functions")
-    beyond = growth_past_size(opts)
+        raise BasisFileError(f"{where}: progress {cursor.to_dict()} does not fit a basis of {nb} functions")
+    beyond = kind_of(opts).beyond(opts)
     if nb > opts.size + beyond:
         pruning = f" (and {beyond} more while pruning)" if beyond else ""
         raise BasisFileError(f"{where}: {nb} functions, more than the run's size = {opts.size}{pruning} allows")
     return basis, cursor, history, elapsed, schedule, stopped
 
 
-def growth_past_size(opts: Optimiser) -> int:
-    """The functions a checkpoint of `opts`'s run may hold past its size: a fixed schedule's
-    pruning grows `prune` functions past it a step at a time, a checkpoint after each; an adaptive
-    one grows and prunes in one step (methods.PrunePass), so its checkpoints never stand above it."""
-    return 0 if opts.adaptive else opts.prune or 0
-
-
 def followed_roots(d: dict, targets: tuple, where: str,
-                   recorded: Callable[[tuple], bool] | None = None) -> tuple[tuple, list]:
+                   recorded: Callable[[tuple], bool] | None = None) -> tuple[tuple, list[Followed]]:
     """The root indices at which a run with several or higher targeted levels (`targets`, the
-    state's) stood, and the record of its re-assignments (objective.py, following), from checkpoint
+    state's) stood, and the record of its re-assignments (objective.Followed), from checkpoint
     content `d` (the state's own indices where it has none); BasisFileError naming `where`, the key
     and its value for `levels` that are not distinct root indices, `followed` rows that are not
     [seconds, roots before, roots after], and levels that do not stand one per targeted level at or
@@ -74,25 +66,34 @@ def followed_roots(d: dict, targets: tuple, where: str,
     edited key is the state's `roots` if they are not where the levels started — the first row's
     roots before, or, for levels that never moved, the roots at which the checkpoint's objective is
     Σ w_k E_k (`recorded(roots)`: whether it is at `roots`; without it, `levels` is named)."""
-    levels, followed = d.get("levels", list(targets)), d.get("followed", [])
+    levels, rows = d.get("levels", list(targets)), d.get("followed", [])
+    followed = [followed_row(f) for f in rows] if isinstance(rows, list) else [None]
     if not indices(levels):
         raise BasisFileError(f"{where}: levels = {reprlib.repr(levels)}: must be distinct root indices, one per "
                              "targeted level")
-    if not (isinstance(followed, list) and all(isinstance(f, list) and len(f) == 3 and indices(f[1])
-                                               and indices(f[2]) for f in followed)):
-        raise BasisFileError(f"{where}: followed = {reprlib.repr(followed)}: must be [seconds, roots before, "
+    if None in followed:
+        raise BasisFileError(f"{where}: followed = {reprlib.repr(rows)}: must be [seconds, roots before, "
                              "roots after] rows")
     if len(levels) == len(targets) and all(r >= t for r, t in zip(levels, targets)):
         return tuple(levels), followed
     state = d["system"]["state"]
-    if followed[0][1] != list(targets) if followed else recorded is not None and not recorded(targets):
+    if followed[0].before != tuple(targets) if followed else recorded is not None and not recorded(targets):
         read = f"roots = {reprlib.repr(state['roots'])}" if "roots" in state else "no roots (the lowest alone)"
-        how = f"where its levels started, followed[0]: {followed[0][1]}" if followed else \
+        how = f"where its levels started, followed[0]: {list(followed[0].before)}" if followed else \
             f"its objective is not Σ w_k E_k there; its levels = {levels} never moved"
         raise BasisFileError(f"{where}: system.state: {read}: not the roots the run targeted ({how}): a resumed run "
                              "goes on for its own; start a new run for other roots")
     raise BasisFileError(f"{where}: levels = {reprlib.repr(levels)}: must be {len(targets)} root indices, one per "
                          f"targeted level, each at or above its target {list(targets)}")
+
+
+def followed_row(row) -> Followed | None:
+    """The re-assignment of a checkpoint's `followed` row [seconds, roots before, roots after]
+    (objective.Followed), or None for a malformed one."""
+    if not (isinstance(row, list) and len(row) == 3):
+        return None
+    _, before, after = row
+    return Followed.of(row) if indices(before) and indices(after) else None
 
 
 def indices(roots) -> bool:
@@ -131,7 +132,8 @@ def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
     except PreboError as exc:
         raise BasisFileError(f"{path}: {exc}") from exc
     basis, *_ = resumed(d, opts, np.random.default_rng(), str(path))
-    followed_roots(d, basis.system.state.levels[0], str(path), lambda roots: objective_at(d, basis, opts, roots))
+    targets, _ = basis.system.state.levels
+    followed_roots(d, targets, str(path), lambda roots: objective_at(d, basis, opts, roots))
     Momentum.from_dict(d.get("momentum"), basis, str(path))
     return d, basis.system, opts
 
@@ -139,10 +141,10 @@ def load_checkpoint(folder) -> tuple[dict, System, Optimiser]:
 def objective_at(d: dict, basis: Basis, opts: Optimiser, roots: tuple) -> bool:
     """Whether checkpoint content `d`'s objective is Σ w_k E_k of `basis` at `roots` (the state's
     weights; the run's representation and linear-dependence settings), to 1e-10 relative."""
-    recorded = d.get("objective")
+    recorded, (_, weights) = d.get("objective"), basis.system.state.levels
     try:
         value = Expansion(basis, laboratory(basis.system), opts.threshold, opts.min_norm, opts.max_overlap,
-                          Levels(roots, basis.system.state.levels[1])).energy
+                          Levels(roots, weights)).energy
     except PreboError:
         return False
     return type(recorded) is float and abs(value - recorded) <= 1e-10 * abs(recorded)

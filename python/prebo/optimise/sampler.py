@@ -88,6 +88,19 @@ def pair_lengths(system: System) -> tuple[np.ndarray, np.ndarray]:
     return a, outer
 
 
+@dataclass(frozen=True, slots=True)
+class Learned:
+    """A channel's learned distribution (Sampler.learn): the parametrisation `p` of one of its
+    functions, the mean and spread of θ, the powers K (None for a family without), and the
+    `count` of its functions (its share of the draws)."""
+
+    p: Parametrisation
+    mean: np.ndarray
+    std: np.ndarray
+    Ks: np.ndarray | None
+    count: int
+
+
 @dataclass(frozen=True)
 class Carrier:
     """The coordinate v = u^T r a fresh draw singled out (its exponent carries the family's power)
@@ -147,8 +160,8 @@ class Sampler:
                 thetas.append(seen[key])
             thetas = np.array(thetas)
             Ks = basis.family.powers(basis, idx)
-            self.learned[ch] = (Parametrisation.of(basis.subset(idx[:1])), thetas.mean(axis=0), thetas.std(axis=0),
-                                Ks, len(idx))
+            self.learned[ch] = Learned(Parametrisation.of(basis.subset(idx[:1])), thetas.mean(axis=0),
+                                       thetas.std(axis=0), Ks, len(idx))
         self._thetas = seen
 
     def neighbours(self, f: Basis) -> list:
@@ -194,12 +207,12 @@ class Sampler:
         learned = getattr(self, "learned", {})
         if learned and self.rng.random() < self.opts.learned:
             names = list(learned)
-            weights = np.array([learned[c][4] for c in names], float)
-            p, mean, std, Ks, _ = learned[names[self.rng.choice(len(names), p=weights / weights.sum())]]
-            theta = mean + self.rng.normal(size=mean.shape) * np.maximum(std, 0.05)
-            K = None if Ks is None else family(self.opts.kind).draw_learned_power(self.rng, Ks, self.opts.K_max)
+            weights = np.array([learned[c].count for c in names], float)
+            one = learned[names[self.rng.choice(len(names), p=weights / weights.sum())]]
+            theta = one.mean + self.rng.normal(size=one.mean.shape) * np.maximum(one.std, 0.05)
+            K = None if one.Ks is None else family(self.opts.kind).draw_learned_power(self.rng, one.Ks, self.opts.K_max)
             try:
-                return p.function(theta, K)
+                return one.p.function(theta, K)
             except IllConditionedError:
                 return self.fresh()
         return self.fresh()

@@ -1,7 +1,13 @@
 """A schedule answers "what next" from the run's state and learns from what each unit of work
 left: the fixed one of the settings (fixed.py) or the adaptive one that chooses by the energy each
 kind of pass gains per second (adaptive.py). The driver (driver.optimise) runs either through
-`Schedule` alone, made by `schedule_of`.
+`Schedule` alone, made by `schedule_of`; what else depends on the kind — the defaults
+(defaults.resolved), the methods (methods.methods), a checkpoint's margin past the size
+(resume.py), the convergence report — asks the kind, `kind_of`.
+
+The kind is the [optimiser] setting `schedule`. Inputs written before it have none: there the
+kind is fixed if any of the fixed schedule's settings (settings.FIXED) is given, adaptive
+otherwise, as it was.
 """
 from __future__ import annotations
 
@@ -10,7 +16,10 @@ from typing import Protocol
 from .adaptive import Adaptive
 from .cursor import Cursor
 from .fixed import Fixed
-from .settings import Optimiser
+from .settings import FIXED, Optimiser
+
+#: the kinds of schedule by their [optimiser] schedule names
+KINDS = {kind.name: kind for kind in (Adaptive, Fixed)}
 
 
 class Schedule(Protocol):
@@ -49,13 +58,22 @@ class Schedule(Protocol):
         """The progress line's (description, done, total) of the unit of work at `cursor` on a basis
         of `nb` functions (report.Reporter)."""
 
+    def cursor(self, progress, nb: int) -> Cursor:
+        """The cursor of a checkpoint's "progress" block on a basis of `nb` functions."""
+
     def to_dict(self) -> dict:
         """The checkpoint's "schedule" block."""
 
 
+def kind_of(opts: Optimiser) -> type[Adaptive] | type[Fixed]:
+    """The kind of schedule of `opts`: its `schedule`, or where that is not given, fixed if any of
+    the fixed schedule's settings is (module docstring)."""
+    if opts.schedule is not None:
+        return KINDS[opts.schedule]
+    return Fixed if any(getattr(opts, k) is not None for k in FIXED) else Adaptive
+
+
 def schedule_of(opts: Optimiser, block: dict | None = None) -> Schedule:
-    """The schedule of `opts` (fixed unless `opts.adaptive`), with the state of a checkpoint's
-    "schedule" block (Adaptive.check: ValueError for one that is malformed; a fixed schedule's
-    block is an adaptive one's before its first pass, fixed.IDLE)."""
-    adaptive = Adaptive.check(opts, block)
-    return adaptive if opts.adaptive else Fixed(opts)
+    """The schedule of `opts` (`kind_of`), with the state of a checkpoint's "schedule" block (its
+    kind's `check`: ValueError for one that is malformed)."""
+    return kind_of(opts).check(opts, block)

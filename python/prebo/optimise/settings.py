@@ -24,7 +24,9 @@ LENGTHS = Lengths(1e-4, 1e4)
 #: energies within 6e-14 Eh (as any change of A's bits does), at 1e-3 He moves 2e-12, at 1e5 H 6e-13,
 #: and a run for H at c_A = 1e6 went below the exact energy
 C_A = Real(1e-2, 1e3, True, True)
-SCHEDULE = ("prune", "sweeps", "refine", "polish", "cycles")  # the fixed schedule's settings
+SCHEDULES = ("adaptive", "fixed")  # the kinds of schedule (schedule.py)
+FIXED = ("prune", "sweeps", "refine", "polish", "cycles")  # the fixed schedule's own settings
+ADAPTIVE = ("tolerance",)  # the adaptive schedule's own settings
 
 
 @dataclass(frozen=True)
@@ -37,6 +39,9 @@ class Setting:
 
 
 SETTINGS = {
+    "schedule": Setting(Automatic(Choice(SCHEDULES)), "the schedule: one that chooses its passes by the energy "
+                        "each gains per second, or the fixed one of prune, sweeps, refine, polish and cycles (not "
+                        "given: fixed if any of those is given)", "[optimiser] schedule"),
     "size": Setting(Integer(1, MAX_SIZE), f"basis functions; at most {MAX_SIZE}, what {MATRICES} nb x nb "
                     "matrices in this machine's memory allow", "[basis] size"),
     "trials": Setting(Automatic(Integer(1, MAX_SIZE)), "competitive trials per step", "[optimiser] trials"),
@@ -108,10 +113,12 @@ class Optimiser:
     trials that perturb functions of the basis at their own scale; with near > 0 a replacement
     sweep's trials all move the function replaced (sampler.py; chosen by the schedule when not
     given).
-    Schedule: with none of prune, sweeps, refine, polish and cycles given, the schedule chooses itself
-    (adaptive.py: growth, refinement, replacement, joint and pruning passes by the energy each
-    gains per second), stopping at `budget` seconds, or when every kind of pass gains less than
-    `tolerance` Eh. Given any of them, the fixed schedule of methods.py: prune — functions grown
+    Schedule: schedule — "adaptive" chooses itself (adaptive.py: growth, refinement, replacement,
+    joint and pruning passes by the energy each gains per second), stopping at `budget` seconds,
+    or when every kind of pass gains less than `tolerance` Eh; "fixed" (fixed.py) runs the
+    settings FIXED; not given (inputs written before it), fixed if any of FIXED is given, else
+    adaptive (schedule.kind_of); given, a setting of the other kind (FIXED, ADAPTIVE) is refused.
+    prune — functions grown
     past `size` and then removed, those whose removal costs least, at the start of each cycle; sweeps — replacement
     sweeps per cycle; refine — refinement sweeps per cycle (and refinement of every grown or
     replacing function when > 0); polish — joint L-BFGS steps per cycle; cycles — repetitions of
@@ -128,6 +135,7 @@ class Optimiser:
     relative overlap eigenvalue below which eigen.solve drops directions.
     """
 
+    schedule: str | None = None
     size: int = 50
     trials: int | None = None
     sweeps: int | None = None
@@ -155,11 +163,6 @@ class Optimiser:
     max_overlap: float = 0.99
     threshold: float = THRESHOLD
 
-    @property
-    def adaptive(self) -> bool:
-        """Whether the schedule chooses itself (none of prune, sweeps, refine, polish, cycles given)."""
-        return all(getattr(self, k) is None for k in SCHEDULE)
-
     def to_dict(self) -> dict:
         """The settings as a JSON-ready mapping (a checkpoint's "optimiser")."""
         return vars(self) | {"length_range": list(self.length_range)}
@@ -174,3 +177,9 @@ class Optimiser:
     def __post_init__(self):
         for f in fields(self):
             setattr(self, f.name, check(f.name, getattr(self, f.name), f"Optimiser {f.name}"))
+        if self.schedule is not None:
+            other, theirs = {"fixed": ("adaptive", ADAPTIVE), "adaptive": ("fixed", FIXED)}[self.schedule]
+            given = next((k for k in theirs if getattr(self, k) is not None), None)
+            if given is not None:
+                raise InputError(f"{SETTINGS[given].key} = {getattr(self, given)!r}: a setting of the {other} "
+                                 f"schedule, but schedule = {self.schedule!r}")
