@@ -3,8 +3,6 @@ checkpoint or ecgpack file is evaluated as the state its label says or refused i
 the file (and the function and key) — never a number for another state, never a traceback."""
 import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,9 +13,8 @@ from prebo.cli import main
 from prebo.errors import BasisFileError, InputError
 from prebo.io import basis_json, ecgpack
 from prebo.validation import MAX_SIZE
-from conftest import ROOT
+from conftest import ROOT, cli_error, prebo_process
 from test_fuzz import Accepted, accepting
-from test_validation import cli_error
 
 BASES = ROOT / "examples" / "bases"
 HE = BASES / "he" / "basis.json"  # singlet He, plain ECGs
@@ -234,7 +231,7 @@ def test_more_functions_than_memory_holds_are_refused_before_anything_is_built(t
     process of its own, as an abort would end the tests."""
     f = edited(tmp_path, HE, lambda d: (d.update(functions=(d["functions"] * (MAX_SIZE // 150 + 1))[:MAX_SIZE + 1]),
                                         d.pop("coefficients")))
-    r = subprocess.run([sys.executable, "-m", "prebo", "energy", str(f)], capture_output=True, text=True, timeout=120)
+    r = prebo_process("energy", f, timeout=120)
     assert r.returncode == 2 and r.stderr == (f"prebo: error: {f}: {MAX_SIZE + 1} functions, more than the "
                                               f"{MAX_SIZE} this machine's memory holds\n")
 

@@ -9,7 +9,7 @@ import pytest
 import prebo
 from prebo.cli import main
 from prebo.errors import InputError, LinearDependenceError
-from prebo.results import HARTREE_CM
+from prebo.level.evaluate import HARTREE_CM
 
 from conftest import ROOT, hydrogen_s
 

@@ -16,47 +16,11 @@ import prebo
 from prebo.cli import main
 from prebo.errors import InputError, PreboError
 
+from conftest import cli_error, h_input, toml_text
+
 ROOT = Path(__file__).resolve().parents[1]
 H_TOML = '[system]\nparticles = ["p", "e"]\n[basis]\nsize = 3\n[optimiser]\ntrials = 4\nseed = 3\n'
 HMINUS_TOML = '[system]\nparticles = ["p", "e", "e"]\n[basis]\nsize = 3\n[optimiser]\ntrials = 4\nseed = 3\n'
-
-
-def toml_value(v) -> str:
-    """A TOML literal of a Python value (strings, numbers with nan/inf, booleans, lists, tables)."""
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, float) and not np.isfinite(v):
-        return "nan" if v != v else ("inf" if v > 0 else "-inf")
-    if isinstance(v, (int, float)):
-        return repr(v)
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(map(toml_value, v)) + "]"
-    return "{" + ", ".join(f"{json.dumps(k)} = {toml_value(x)}" for k, x in v.items()) + "}"
-
-
-def toml_text(doc: dict) -> str:
-    """A TOML document of tables (a non-table value stays a top-level key)."""
-    top = [f"{json.dumps(k)} = {toml_value(v)}" for k, v in doc.items() if not isinstance(v, dict)]
-    tables = [f"[{json.dumps(k)}]\n" + "".join(f"{json.dumps(a)} = {toml_value(x)}\n" for a, x in v.items())
-              for k, v in doc.items() if isinstance(v, dict)]
-    return "".join(line + "\n" for line in top) + "".join(tables)
-
-
-def h_input(**optimiser) -> dict:
-    return {"system": {"particles": ["p", "e"]}, "basis": {"size": 3}, "optimiser": {"trials": 4, "seed": 3} | optimiser}
-
-
-def cli_error(capsys, *argv) -> str:
-    """Run `prebo ARGV` in-process; assert exit 2 and exactly one `prebo: error:` line on stderr;
-    return that line."""
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert rc == 2, (rc, out, err)
-    assert err.startswith("prebo: error: ") and err.count("\n") == 1 and "Traceback" not in err, err
-    assert out == ""
-    return err
 
 
 def toml_error(capsys, tmp_path, text, *words) -> str:

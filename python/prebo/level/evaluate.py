@@ -1,8 +1,8 @@
 """Energies of a basis: translation-free and laboratory-frame, with the virial coefficient.
 
 The pipeline's last stage (system → basis → integrals → eigen → results): `evaluate` is what
-`prebo energy`, `prebo run` (result.json) and the Python API report. It stays a top-level
-module because it uses every earlier stage and none of them uses it.
+`prebo energy`, `prebo run` (result.json) and the Python API report; it uses every earlier stage
+and none of them uses it.
 
 result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_uncertainty
 (Eh, below), energy_lab (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential,
@@ -46,14 +46,14 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import eigen
-from .basis import Basis
-from .errors import CancellationError, InputError
+from .. import eigen
+from ..basis import Basis
+from ..errors import CancellationError, InputError
+from ..integrals import laboratory, require_shared_c_A, translationally_invariant
+from ..optimise.settings import check
+from ..thresholds import candidates, lowest
+from ..validation import Integer, checked
 from .expectation import densities, density_classes, expectation, operator
-from .integrals import laboratory, require_shared_c_A, translationally_invariant
-from .optimise.settings import check
-from .thresholds import candidates, lowest
-from .validation import Integer, checked
 
 #: the hartree in wavenumbers, E_h/(hc) in cm⁻¹ (CODATA 2018: E. Tiesinga et al., Rev. Mod. Phys.
 #: 93, 025010 (2021), hartree-inverse meter relationship 2.1947463136320e7 m⁻¹)
