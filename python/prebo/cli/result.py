@@ -10,15 +10,18 @@ from ..level.expectation import OPERATORS
 from .tables import show
 
 
-def result(basis, where, threshold: float, coordinates: str = "lab", operators=(), roots: int | None = None) -> dict:
+def result(basis, where, threshold: float, coordinates: str = "lab", operators=(), roots: int | None = None,
+           targets=None) -> dict:
     """The JSON-ready result of `basis` (overlap directions below `threshold` dropped, with the
-    expectation values of `operators` and the lowest `roots` levels; level.evaluate);
+    expectation values of `operators` and the lowest `roots` levels, the levels optimised standing
+    at the roots `targets`; level.evaluate);
     NonFiniteError naming the keys that are not finite numbers, and every error prefixed with
     `where` (the basis file)."""
     from ..level.evaluate import evaluate, public
 
     try:
-        r = public(evaluate(basis, coordinates=coordinates, operators=operators, threshold=threshold, roots=roots))
+        r = public(evaluate(basis, coordinates=coordinates, operators=operators, threshold=threshold, roots=roots,
+                            targets=targets))
         flat = {}
         for prefix, part in [("", r)] + [(f"level {v['root']} ", v) for v in r.get("levels", [])]:
             flat |= {prefix + k: v for k, v in part.items()}
@@ -40,8 +43,9 @@ def print_result(r: dict) -> None:
     from ..optimise.convergence import STOPPED
 
     t = Table(show_header=False, box=None)
-    # the head is root 0's (level.evaluate); a basis optimised for other levels says so
-    of = "" if r.get("targets", [0]) == [0] else " of root 0"
+    # the head is the lowest targeted root's (level.evaluate); a basis optimised for other levels than
+    # the lowest says which
+    of = "" if r.get("targets", [0]) == [0] else f" of root {r['root']}"
     t.add_row(f"energy{of} (translation-free)", f"{r['energy']:.12f} Eh")
     t.add_row("numerical uncertainty", f"{r['energy_uncertainty']:.1e} Eh")
     if r.get("energy_lab") is not None:
@@ -124,7 +128,7 @@ def warn_if_unbound(r: dict) -> None:
         print(f"prebo: warning: E = {r['energy']:.12g} Eh is not below the dissociation threshold "
               f"{r['threshold']:.12g} Eh ({r['threshold_fragments']}): the state is not bound in this basis "
               "(a small virial coefficient is no evidence of binding)", file=sys.stderr)
-    above = [v["root"] for v in r.get("levels", [])[1:] if not v["bound"]]
+    above = [v["root"] for v in r.get("levels", []) if v["root"] != r["root"] and not v["bound"]]
     if above and r["bound"]:
         which = f"level {above[0]}" if len(above) == 1 else f"{len(above)} levels ({above[0]}, ..., {above[-1]})"
         print(f"prebo: warning: {which} not below the dissociation threshold {r['threshold']:.12g} Eh "

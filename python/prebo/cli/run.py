@@ -84,16 +84,13 @@ def command(args) -> int:
         where = out / LOWEST if (out / LOWEST).exists() else out / CHECKPOINT  # the file of the state returned
         levels = basis.convergence.get("levels")  # where the targeted levels stand, if followed
         derived = reported(basis.family)  # the properties block
-        roots = None if levels is None else max(levels) + 1
         try:
-            r = result(basis, where, opts.threshold, operators=derived, roots=roots)
+            r = result(basis, where, opts.threshold, operators=derived, targets=levels)
         except NonFiniteError as exc:  # the energies stand without the properties: say so, write them
-            r = result(basis, where, opts.threshold, roots=roots)
+            r = result(basis, where, opts.threshold, targets=levels)
             print(f"prebo: warning: result.json without expectation values: {exc}", file=sys.stderr)
         for level in r.get("levels", [r]):  # each level's Breit–Pauli correction and regularised δ, p⁴
             level |= corrections(basis, level)
-        if levels is not None:
-            r["targets"] = levels
         r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
               "convergence": basis.convergence, "provenance": provenance()}
         if root:
