@@ -11,6 +11,7 @@ pytest.register_assert_rewrite("gvr_reference", "fecg_reference")  # helper modu
 
 import prebo  # noqa: E402
 from prebo.cli import main  # noqa: E402
+from prebo.io import ecgpack  # noqa: E402
 from prebo.io.toml import tomllib  # noqa: E402  (tomli before Python 3.11)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -19,6 +20,12 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="session")
 def references():
     return tomllib.loads((ROOT / "tests" / "data" / "reference_energies.toml").read_text())
+
+
+@pytest.fixture(scope="module")
+def li():
+    """Li (⁷Li, 100 plain ECGs) read from its ecgpack file."""
+    return ecgpack.read_inout(ROOT / "tests" / "data" / "ecgpack" / "ecgpack-Li7-100.inout.txt")
 
 
 def pair_A(system, alpha: dict, c_A: float) -> np.ndarray:
@@ -92,6 +99,15 @@ def scaled_error(got, ref, scale=None) -> float:
     sc = ref if scale is None else scale
     d = np.sqrt(np.abs(np.outer(np.diag(sc), np.diag(sc))))
     return float(np.max(np.abs(got - ref) / np.maximum(np.abs(ref), d)))
+
+
+def edited(tmp_path, src, edit, name="basis.json") -> Path:
+    """A copy of basis file `src` with `edit(d)` applied to its mapping."""
+    d = json.loads(Path(src).read_text())
+    edit(d)
+    f = tmp_path / name
+    f.write_text(json.dumps(d))
+    return f
 
 
 def toml_value(v) -> str:

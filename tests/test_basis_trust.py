@@ -2,8 +2,6 @@
 checkpoint or ecgpack file is evaluated as the state its label says or refused in one line naming
 the file (and the function and key) — never a number for another state, never a traceback."""
 import json
-import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +11,7 @@ from prebo.cli import main
 from prebo.errors import BasisFileError, InputError
 from prebo.io import basis_json, ecgpack
 from prebo.validation import MAX_SIZE
-from conftest import ROOT, cli_error, prebo_process
+from conftest import ROOT, cli_error, edited, prebo_process
 from test_fuzz import Accepted, accepting
 
 BASES = ROOT / "examples" / "bases"
@@ -22,15 +20,6 @@ GVR = BASES / "h2plus-gvr" / "basis.json"
 FECG = BASES / "h2plus-fecg" / "basis.json"
 RUN = BASES / "auto-h" / "basis.json"  # a finished run's checkpoint (H, plain ECGs)
 DATA = ROOT / "tests" / "data" / "ecgpack"
-
-
-def edited(tmp_path, src, edit, name="basis.json") -> Path:
-    """A copy of basis file `src` with `edit(d)` applied to its mapping."""
-    d = json.loads(Path(src).read_text())
-    edit(d)
-    f = tmp_path / name
-    f.write_text(json.dumps(d))
-    return f
 
 
 def energy(capsys, f) -> float:
@@ -78,11 +67,6 @@ def test_a_malformed_symmetry_block_is_refused(tmp_path, capsys, block, words):
     f = edited(tmp_path, HE, lambda d: d.update(symmetry=block))
     err = cli_error(capsys, "energy", f)
     assert str(f) in err and words in err
-
-
-@pytest.fixture(scope="module")
-def li():
-    return ecgpack.read_inout(DATA / "ecgpack-Li7-100.inout.txt")
 
 
 def test_an_ecgpack_operator_is_kept_and_checked_against_the_state(li, tmp_path, capsys):

@@ -34,11 +34,6 @@ def he():
     return ecgpack.read_inout(HE)
 
 
-@pytest.fixture(scope="module")
-def li():
-    return ecgpack.read_inout(LI)
-
-
 def rel(a, b):
     return abs(a - b) / abs(b)
 

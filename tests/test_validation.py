@@ -16,7 +16,7 @@ import prebo
 from prebo.cli import main
 from prebo.errors import InputError, PreboError
 
-from conftest import cli_error, h_input, toml_text
+from conftest import cli_error, edited, h_input, toml_text
 
 ROOT = Path(__file__).resolve().parents[1]
 H_TOML = '[system]\nparticles = ["p", "e"]\n[basis]\nsize = 3\n[optimiser]\ntrials = 4\nseed = 3\n'
@@ -45,24 +45,16 @@ def bases(tmp_path_factory):
     return {"pecg": d / "h.json", "gvr": d / "h2p.json"}
 
 
-def edited(path, tmp_path, edit) -> Path:
-    d = json.loads(Path(path).read_text())
-    edit(d)
-    f = tmp_path / "edited.json"
-    f.write_text(json.dumps(d))
-    return f
-
-
 # --- 2: a basis type that cannot describe the state ---------------------------------------
 @pytest.mark.parametrize("N, parity", [(1, -1), (1, 1), (0, -1)])
 def test_plain_ecg_basis_file_with_another_state_is_refused(bases, tmp_path, capsys, N, parity):
-    f = edited(bases["pecg"], tmp_path, lambda d: d["system"]["state"].update(N=N, parity=parity))
+    f = edited(tmp_path, bases["pecg"], lambda d: d["system"]["state"].update(N=N, parity=parity))
     err = cli_error(capsys, "energy", f, "--json")
     assert str(f) in err and "N = 0, parity +1" in err and f"not N = {N}, parity {parity:+d}" in err
 
 
 def test_gvr_basis_file_with_unnatural_parity_is_refused(bases, tmp_path, capsys):
-    f = edited(bases["gvr"], tmp_path, lambda d: d["system"]["state"].update(parity=1))
+    f = edited(tmp_path, bases["gvr"], lambda d: d["system"]["state"].update(parity=1))
     assert "natural parity (-1)^N = -1" in cli_error(capsys, "energy", f)
 
 
@@ -156,7 +148,7 @@ def test_overflowing_basis_gives_an_error_not_nan(bases, tmp_path, capsys):
         f = d["functions"][0]
         f["A"] = (np.array(f["A"]) * 1e300).tolist()
         f["c_A"] *= 1e300
-    f = edited(bases["pecg"], tmp_path, scale)
+    f = edited(tmp_path, bases["pecg"], scale)
     for extra in ([], ["--json"]):
         err = cli_error(capsys, "energy", f, *extra)
         assert str(f) in err and "finite" in err
@@ -201,7 +193,7 @@ def test_basis_file_without_functions(bases, tmp_path, capsys):
     def empty(d):
         d["functions"] = []
         del d["coefficients"]
-    f = edited(bases["pecg"], tmp_path, empty)
+    f = edited(tmp_path, bases["pecg"], empty)
     assert "the basis has no functions" in cli_error(capsys, "energy", f)
 
 
