@@ -19,8 +19,8 @@ import tomllib
 from pathlib import Path
 
 import prebo
-from prebo.relativistic import ALPHA
-from prebo.results import HARTREE_CM
+from prebo.level.evaluate import HARTREE_CM
+from prebo.level.relativistic import ALPHA
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,5 +1,5 @@
 """Convergence of the contact density ⟨δ³(r_ij)⟩ and of the lightest particles' ⟨p⁴⟩ with the basis
-size, direct against regularised (prebo.drachmann: Drachmann's δ, eq. 27, and ⟨p⁴⟩ by ⟨T_TI²⟩ =
+size, direct against regularised (prebo.level.drachmann: Drachmann's δ, eq. 27, and ⟨p⁴⟩ by ⟨T_TI²⟩ =
 ⟨(E − V)²⟩, eq. 27'; docs/properties-derivations.md §6).
 
 Hydrogen (finite proton mass) 1s in the n even-tempered s Gaussians 3e-3 · 1.6^k bohr⁻², k < n,

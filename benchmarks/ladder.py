@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 
 from prebo.io.toml import tomllib
-from prebo.results import HARTREE_CM
+from prebo.level.evaluate import HARTREE_CM
 
 ROOT = Path(__file__).resolve().parents[1]
 

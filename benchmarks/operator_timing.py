@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 import prebo
-from prebo.expectation import OPERATORS
+from prebo.level.expectation import OPERATORS
 from prebo.integrals import laboratory
 
 

@@ -1,5 +1,7 @@
 import itertools
 import json
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -9,6 +11,8 @@ import pytest
 pytest.register_assert_rewrite("gvr_reference", "fecg_reference")  # helper modules' asserts explained
 
 import prebo  # noqa: E402
+from prebo.cli import main  # noqa: E402
+from prebo.io import ecgpack  # noqa: E402
 from prebo.io.toml import tomllib  # noqa: E402  (tomli before Python 3.11)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -17,6 +21,12 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="session")
 def references():
     return tomllib.loads((ROOT / "tests" / "data" / "reference_energies.toml").read_text())
+
+
+@pytest.fixture(scope="module")
+def li():
+    """Li (⁷Li, 100 plain ECGs) read from its ecgpack file."""
+    return ecgpack.read_inout(ROOT / "tests" / "data" / "ecgpack" / "ecgpack-Li7-100.inout.txt")
 
 
 def pair_A(system, alpha: dict, c_A: float) -> np.ndarray:
@@ -121,3 +131,70 @@ def mid_schedule(folder, seconds: float = 120) -> None:
         except (OSError, json.JSONDecodeError, KeyError):
             pass
         time.sleep(0.01)
+
+
+def custom(name: str, mass: float, charge: float) -> dict:
+    """A particle of its own, given by its table: spin ½, `mass` (m_e) and `charge` (e)."""
+    return {"name": name, "mass": mass, "charge": charge, "spin": 0.5}
+
+
+def scaled_error(got, ref, scale=None) -> float:
+    """max_IJ |got - ref| / max(|ref_IJ|, sqrt|scale_II scale_JJ|) of two matrices (`scale`: ref if None)."""
+    sc = ref if scale is None else scale
+    d = np.sqrt(np.abs(np.outer(np.diag(sc), np.diag(sc))))
+    return float(np.max(np.abs(got - ref) / np.maximum(np.abs(ref), d)))
+
+
+def edited(tmp_path, src, edit, name="basis.json") -> Path:
+    """A copy of basis file `src` with `edit(d)` applied to its mapping."""
+    d = json.loads(Path(src).read_text())
+    edit(d)
+    f = tmp_path / name
+    f.write_text(json.dumps(d))
+    return f
+
+
+def toml_value(v) -> str:
+    """A TOML literal of a Python value (strings, numbers with nan/inf, booleans, lists, tables)."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, float) and not np.isfinite(v):
+        return "nan" if v != v else ("inf" if v > 0 else "-inf")
+    if isinstance(v, (int, float)):
+        return repr(v)
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(map(toml_value, v)) + "]"
+    return "{" + ", ".join(f"{json.dumps(k)} = {toml_value(x)}" for k, x in v.items()) + "}"
+
+
+def toml_text(doc: dict) -> str:
+    """A TOML document of tables (a non-table value stays a top-level key)."""
+    top = [f"{json.dumps(k)} = {toml_value(v)}" for k, v in doc.items() if not isinstance(v, dict)]
+    tables = [f"[{json.dumps(k)}]\n" + "".join(f"{json.dumps(a)} = {toml_value(x)}\n" for a, x in v.items())
+              for k, v in doc.items() if isinstance(v, dict)]
+    return "".join(line + "\n" for line in top) + "".join(tables)
+
+
+def h_input(**optimiser) -> dict:
+    """The input of a 3-function H run (the `optimiser` settings added) as a TOML document's dict."""
+    return {"system": {"particles": ["p", "e"]}, "basis": {"size": 3}, "optimiser": {"trials": 4, "seed": 3} | optimiser}
+
+
+def cli_error(capsys, *argv) -> str:
+    """Run `prebo ARGV` in-process; assert exit 2 and exactly one `prebo: error:` line on stderr;
+    return that line."""
+    rc = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    assert rc == 2, (rc, out, err)
+    assert err.startswith("prebo: error: ") and err.count("\n") == 1 and "Traceback" not in err, err
+    assert out == ""
+    return err
+
+
+def prebo_process(*args, timeout: float = 300, **kw) -> subprocess.CompletedProcess:
+    """`python -m prebo ARGS` in a process of its own, its output captured as text."""
+    return subprocess.run([sys.executable, "-m", "prebo", *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout, **kw)
+

@@ -14,10 +14,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).parent))
 
 import prebo  # noqa: E402
-from prebo.expectation import OPERATORS  # noqa: E402
+from prebo.level.expectation import OPERATORS  # noqa: E402
 from prebo.integrals import laboratory  # noqa: E402
 from prebo.parallel import world  # noqa: E402
-from test_operators import _p, family_basis  # noqa: E402
+from conftest import custom  # noqa: E402
+from test_operators import family_basis  # noqa: E402
 
 
 def same(a: dict, b: dict, what: str) -> None:
@@ -27,7 +28,7 @@ def same(a: dict, b: dict, what: str) -> None:
 
 def integrals() -> None:
     ranks = world()
-    e, p = _p("e", 1.0, -1.0), _p("p", 1836.15267343, 1.0)
+    e, p = custom("e", 1.0, -1.0), custom("p", 1836.15267343, 1.0)
     for kind, N in [("pecg", 0), ("ecg-gvr", 0), ("ecg-gvr", 1), ("fecg", 0)]:
         system = prebo.System([p, e, e], state=prebo.State(N=N, parity=(-1) ** N, spin={"e": 0}))
         rng = np.random.default_rng(11)
@@ -65,14 +66,14 @@ def fail() -> None:
     ranks = world()
     if ranks.rank == ranks.size - 1:
         raise RuntimeError("a deliberate failure on the last rank")
-    e, p = _p("e", 1.0, -1.0), _p("p", 1836.15267343, 1.0)
+    e, p = custom("e", 1.0, -1.0), custom("p", 1836.15267343, 1.0)
     system = prebo.System([p, e, e], state=prebo.State(N=0, parity=1, spin={"e": 0}))
     basis = family_basis("pecg", system, np.random.default_rng(1), nb=40)
     laboratory(system).matrices(basis)
 
 
 def diverge() -> None:
-    e, p = _p("e", 1.0, -1.0), _p("p", 1836.15267343, 1.0)
+    e, p = custom("e", 1.0, -1.0), custom("p", 1836.15267343, 1.0)
     system = prebo.System([p, e, e], state=prebo.State(N=0, parity=1, spin={"e": 0}))
     basis = family_basis("pecg", system, np.random.default_rng(1), nb=20 + world().rank)
     laboratory(system).matrices(basis)

@@ -2,10 +2,6 @@
 checkpoint or ecgpack file is evaluated as the state its label says or refused in one line naming
 the file (and the function and key) — never a number for another state, never a traceback."""
 import json
-import math
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,9 +11,8 @@ from prebo.cli import main
 from prebo.errors import BasisFileError, InputError
 from prebo.io import basis_json, ecgpack
 from prebo.validation import MAX_SIZE
-from conftest import ROOT
+from conftest import ROOT, cli_error, edited, prebo_process
 from test_fuzz import Accepted, accepting
-from test_validation import cli_error
 
 BASES = ROOT / "examples" / "bases"
 HE = BASES / "he" / "basis.json"  # singlet He, plain ECGs
@@ -25,15 +20,6 @@ GVR = BASES / "h2plus-gvr" / "basis.json"
 FECG = BASES / "h2plus-fecg" / "basis.json"
 RUN = BASES / "auto-h" / "basis.json"  # a finished run's checkpoint (H, plain ECGs)
 DATA = ROOT / "tests" / "data" / "ecgpack"
-
-
-def edited(tmp_path, src, edit, name="basis.json") -> Path:
-    """A copy of basis file `src` with `edit(d)` applied to its mapping."""
-    d = json.loads(Path(src).read_text())
-    edit(d)
-    f = tmp_path / name
-    f.write_text(json.dumps(d))
-    return f
 
 
 def energy(capsys, f) -> float:
@@ -81,11 +67,6 @@ def test_a_malformed_symmetry_block_is_refused(tmp_path, capsys, block, words):
     f = edited(tmp_path, HE, lambda d: d.update(symmetry=block))
     err = cli_error(capsys, "energy", f)
     assert str(f) in err and words in err
-
-
-@pytest.fixture(scope="module")
-def li():
-    return ecgpack.read_inout(DATA / "ecgpack-Li7-100.inout.txt")
 
 
 def test_an_ecgpack_operator_is_kept_and_checked_against_the_state(li, tmp_path, capsys):
@@ -234,7 +215,7 @@ def test_more_functions_than_memory_holds_are_refused_before_anything_is_built(t
     process of its own, as an abort would end the tests."""
     f = edited(tmp_path, HE, lambda d: (d.update(functions=(d["functions"] * (MAX_SIZE // 150 + 1))[:MAX_SIZE + 1]),
                                         d.pop("coefficients")))
-    r = subprocess.run([sys.executable, "-m", "prebo", "energy", str(f)], capture_output=True, text=True, timeout=120)
+    r = prebo_process("energy", f, timeout=120)
     assert r.returncode == 2 and r.stderr == (f"prebo: error: {f}: {MAX_SIZE + 1} functions, more than the "
                                               f"{MAX_SIZE} this machine's memory holds\n")
 

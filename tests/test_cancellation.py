@@ -5,11 +5,10 @@ import numpy as np
 import pytest
 
 import prebo
-from conftest import ROOT, random_basis
+from conftest import ROOT, cli_error, random_basis
 from prebo.errors import CancellationError, UnsupportedError
 from prebo.integrals import laboratory
 from prebo.optimise.expansion import Expansion
-from test_validation import cli_error
 
 HE_FILE = ROOT / "tests" / "data" / "ecgpack" / "ecgpack-He4-490.inout.txt"
 

@@ -11,13 +11,12 @@ import prebo
 from prebo.cli import main
 from prebo.errors import InputError, NonFiniteError
 from prebo import eigen
-from prebo.expectation import densities
 from prebo.integrals import laboratory, translationally_invariant
-from prebo.results import grids
-from prebo.properties import rms
+from prebo.level.evaluate import grids
+from prebo.level.expectation import densities
+from prebo.level.properties import rms
 
-from conftest import ROOT, hydrogen_s
-from test_validation import cli_error
+from conftest import ROOT, cli_error, hydrogen_s
 
 BASES = ROOT / "examples" / "bases"
 

@@ -1,4 +1,4 @@
-"""Drachmann's regularised ⟨δ³(r_ij)⟩ (prebo.drachmann; docs/properties-derivations.md §6, eq. 27)
+"""Drachmann's regularised ⟨δ³(r_ij)⟩ (prebo.level.drachmann; docs/properties-derivations.md §6, eq. 27)
 on wave functions: hydrogen against the closed form, helium and H2⁺ (floating ECGs, ECG-GVR) against
 the direct ⟨δ⟩. The elements are checked against quadratures in
 crates/prebo-core/src/operators/drachmann.rs."""
@@ -10,11 +10,11 @@ import pytest
 import prebo
 from prebo import eigen
 from prebo.cli import main
-from prebo import drachmann
-from prebo.drachmann import delta_regularised
-from prebo.expectation import expectation
 from prebo.integrals import laboratory, translationally_invariant
 from prebo.io.ecgpack import read_inout
+from prebo.level import drachmann
+from prebo.level.drachmann import delta_regularised
+from prebo.level.expectation import expectation
 
 from conftest import ROOT, hydrogen_s
 
@@ -115,7 +115,7 @@ def test_a_heavy_repelling_pair_keeps_the_direct_contact_density(capsys):
     direct, m = p["expectation"]["delta"]["p-p"], basis.system.particles[0].mass
     assert direct > 0
     # the Darwin term of the one p-p pair of two Dirac protons (q_p² = 1) with the direct value
-    darwin = -np.pi * prebo.relativistic.ALPHA**2 / 2 * (2 / m**2) * direct
+    darwin = -np.pi * prebo.level.relativistic.ALPHA**2 / 2 * (2 / m**2) * direct
     assert p["breit_pauli"]["classes"]["darwin"]["p-p"] == pytest.approx(darwin, rel=1e-12)
     # what the form would give for p-p: below zero
     inv_r, potential, gradient = (p["expectation"][name]["p-p"] for name in drachmann.TERMS)
@@ -130,7 +130,7 @@ def raw_delta(rep, basis, C, monkeypatch) -> list[dict]:
     """⟨δ³(r_ij)⟩ from its elements alone, whatever the symmetry says (`Operator.contact` off)."""
     from dataclasses import replace
 
-    from prebo import expectation as module
+    from prebo.level import expectation as module
     with monkeypatch.context() as m:
         m.setitem(module.OPERATORS, "delta", replace(module.OPERATORS["delta"], contact=False))
         return expectation(rep, basis, C, "delta")
@@ -143,7 +143,7 @@ def test_a_contact_density_zero_by_symmetry_is_zero_and_its_elements_agree(parti
     elements alone give ⟨δ³⟩ of that class at the rounding level (|value| < 1e-12 of the other
     classes'), and the reported value is 0.0 exactly, as is Drachmann's."""
     from conftest import random_basis
-    from prebo.expectation import vanishing
+    from prebo.level.expectation import vanishing
 
     system = prebo.System(particles, spin=spin)
     basis = random_basis(system, 12, np.random.default_rng(5))

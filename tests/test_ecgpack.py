@@ -34,11 +34,6 @@ def he():
     return ecgpack.read_inout(HE)
 
 
-@pytest.fixture(scope="module")
-def li():
-    return ecgpack.read_inout(LI)
-
-
 def rel(a, b):
     return abs(a - b) / abs(b)
 
@@ -77,7 +72,8 @@ def test_he_evaluated_as_ecgpack_solves_it(tmp_path, references):
     """ecgpack keeps every overlap direction; `prebo energy` of its file and of the file's import keeps
     them too (eigen.THRESHOLD, the default) and reproduces the file's energy (1.5e-13 above it), where
     the former default threshold, 1e-13, dropped 2 of the 490 directions and 1.7e-10 Eh."""
-    from prebo.cli import load_basis, main
+    from prebo.cli import main
+    from prebo.cli.files import load_basis
 
     assert main(["import", str(HE), "--out", str(tmp_path / "he.json")]) == 0
     for path in (HE, tmp_path / "he.json"):

@@ -186,3 +186,17 @@ def test_root_1_of_h_minus_and_ps_minus_is_optimised_and_reported_not_bound(tmp_
     assert main(["energy", str(tmp_path / "run" / "basis.json")]) == 0
     out = capsys.readouterr().out
     assert "energy of root 0 (translation-free)" in out and "binding energy of root 0" in out
+
+
+def test_a_root_1_run_writes_root_1_at_the_top_of_its_result(tmp_path):
+    """`prebo run` of a root = 1 input (H's 2s level): result.json's top-level energy, uncertainty
+    and virial coefficient are root 1's (`root`), the level it optimised, not root 0's (issue 56)."""
+    path = tmp_path / "in.toml"
+    path.write_text('[system]\nparticles = ["p", "e"]\n[state]\nroot = 1\n[basis]\nsize = 8\n'
+                    "[optimiser]\nrefine = 2\npolish = 5\nseed = 2\n")
+    assert main(["run", str(path), "--out", str(tmp_path / "run"), "--quiet"]) == 0
+    r = json.loads((tmp_path / "run" / "result.json").read_text())
+    assert r["targets"] == [1] and r["root"] == 1 and [v["root"] for v in r["levels"]] == [0, 1]
+    assert r["energy"] > r["levels"][0]["energy"] + 0.3  # 2s, not 1s (−μ/8 against −μ/2)
+    assert {k: r[k] for k in ("energy", "energy_uncertainty", "virial")} == \
+        {k: r["levels"][1][k] for k in ("energy", "energy_uncertainty", "virial")}

@@ -79,7 +79,7 @@ import pytest
 import prebo
 from prebo.integrals import laboratory, translationally_invariant
 
-from conftest import random_basis, random_centres, random_pair_A
+from conftest import custom, random_basis, random_centres, random_pair_A, scaled_error
 from fecg_reference import (N_THETA, blind_log_gaussian, coulomb_pair, coulomb_reference, gh_pair,
                             log_gauss_integral, reference)
 
@@ -89,22 +89,11 @@ RTOL = 1e-10  # quadrature comparisons (the rules are exact; observed ~1e-14)
 # ---------------------------------------------------------------------------
 # systems, bases, comparison
 # ---------------------------------------------------------------------------
-def _p(name, mass, charge):
-    return {"name": name, "mass": mass, "charge": charge, "spin": 0.5}
-
-
 def fecg_basis(system, A, c_A, centres):
     basis = prebo.Basis(system, np.array(A, float), np.array(c_A, float), kind="fecg",
                         s=np.array(centres, float))
     basis.validate()  # symmetric, positive definite, A 1 = c_A m/m_tot, finite centres
     return basis
-
-
-def scaled_error(got, ref, scale=None):
-    """max_IJ |got - ref| / max(|ref_IJ|, sqrt|scale_II scale_JJ|) (scale defaults to ref)."""
-    sc = ref if scale is None else scale
-    d = np.sqrt(np.abs(np.outer(np.diag(sc), np.diag(sc))))
-    return float(np.max(np.abs(got - ref) / np.maximum(np.abs(ref), d)))
 
 
 def worst(got, ref, scale=None):
@@ -162,7 +151,7 @@ TWO_BODY_CHARGES = {"attractive": (2.0, -1.0), "repulsive": (1.5, 0.8)}
 @pytest.mark.parametrize("charges", list(TWO_BODY_CHARGES))
 def test_two_particle_quadrature(charges):
     q = TWO_BODY_CHARGES[charges]
-    s = prebo.System([_p("a", 1.7, q[0]), _p("b", 0.6, q[1])])
+    s = prebo.System([custom("a", 1.7, q[0]), custom("b", 0.6, q[1])])
     rng = np.random.default_rng(21 + len(charges))
     cA = np.array([0.7, 1.3, 0.45, 2.1])
     A = np.array([random_pair_A(s, rng, c) for c in cA])
@@ -182,7 +171,7 @@ def test_two_particle_quadrature(charges):
     assert scaled_error(n2, l2) > 1e-2
 
 
-THREE_BODY = [_p("a", 1.7, 2.0), _p("b", 0.6, -1.0), _p("c", 3.1, -1.0)]
+THREE_BODY = [custom("a", 1.7, 2.0), custom("b", 0.6, -1.0), custom("c", 3.1, -1.0)]
 
 
 def three_body_basis(system, rng, nb):
@@ -225,7 +214,7 @@ def test_three_particle_quadrature():
 
 def test_identical_particles():
     """Three identical particles (spin 1/2 each, total 1/2): the Young operator has 3-cycles."""
-    s = prebo.System([_p("x", 0.9, -1.0)] * 3)
+    s = prebo.System([custom("x", 0.9, -1.0)] * 3)
     perms = s.symmetriser.permutations
     assert len(perms) == 6 and any(list(p) != list(np.argsort(p)) for p in perms)  # Π != Π^T occurs
     rng = np.random.default_rng(8)
@@ -252,7 +241,8 @@ SYSTEMS = {
     "p-e-mu": lambda: prebo.System(["p", "e", "mu"]),
     "p-e-e": lambda: prebo.System(["p", "e", "e"], state=prebo.State(spin={"e": 0})),
     "ps2": lambda: prebo.System(["e+", "e+", "e", "e"], state=prebo.State(spin={"e+": 0, "e": 0})),
-    "a-b-c-d": lambda: prebo.System([_p("a", 2.2, 1.0), _p("b", 1.0, -1.0), _p("c", 0.7, 1.5), _p("d", 4.0, -0.5)]),
+    "a-b-c-d": lambda: prebo.System([custom("a", 2.2, 1.0), custom("b", 1.0, -1.0), custom("c", 0.7, 1.5),
+                                     custom("d", 4.0, -0.5)]),
 }
 
 

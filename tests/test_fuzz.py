@@ -27,7 +27,8 @@ from prebo.basis import FAMILIES
 from prebo.cli import main
 from prebo.errors import PreboError
 from prebo.optimise import SETTINGS
-from test_validation import h_input, toml_text
+
+from conftest import h_input, prebo_process, toml_text
 
 ROOT = Path(__file__).resolve().parents[1]
 BASES = ROOT / "examples" / "bases"
@@ -428,11 +429,6 @@ def test_system_arguments(particles, state):
 
 
 # --- real processes ---------------------------------------------------------------------
-def prebo_process(*args, **kw):
-    return subprocess.run([sys.executable, "-m", "prebo", *map(str, args)], capture_output=True, text=True,
-                          timeout=120, **kw)
-
-
 def test_closed_output_pipe(tmp_path, checkpoints):
     """`prebo energy --json | true`: one line and exit 2, no BrokenPipeError traceback."""
     f = tmp_path / "basis.json"

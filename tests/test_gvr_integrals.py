@@ -74,7 +74,7 @@ import pytest
 import prebo
 from prebo.integrals import laboratory, translationally_invariant
 
-from conftest import pair_A, random_set_A
+from conftest import custom, pair_A, random_set_A, scaled_error
 from gvr_reference import (gauss_legendre_01, gauss_moment, gh_overlap_kinetic, gh_tensor, mp_reference,
                            spherical_overlap_coulomb)
 
@@ -84,12 +84,8 @@ MP_DPS = 50
 # ---------------------------------------------------------------------------
 # helpers: systems, bases, comparison
 # ---------------------------------------------------------------------------
-def _p(name, mass, charge):
-    return {"name": name, "mass": mass, "charge": charge, "spin": 0.5}
-
-
 def two_body(N, charges):
-    return prebo.System([_p("a", 1.7, charges[0]), _p("b", 0.6, charges[1])],
+    return prebo.System([custom("a", 1.7, charges[0]), custom("b", 0.6, charges[1])],
                         state=prebo.State(N=N, parity=(-1) ** N))
 
 
@@ -98,12 +94,6 @@ def gvr_basis(system, A, c_A, u, K):
                         u=np.array(u, float), K=np.array(K))
     basis.validate()  # symmetric, positive definite, A 1 = c_A m/m_tot
     return basis
-
-
-def scaled_error(got, ref):
-    """max_IJ |got - ref| / max(|ref_IJ|, sqrt|ref_II ref_JJ|)."""
-    d = np.sqrt(np.abs(np.outer(np.diag(ref), np.diag(ref))))
-    return float(np.max(np.abs(got - ref) / np.maximum(np.abs(ref), d)))
 
 
 def normalise(raw, s_raw):
@@ -258,7 +248,7 @@ def test_two_body_radial_high_k(N):
 
 
 def three_body_system(N):
-    return prebo.System([_p("x", 3.0, 2.0), _p("y", 1.0, -1.0), _p("z", 0.45, -1.0)],
+    return prebo.System([custom("x", 3.0, 2.0), custom("y", 1.0, -1.0), custom("z", 0.45, -1.0)],
                         state=prebo.State(N=N, parity=(-1) ** N))
 
 
@@ -300,13 +290,14 @@ def test_three_body_moments_high_k(N):
 # item 4: translation-free kinetic energy and TICC
 # ---------------------------------------------------------------------------
 FOUR_SYSTEMS = {
-    "x-y-z": lambda N: prebo.System([_p("x", 3.0, 2.0), _p("y", 1.0, -1.0), _p("z", 0.45, -1.0)],
+    "x-y-z": lambda N: prebo.System([custom("x", 3.0, 2.0), custom("y", 1.0, -1.0), custom("z", 0.45, -1.0)],
                                     state=prebo.State(N=N, parity=(-1) ** N)),
     "p-e-mu": lambda N: prebo.System(["p", "e", "mu"], state=prebo.State(N=N, parity=(-1) ** N)),
     "p-e-e": lambda N: prebo.System(["p", "e", "e"], state=prebo.State(N=N, parity=(-1) ** N, spin={"e": 0})),
     "ps2": lambda N: prebo.System(["e+", "e+", "e", "e"],
                                   state=prebo.State(N=N, parity=(-1) ** N, spin={"e+": 0, "e": 0})),
-    "a-b-c-d": lambda N: prebo.System([_p("a", 2.2, 1.0), _p("b", 1.0, -1.0), _p("c", 0.7, 1.5), _p("d", 4.0, -0.5)],
+    "a-b-c-d": lambda N: prebo.System([custom("a", 2.2, 1.0), custom("b", 1.0, -1.0), custom("c", 0.7, 1.5),
+                                       custom("d", 4.0, -0.5)],
                                       state=prebo.State(N=N, parity=(-1) ** N)),
 }
 

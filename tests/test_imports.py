@@ -83,7 +83,7 @@ def test_the_scan_sees_imports_inside_functions_and_relative_ones():
     g = graph()
     assert "prebo.optimise.settings" in g["prebo.io.toml"]  # from ..optimise.settings import ...
     assert "prebo.optimise.driver" in g["prebo.optimise"]  # from .driver import ... in __init__
-    assert "prebo.results" in g["prebo.cli"]  # inside a function
+    assert "prebo.level.evaluate" in g["prebo.cli.result"]  # inside a function
     assert cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
 
 

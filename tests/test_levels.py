@@ -2,6 +2,7 @@
 report the lowest K levels of the symmetry, each an upper bound to its exact level
 (Hylleraas–Undheim–MacDonald), their uncertainties, whether each is bound, and the transitions."""
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -9,7 +10,8 @@ import pytest
 import prebo
 from prebo.cli import main
 from prebo.errors import InputError, LinearDependenceError
-from prebo.results import HARTREE_CM
+from prebo.integrals import laboratory
+from prebo.level.evaluate import HARTREE_CM
 
 from conftest import ROOT, hydrogen_s
 
@@ -88,3 +90,34 @@ def test_roots_beyond_the_resolved_directions_and_bad_types_are_refused():
     for bad in (True, 2.0, "2"):
         with pytest.raises(InputError, match="evaluate: roots"):
             prebo.evaluate(basis, roots=bad)
+
+
+def test_a_root_k_result_is_that_roots_at_the_top(tmp_path, capsys):
+    """A basis optimised for root = 1 (H's 2s level): the top of its result — energy, uncertainty,
+    virial coefficient, expectation values, `coefficients`, the laboratory-frame energy — is root
+    1's, named by `root`, not root 0's; every targeted root's vector is kept (`vectors`), and
+    `prebo energy` heads its table with root 1 (issue 56)."""
+    basis, mu = hydrogen(20)
+    excited = replace(basis, system=prebo.System(basis.system.particles, prebo.State(root=1)))
+    r, both = prebo.evaluate(excited, operators=["r2"]), prebo.evaluate(basis, operators=["r2"], roots=2)
+    for key in ("energy", "energy_uncertainty", "virial", "kinetic", "potential", "bound", "binding_energy",
+                "expectation"):
+        assert r[key] == both["levels"][1][key], key
+    assert r["root"] == 1 and r["targets"] == [1] and r["levels"] == both["levels"]
+    assert r["energy"] > -mu / 8 and r["energy_lab"] - r["energy"] == pytest.approx(both["energy_lab"] - both["energy"])
+    m = laboratory(basis.system).matrices(basis)
+    c = r["coefficients"]
+    assert r["vectors"].shape == (len(basis), 1) and np.array_equal(r["vectors"][:, 0], c)
+    residual = (m["T_ti"] + m["V"]) @ c - r["energy"] * m["S"] @ c
+    assert c @ m["S"] @ c == pytest.approx(1.0) and np.max(np.abs(residual)) < 1e-8
+    pair = prebo.evaluate(replace(basis, system=prebo.System(basis.system.particles, prebo.State(roots=[0, 2]))))
+    assert pair["root"] == 0 and pair["energy"] == both["energy"] and pair["vectors"].shape == (len(basis), 2)
+    assert np.array_equal(pair["vectors"][:, 0], pair["coefficients"])
+    for bad in ([1, 1], [], [len(basis)], 1):
+        with pytest.raises(InputError, match="evaluate: targets"):
+            prebo.evaluate(basis, targets=bad)
+    f = tmp_path / "basis.json"
+    excited.save(f)
+    assert main(["energy", str(f)]) == 0
+    out = capsys.readouterr().out
+    assert "energy of root 1 (translation-free)" in out and f"{r['energy']:.12f} Eh" in out

@@ -22,7 +22,7 @@ SCRIPT = """
 import ctypes, glob, json, os, sys
 import numpy
 from prebo.basis import Basis
-from prebo.results import evaluate
+from prebo.level.evaluate import evaluate
 
 core = "unknown"
 for lib in glob.glob(os.path.join(os.path.dirname(numpy.__file__), "..", "numpy.libs", "*openblas*")):

@@ -19,7 +19,8 @@ import prebo
 from prebo.errors import InputError, PreboError
 from prebo.optimise.defaults import resolved
 from prebo.optimise.sampler import Sampler
-from test_validation import ROOT, cli_error, h_input, toml_text
+
+from conftest import ROOT, cli_error, h_input, toml_text
 
 BASES = ROOT / "examples" / "bases"
 FAMILY = settings(max_examples=40, derandomize=True, database=None, deadline=None,

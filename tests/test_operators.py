@@ -19,20 +19,16 @@ import pytest
 from numpy.polynomial.hermite import hermgauss
 
 import prebo
-from prebo.expectation import OPERATORS, vector
 from prebo.integrals import laboratory, translationally_invariant
+from prebo.level.expectation import OPERATORS, vector
 
-from conftest import ROOT, random_centres, random_pair_A
-
-
-def _p(name, mass, charge):
-    return {"name": name, "mass": mass, "charge": charge, "spin": 0.5}
+from conftest import ROOT, custom, random_centres, random_pair_A
 
 
 def distinguishable(n, N=0):
     """n distinguishable particles of O(1) masses and charges of both signs (symmetriser = 1)."""
     masses, charges = [1.7, 0.6, 2.3], [1.0, -1.0, 0.5]
-    parts = [_p(name, m, q) for name, m, q in zip("abc", masses[:n], charges[:n])]
+    parts = [custom(name, m, q) for name, m, q in zip("abc", masses[:n], charges[:n])]
     return prebo.System(parts, state=prebo.State(N=N, parity=(-1) ** N))
 
 
@@ -128,7 +124,7 @@ def test_every_operator_is_the_same_in_lfcc_and_ticc(kind, name):
     matrices of every registered operator equal those in Jacobi coordinates, for three particles
     with two identical ones (pair vectors transformed like r, particle momenta like ∇). An operator
     the family has no element for is refused in one line."""
-    e, p = _p("e", 1.0, -1.0), _p("p", 1836.15267343, 1.0)
+    e, p = custom("e", 1.0, -1.0), custom("p", 1836.15267343, 1.0)
     system = prebo.System([p, p, e], state=prebo.State(N=0, parity=1))
     basis = family_basis(kind, system, np.random.default_rng(3), nb=4, shared_c_A=0.9, cm_free=True)
     op = OPERATORS[name]
@@ -170,13 +166,13 @@ def test_pair_class_averages_of_a_symmetrised_state(kind, names):
     rng = np.random.default_rng(11)
     masses = {"p": 1836.15267343, "e": 1.0}
     charges = {"p": 1.0, "e": -1.0}
-    system = prebo.System([_p(x, masses[x], charges[x]) for x in names], state=prebo.State(N=0, parity=1))
+    system = prebo.System([custom(x, masses[x], charges[x]) for x in names], state=prebo.State(N=0, parity=1))
     basis = family_basis(kind, system, rng, nb=3)
     names_checked = ("r2", "p2p2", "orbit_orbit")
     result = prebo.evaluate(basis, operators=list(names_checked))
     c = result["coefficients"]
     labels = [f"{x}{i}" for i, x in enumerate(names)]
-    plain = prebo.System([_p(label, masses[x], charges[x]) for label, x in zip(labels, names)],
+    plain = prebo.System([custom(label, masses[x], charges[x]) for label, x in zip(labels, names)],
                          state=prebo.State(N=0, parity=1))
     parts, c_P = images(basis, system.symmetriser)
     A = np.concatenate([a for a, _ in parts])

@@ -10,7 +10,7 @@ import pytest
 
 import prebo
 from prebo.cli import main
-from prebo.expectation import OPERATORS
+from prebo.level.expectation import OPERATORS
 from prebo.integrals import laboratory
 
 from conftest import ROOT, hydrogen_s

@@ -67,7 +67,7 @@ from scipy.integrate import quad
 import prebo
 from prebo.integrals import laboratory
 
-from conftest import pair_A
+from conftest import custom, pair_A
 
 RTOL = 1e-8
 N_GH = 20  # Gauss-Hermite nodes per dimension
@@ -81,15 +81,11 @@ FD_K = np.arange(-4, 5)
 # ---------------------------------------------------------------------------
 # test systems and bases
 # ---------------------------------------------------------------------------
-def _custom(name, mass, charge):
-    return {"name": name, "mass": mass, "charge": charge, "spin": 0.5}
-
-
 SYSTEMS = {
     "p-e": lambda: prebo.System(["p", "e"]),
-    "a-b": lambda: prebo.System([_custom("a", 1.7, 2.0), _custom("b", 0.6, -1.0)]),
+    "a-b": lambda: prebo.System([custom("a", 1.7, 2.0), custom("b", 0.6, -1.0)]),
     "p-e-mu": lambda: prebo.System(["p", "e", "mu"]),
-    "x-y-z": lambda: prebo.System([_custom("x", 3.0, 2.0), _custom("y", 1.0, -1.0), _custom("z", 0.45, -1.0)]),
+    "x-y-z": lambda: prebo.System([custom("x", 3.0, 2.0), custom("y", 1.0, -1.0), custom("z", 0.45, -1.0)]),
 }
 
 
@@ -304,7 +300,7 @@ def test_kinetic_is_sensitive(name):
 
 def test_full_six_dimensional_two_particles():
     """No Cartesian factorisation: φ(r) = exp(-Σ_ij A_ij r_i·r_j) integrated over R^6 directly."""
-    system = prebo.System([_custom("a", 1.3, 1.0), _custom("b", 0.8, -1.0)])
+    system = prebo.System([custom("a", 1.3, 1.0), custom("b", 0.8, -1.0)])
     A, c = make_basis(system, nb=2, seed=7)
     lab = laboratory(system).matrices(prebo.Basis(system, A, c))
     I3 = np.eye(3)

@@ -1,4 +1,4 @@
-"""The Breit–Pauli correction (python/prebo/relativistic.py, docs/relativistic.md): its assembly
+"""The Breit–Pauli correction (python/prebo/level/relativistic.py, docs/relativistic.md): its assembly
 from given expectation values against closed forms, its conventions per particle type, and
 hydrogen with a finite proton mass from a plain-ECG basis."""
 import json
@@ -9,7 +9,7 @@ import pytest
 
 import prebo
 from prebo.cli import main
-from prebo.relativistic import ALPHA, terms
+from prebo.level.relativistic import ALPHA, terms
 
 from conftest import ROOT, hydrogen_s
 

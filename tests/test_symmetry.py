@@ -115,5 +115,5 @@ def test_the_pairs_at_whose_coalescence_every_state_vanishes(particles, spin, ze
     """A pair class vanishes by symmetry when the operator makes each of its pairs antisymmetric
     (P_ij O = O P_ij = −O): two identical fermions with symmetric spins (triplet, quartet), spin-1
     bosons in S = 1; not the electron pairs of a doublet of three, whose operator mixes both."""
-    from prebo.expectation import vanishing
+    from prebo.level.expectation import vanishing
     assert vanishing(prebo.System(particles, spin=spin)) == zero

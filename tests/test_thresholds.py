@@ -3,20 +3,17 @@ user's threshold, and the result's verdict and warning — shown on an H⁻ basi
 hydrogen atom plus a distant electron, whose virial coefficient is as small as a bound state's."""
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import prebo
-from conftest import ROOT
+from conftest import ROOT, cli_error, prebo_process, toml_text
 from prebo.cli import main
 from prebo.errors import InputError
 from prebo.io import toml
 from prebo.system.particles import KNOWN
 from prebo.thresholds import hydrogen_like, lowest
-from test_validation import cli_error, toml_text
 
 M = {name: mass for name, (mass, _, _) in KNOWN.items()}
 LI = {"name": "li", "mass": 12786.3933, "charge": 3, "spin": 1.5}  # a 7Li nucleus by hand
@@ -150,7 +147,7 @@ def test_the_optimised_h_minus_basis_is_bound(optimised, references):
 def test_prebo_energy_warns_when_not_bound(tmp_path, capsys):
     f = tmp_path / "basis.json"
     hydrogen_plus_distant_electron().save(f)
-    r = subprocess.run([sys.executable, "-m", "prebo", "energy", str(f)], capture_output=True, text=True)
+    r = prebo_process("energy", f)
     assert r.returncode == 0 and "dissociation threshold" in r.stdout and "not bound" in r.stdout, r.stderr
     assert r.stderr.count("\n") == 1 and r.stderr.startswith("prebo: warning: E = -0.4997"), r.stderr
     for words in ("is not below the dissociation threshold -0.4997", "Eh (p-e + e): the state is not bound in this",

@@ -16,47 +16,11 @@ import prebo
 from prebo.cli import main
 from prebo.errors import InputError, PreboError
 
+from conftest import cli_error, edited, h_input, toml_text
+
 ROOT = Path(__file__).resolve().parents[1]
 H_TOML = '[system]\nparticles = ["p", "e"]\n[basis]\nsize = 3\n[optimiser]\ntrials = 4\nseed = 3\n'
 HMINUS_TOML = '[system]\nparticles = ["p", "e", "e"]\n[basis]\nsize = 3\n[optimiser]\ntrials = 4\nseed = 3\n'
-
-
-def toml_value(v) -> str:
-    """A TOML literal of a Python value (strings, numbers with nan/inf, booleans, lists, tables)."""
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, float) and not np.isfinite(v):
-        return "nan" if v != v else ("inf" if v > 0 else "-inf")
-    if isinstance(v, (int, float)):
-        return repr(v)
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(map(toml_value, v)) + "]"
-    return "{" + ", ".join(f"{json.dumps(k)} = {toml_value(x)}" for k, x in v.items()) + "}"
-
-
-def toml_text(doc: dict) -> str:
-    """A TOML document of tables (a non-table value stays a top-level key)."""
-    top = [f"{json.dumps(k)} = {toml_value(v)}" for k, v in doc.items() if not isinstance(v, dict)]
-    tables = [f"[{json.dumps(k)}]\n" + "".join(f"{json.dumps(a)} = {toml_value(x)}\n" for a, x in v.items())
-              for k, v in doc.items() if isinstance(v, dict)]
-    return "".join(line + "\n" for line in top) + "".join(tables)
-
-
-def h_input(**optimiser) -> dict:
-    return {"system": {"particles": ["p", "e"]}, "basis": {"size": 3}, "optimiser": {"trials": 4, "seed": 3} | optimiser}
-
-
-def cli_error(capsys, *argv) -> str:
-    """Run `prebo ARGV` in-process; assert exit 2 and exactly one `prebo: error:` line on stderr;
-    return that line."""
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert rc == 2, (rc, out, err)
-    assert err.startswith("prebo: error: ") and err.count("\n") == 1 and "Traceback" not in err, err
-    assert out == ""
-    return err
 
 
 def toml_error(capsys, tmp_path, text, *words) -> str:
@@ -81,24 +45,16 @@ def bases(tmp_path_factory):
     return {"pecg": d / "h.json", "gvr": d / "h2p.json"}
 
 
-def edited(path, tmp_path, edit) -> Path:
-    d = json.loads(Path(path).read_text())
-    edit(d)
-    f = tmp_path / "edited.json"
-    f.write_text(json.dumps(d))
-    return f
-
-
 # --- 2: a basis type that cannot describe the state ---------------------------------------
 @pytest.mark.parametrize("N, parity", [(1, -1), (1, 1), (0, -1)])
 def test_plain_ecg_basis_file_with_another_state_is_refused(bases, tmp_path, capsys, N, parity):
-    f = edited(bases["pecg"], tmp_path, lambda d: d["system"]["state"].update(N=N, parity=parity))
+    f = edited(tmp_path, bases["pecg"], lambda d: d["system"]["state"].update(N=N, parity=parity))
     err = cli_error(capsys, "energy", f, "--json")
     assert str(f) in err and "N = 0, parity +1" in err and f"not N = {N}, parity {parity:+d}" in err
 
 
 def test_gvr_basis_file_with_unnatural_parity_is_refused(bases, tmp_path, capsys):
-    f = edited(bases["gvr"], tmp_path, lambda d: d["system"]["state"].update(parity=1))
+    f = edited(tmp_path, bases["gvr"], lambda d: d["system"]["state"].update(parity=1))
     assert "natural parity (-1)^N = -1" in cli_error(capsys, "energy", f)
 
 
@@ -192,7 +148,7 @@ def test_overflowing_basis_gives_an_error_not_nan(bases, tmp_path, capsys):
         f = d["functions"][0]
         f["A"] = (np.array(f["A"]) * 1e300).tolist()
         f["c_A"] *= 1e300
-    f = edited(bases["pecg"], tmp_path, scale)
+    f = edited(tmp_path, bases["pecg"], scale)
     for extra in ([], ["--json"]):
         err = cli_error(capsys, "energy", f, *extra)
         assert str(f) in err and "finite" in err
@@ -237,7 +193,7 @@ def test_basis_file_without_functions(bases, tmp_path, capsys):
     def empty(d):
         d["functions"] = []
         del d["coefficients"]
-    f = edited(bases["pecg"], tmp_path, empty)
+    f = edited(tmp_path, bases["pecg"], empty)
     assert "the basis has no functions" in cli_error(capsys, "energy", f)
 
 

@@ -7,10 +7,9 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.basis`: `Basis` and its families (plain ECGs, ECG-GVR, floating ECGs);
 - `prebo.integrals`, `prebo.eigen`: matrices and the generalised eigenproblem;
 - `prebo.optimise`: `Optimiser` settings and `optimise`, the stochastic variational driver;
-- `prebo.results`: `evaluate`, the energies of a basis;
-- `prebo.properties`: `properties`, a level's energy, expectation values and their corrections
-  (`prebo.relativistic`, the Breit–Pauli terms; `prebo.drachmann`, the regularised δ); `densities`,
-  the distance distributions of levels;
+- `prebo.level`: the results of a basis's levels: `evaluate`, their energies; `properties`, a
+  level's energy, expectation values and their corrections; `densities`, the distance
+  distributions of levels;
 - `prebo.thresholds`: the lowest dissociation threshold, below which a state is bound;
 - `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
 - `prebo.cli`, `prebo.plot`: the command line and convergence plots;
@@ -23,8 +22,8 @@ from .basis import Basis
 from .coordinates import CoordinateSet, all_sets, cm_centred, heavy_particle_centred, jacobi
 from .errors import PreboError
 from .optimise import Optimiser, optimise
-from .properties import densities, properties
-from .results import evaluate
+from .level.evaluate import evaluate
+from .level.properties import densities, properties
 from .system import Particle, State, System, particle
 
 __all__ = [

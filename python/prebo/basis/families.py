@@ -2,11 +2,11 @@
 from __future__ import annotations
 
 from ..errors import InputError
-from . import fecg, gvr, pecg
+from . import ecg_gvr, fecg, pecg
 from .family import Family
 
 #: name -> family, in the order the settings list them
-FAMILIES: dict[str, Family] = {f.name: f for f in (pecg.FAMILY, gvr.FAMILY, fecg.FAMILY)}
+FAMILIES: dict[str, Family] = {f.name: f for f in (pecg.FAMILY, ecg_gvr.FAMILY, fecg.FAMILY)}
 
 
 def family(name: str) -> Family:

@@ -13,7 +13,7 @@ from ..errors import BasisFileError, InputError, SeparabilityError
 from .family import Family
 
 
-class FloatingECG(Family):
+class Fecg(Family):
     """Floating ECGs: centres s (n x 3, bohr) per function; N = 0 labels, <N²> reported."""
 
     name = "fecg"
@@ -60,4 +60,4 @@ class FloatingECG(Family):
         return ds
 
 
-FAMILY = FloatingECG()
+FAMILY = Fecg()

@@ -9,7 +9,7 @@ from ..errors import InputError
 from .family import Family
 
 
-class PlainECG(Family):
+class Pecg(Family):
     """Plain ECGs: A and c_A only; N = 0, parity +1 states."""
 
     name = "pecg"
@@ -22,4 +22,4 @@ class PlainECG(Family):
                              f"parity {state.parity:+d} (use ecg-gvr)")
 
 
-FAMILY = PlainECG()
+FAMILY = Pecg()

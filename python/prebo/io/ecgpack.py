@@ -484,7 +484,7 @@ def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFi
     young = young_string(system.symmetriser, system.groups, n)
     root = basis.system.state.levels[0][0]
     if energy is None:
-        from ..results import evaluate
+        from ..level.evaluate import evaluate
 
         r = evaluate(basis) if len(basis) > root else {"energy": 0.0}  # the levels up to the targeted one
         energy = r["levels"][root]["energy"] if root else r["energy"]

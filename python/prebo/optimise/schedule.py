@@ -13,13 +13,15 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from .adaptive import Adaptive
+from .adaptive import RATIO, Adaptive
 from .cursor import Cursor
 from .fixed import Fixed
 from .settings import FIXED, Optimiser
 
 #: the kinds of schedule by their [optimiser] schedule names
 KINDS = {kind.name: kind for kind in (Adaptive, Fixed)}
+#: a convergence report's "advantage" above which growth gains faster than the last passes did
+GROWTH_FASTER = 1 / RATIO
 
 
 class Schedule(Protocol):

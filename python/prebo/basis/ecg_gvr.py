@@ -12,14 +12,14 @@ import numpy as np
 from ..errors import InputError, SeparabilityError
 from .family import Family
 
-#: the steps in K of a function's neighbours (`GlobalVectorECG.neighbours`)
+#: the steps in K of a function's neighbours (`EcgGvr.neighbours`)
 K_STEPS = (1, 2)
 #: the range of max |u_k|: a normalised function does not depend on the length of u, the sampler and
 #: the stored bases keep it near 1 (1.0-1.73), and u^T A^-1 u overflows far beyond (1e±100: not finite)
 U_SCALE = (1e-6, 1e6)
 
 
-class GlobalVectorECG(Family):
+class EcgGvr(Family):
     """ECG-GVR functions: u (n) and K per function; states of natural parity (-1)^N."""
 
     name = "ecg-gvr"
@@ -117,4 +117,4 @@ class GlobalVectorECG(Family):
         return dv
 
 
-FAMILY = GlobalVectorECG()
+FAMILY = EcgGvr()

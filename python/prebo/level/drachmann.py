@@ -30,8 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..system import reduced_mass
 from .expectation import expectation, members, operator, vanishing
-from .system import reduced_mass
 
 #: the operators of eq. (27): ⟨1/r_ij⟩, ⟨V/r_ij⟩, ⟨∇Ψ|Λ/r_ij|∇Ψ⟩
 TERMS = ("inv_r", "coulomb_inv_r", "gradient_inv_r")
@@ -70,7 +70,7 @@ def regularisable(system) -> list[str]:
 def regularised(system, expectation: dict, energy: float) -> dict[str, float]:
     """{pair class "a-b": the regularised ⟨δ³(r_ij)⟩ (bohr⁻³)} of one eigenstate of `system` with
     the energy `energy` (Eh) from its expectation values of TERMS ({operator: {class: value}}, as
-    `results.evaluate` gives them), for the `regularisable` classes; 0.0 where the state vanishes
+    `evaluate` gives them), for the `regularisable` classes; 0.0 where the state vanishes
     at the coalescence by symmetry (`expectation.vanishing`): there the direct value is exact, and
     the identity would only return the rounding of its three terms (He 2³S: −1.6e-8)."""
     mu = {label: reduced_mass(*system.masses[list(ms[0])]) for label, ms in members(system, pairs=True).items()}

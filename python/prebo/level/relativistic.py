@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import math
 
+from .evaluate import HARTREE_CM
 from .expectation import members
-from .results import HARTREE_CM
 
 #: the fine-structure constant, CODATA 2018 (E. Tiesinga et al., Rev. Mod. Phys. 93, 025010 (2021))
 ALPHA = 7.2973525693e-3
@@ -45,7 +45,7 @@ def dirac(particle) -> bool:
 
 def terms(system, expectation: dict, delta: dict | None = None, p4: dict | None = None) -> dict:
     """The Breit–Pauli terms (module docstring) of one level of `system` from its expectation
-    values `expectation` ({operator: {class: value}}, as `results.evaluate` gives them, with every
+    values `expectation` ({operator: {class: value}}, as `evaluate` gives them, with every
     operator of NEEDS); `delta`, contact densities per pair class to use instead of the direct
     ⟨δ³(r_ij)⟩ where given, and `p4`, ⟨p_i⁴⟩ per particle class to use instead of the direct ones where given
     (`drachmann.regularised` and `drachmann.p4_regularised`; docs/relativistic.md on pairing them).

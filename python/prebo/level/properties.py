@@ -20,13 +20,14 @@ import math
 
 import numpy as np
 
-from . import drachmann, eigen
-from .basis import Basis
-from .errors import InputError, NonFiniteError
+from .. import eigen
+from ..basis import Basis
+from ..errors import InputError, NonFiniteError
+from ..validation import Integer, checked
+from . import drachmann
+from .evaluate import evaluate, grids
 from .expectation import OPERATORS
 from .relativistic import NEEDS, terms
-from .results import evaluate, grids
-from .validation import Integer, checked
 
 
 def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float = eigen.THRESHOLD,
@@ -35,14 +36,14 @@ def properties(basis, root: int = 0, coordinates: str = "lab", threshold: float 
     the regularised δ and p⁴ if `regularised` (None: where they are cheap, `reported`).
 
     Returns {"root", "energy", "energy_uncertainty" (Eh), "virial", "bound", "threshold_unchecked"
-    (`results.evaluate`), "expectation":
+    (`evaluate`), "expectation":
     {operator: {class: value}}, "units": {operator: unit}, "not_derived": [operators]} (and "n2",
     ⟨N²⟩_TI in ħ², for floating ECGs): the `reported` operators of the basis family, per
     class of equivalent pairs "a-b" or particles "a", and those it has no element for; and
     the level's `corrections` ("breit_pauli", "delta_regularised", "p4_regularised") where it
     holds their operators. InputError
     for a root that is not a non-negative integer below the basis size; the errors of
-    `results.evaluate` otherwise."""
+    `evaluate` otherwise."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"properties: basis = {basis!r}: must be a prebo.Basis with at least one function")
     root = checked(Integer(0, len(basis) - 1), root, "properties: root", f"roots of a basis of {len(basis)} functions")
@@ -74,7 +75,7 @@ def reported(family, regularised: bool | None = None) -> list[str]:
 
 def corrections(basis, level: dict) -> dict:
     """What the expectation values of a level of `basis` ({"energy", "expectation": {operator:
-    {class: value}}}, a level of `results.evaluate`) give beyond themselves, where they hold the
+    {class: value}}}, a level of `evaluate`) give beyond themselves, where they hold the
     operators: "delta_regularised", {pair class: Drachmann's ⟨δ³(r_ij)⟩} (`drachmann.regularised`),
     "p4_regularised", {class of the lightest particles: ⟨p⁴⟩ by eq. (27')}
     (`drachmann.p4_regularised`), and "breit_pauli", the Breit–Pauli correction
@@ -105,7 +106,7 @@ def densities(basis, roots=(0,), r=None, points: int = POINTS, coordinates: str 
     integers below the basis size, or radii that are empty or not finite distances ≥ 0;
     NonFiniteError naming the class and the first radius where P is not finite (a grid that
     reaches where r² overflows against the exponents, ~1e148 bohr for He); the errors of
-    `results.evaluate` otherwise."""
+    `evaluate` otherwise."""
     if not isinstance(basis, Basis) or len(basis) == 0:
         raise InputError(f"densities: basis = {basis!r}: must be a prebo.Basis with at least one function")
     roots = [roots] if not isinstance(roots, (list, tuple)) else list(roots)

@@ -3,11 +3,11 @@
 An operator registered here is evaluated for every basis family that has its element by the core's
 generic path (`prebo._core.Engine.operator`, crates/prebo-core/src/operators/; `_core.OPERATORS`
 names the operators of each family), in the laboratory frame or in translationally invariant
-coordinates; `results.evaluate(basis, operators=...)` and `prebo energy --operator NAME` report it
+coordinates; `evaluate(basis, operators=...)` and `prebo energy --operator NAME` report it
 for the state they solve. A new operator is one core module plus one registration line per layer
 (docs/architecture.md, "Add an operator"). The core's "n2", ⟨N²⟩_TI of floating ECGs, is an
 operator of the whole system (its vector the mass fractions), reported per level by
-`results.evaluate`, not per class here.
+`evaluate`, not per class here.
 
 Pair operators act on r_w = Σ_k w_k r_k with w = e_i − e_j, the inter-particle vector
 r_ij = r_i − r_j (hartree atomic units: lengths in bohr). Particle operators act on particle i's
@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _core
-from .errors import InputError, UnsupportedError
+from .. import _core
+from ..errors import InputError, UnsupportedError
 
 
 #: the kinds of operator vectors (`vector`)
@@ -143,12 +143,12 @@ OPERATORS: dict[str, Operator] = {
     "p4": Operator("p4", "ħ⁴/bohr⁴", "⟨p_i⁴⟩, the mass–velocity term's −Σ⟨p_i⁴⟩/(8m_i³c²) per particle i",
                    ("p_i",)),
     "p2p2": Operator("p2p2", "ħ⁴/bohr⁴", "⟨p_i² p_j²⟩, the product of two particles' square momenta in the "
-                                         "centre-of-mass frame (a term of the regularised ⟨p_i⁴⟩, prebo.drachmann)",
+                                         "centre-of-mass frame (a term of the regularised ⟨p_i⁴⟩, prebo.level.drachmann)",
                      ("p_i", "p_j")),
     "coulomb_inv_r": Operator("coulomb_inv_r", "Eh/bohr", "⟨V/r_ij⟩, the Coulomb potential over r_ij "
-                                                         "(a term of Drachmann's ⟨δ³(r_ij)⟩, prebo.drachmann)"),
+                                                         "(a term of Drachmann's ⟨δ³(r_ij)⟩, prebo.level.drachmann)"),
     "gradient_inv_r": Operator("gradient_inv_r", "Eh/bohr", "⟨∇Ψ|Λ/r_ij|∇Ψ⟩, the kinetic energy density over r_ij "
-                                                           "(a term of Drachmann's ⟨δ³(r_ij)⟩, prebo.drachmann)"),
+                                                           "(a term of Drachmann's ⟨δ³(r_ij)⟩, prebo.level.drachmann)"),
     "orbit_orbit": Operator("orbit_orbit", "ħ²/bohr³", "⟨p_i·(1 + r̂_ij r̂_ij)/r_ij·p_j⟩, the Breit–Pauli orbit–orbit "
                                                      "term −(α²/2) q_i q_j/(m_i m_j) ⟨…⟩ per pair", ("r_ij", "p_i", "p_j")),
 }

@@ -1,8 +1,8 @@
 """Energies of a basis: translation-free and laboratory-frame, with the virial coefficient.
 
 The pipeline's last stage (system → basis → integrals → eigen → results): `evaluate` is what
-`prebo energy`, `prebo run` (result.json) and the Python API report. It stays a top-level
-module because it uses every earlier stage and none of them uses it.
+`prebo energy`, `prebo run` (result.json) and the Python API report; it uses every earlier stage
+and none of them uses it.
 
 result.json / `prebo energy --json` keys: energy (translation-free, Eh), energy_uncertainty
 (Eh, below), energy_lab (with CM motion), virial (η_TI = |1 + <V>/(2<T>_TI)|), kinetic, potential,
@@ -30,9 +30,10 @@ root k = 0..K-1 (root, energy, energy_uncertainty, virial, kinetic, potential, b
 binding_energy, and n2 and expectation where the ground state has them), each eigenvalue an upper
 bound to its exact level (Hylleraas–Undheim–MacDonald), and `transitions`, one dict per pair of
 levels i < j: lower, upper, Eh (E_j − E_i), cm-1 (× HARTREE_CM) and uncertainty (the levels'
-uncertainties added in quadrature, Eh). The top-level keys stay those of root 0. A basis optimised
-for other levels than the lowest (`[state] root`/`roots`) reports the levels up to the highest it
-targets by default, and their indices as `targets`.
+uncertainties added in quadrature, Eh). A basis optimised for other levels than the lowest
+(`[state] root`/`roots`) reports the levels up to the highest it targets by default, and their
+indices as `targets`; the top-level keys are those of the lowest targeted root (root k of a
+`root = k` state, root 0 by default), named by `root`.
 
 `bound` is False when the energy is not below the threshold: the basis describes fragments and free
 particles, not a bound state. The virial coefficient cannot tell: a basis scaled to its variational
@@ -46,14 +47,14 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import eigen
-from .basis import Basis
-from .errors import CancellationError, InputError
+from .. import eigen
+from ..basis import Basis
+from ..errors import CancellationError, InputError
+from ..integrals import laboratory, require_shared_c_A, translationally_invariant
+from ..optimise.settings import check
+from ..thresholds import candidates, lowest
+from ..validation import Integer, checked
 from .expectation import densities, density_classes, expectation, operator
-from .integrals import laboratory, require_shared_c_A, translationally_invariant
-from .optimise.settings import check
-from .thresholds import candidates, lowest
-from .validation import Integer, checked
 
 #: the hartree in wavenumbers, E_h/(hc) in cm⁻¹ (CODATA 2018: E. Tiesinga et al., Rev. Mod. Phys.
 #: 93, 025010 (2021), hartree-inverse meter relationship 2.1947463136320e7 m⁻¹)
@@ -61,8 +62,8 @@ HARTREE_CM = 219474.6313632
 
 
 def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.THRESHOLD, operators=(),
-             roots: int | None = None, radii=None) -> dict:
-    """The energies of `basis`'s lowest state, and of its lowest `roots` levels.
+             roots: int | None = None, radii=None, targets=None) -> dict:
+    """The energies of the level `basis` was optimised for, and of its lowest `roots` levels.
 
     Parameters: `basis`, a non-empty `Basis`; `coordinates`, "lab" (LFCC with the CM kinetic
     energy eliminated, Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112 (2018)) or "ti"
@@ -70,19 +71,22 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     `threshold`, the relative overlap eigenvalue below which directions are dropped
     (`eigen.solve`); `operators`, names of registered operators (`expectation.OPERATORS`, e.g.
     "r2") whose expectation values to add; `roots`, how many of the lowest levels to report
-    (`levels` and `transitions` when more than one; default: up to the highest root the basis's
-    state targets, `State.levels`, whose indices are then given as `targets`); `radii` (bohr),
-    where to add each level's `densities` (`expectation.densities`): one grid for every class, or
-    {"pairs": {"a-b": grid}, "particles": {"a": grid}} with a grid per class.
+    (`levels` and `transitions` when more than one; default: up to the highest targeted root; never
+    short of the lowest one); `radii` (bohr), where to add each level's `densities`
+    (`expectation.densities`): one grid for every class, or {"pairs": {"a-b": grid}, "particles":
+    {"a": grid}} with a grid per class; `targets`, the roots the optimised levels stand at (default:
+    those the basis's state targets, `State.levels`; a run whose levels were followed to other
+    roots ends at others), given as `targets` unless root 0 alone.
 
     Returns a dict with the keys of the module docstring — energy, energy_uncertainty,
     energy_lab, kinetic, potential, threshold and binding_energy in Eh; bound a bool; virial,
-    overlap_condition dimensionless; n2 in ħ²; expectation in each operator's unit — and
-    `coefficients`, the S-normalised ground-state vector. InputError for a basis that is not a
-    non-empty `Basis` or does not fit its system (its arrays or system replaced since it was built),
-    an unknown `coordinates` or operator, UnsupportedError for an operator the basis family has
-    not (`_core.OPERATORS`), `roots` not a positive integer or above the basis size,
-    `radii` empty or not finite non-negative numbers;
+    overlap_condition dimensionless; n2 in ħ²; expectation in each operator's unit — those of
+    the lowest targeted root, `root` —, `coefficients`, its S-normalised vector, and `vectors`,
+    those of the targeted roots (one column each, in the order of `targets`). InputError for a
+    basis that is not a non-empty `Basis` or does not fit its system (its arrays or system replaced
+    since it was built), an unknown `coordinates` or operator, UnsupportedError for an operator the
+    basis family has not (`_core.OPERATORS`), `roots` not a positive integer or above the basis
+    size, `targets` not distinct roots of the basis, `radii` empty or not finite non-negative numbers;
     LinearDependenceError for more roots than the basis resolves; CancellationError for a function whose elements lost
     their digits (Representation.require_resolved); NonFiniteError and the eigen errors as
     `eigen.solve` raises them."""
@@ -98,12 +102,19 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
     if radii is not None:
         radii = grids(basis.system, radii)
     basis = replace(basis)  # built again: the constructor's checks against the system it has now
-    targets = basis.system.state.levels[0]
-    if roots is None and max(targets) >= len(basis):
-        raise InputError(f"state: targets levels {reprlib.repr(list(targets))}: level {max(targets)} is not one of "
-                         f"a basis of {len(basis)} functions (0..{len(basis) - 1})")
+    if targets is None:
+        targets = basis.system.state.levels[0]
+        if max(targets) >= len(basis):
+            raise InputError(f"state: targets levels {reprlib.repr(list(targets))}: level {max(targets)} is not one "
+                             f"of a basis of {len(basis)} functions (0..{len(basis) - 1})")
+    elif not isinstance(targets, (list, tuple)) or not targets or len(set(targets)) < len(targets):
+        raise InputError(f"evaluate: targets = {reprlib.repr(targets)}: must be a list of distinct root indices")
+    targets = tuple(checked(Integer(0, len(basis) - 1), k, "evaluate: targets",
+                            f"roots of a basis of {len(basis)} functions") for k in targets)
+    top = min(targets)
     roots = max(targets) + 1 if roots is None else roots
     roots = checked(Integer(1, len(basis)), roots, "evaluate: roots", f"levels of a basis of {len(basis)} functions")
+    roots = max(roots, top + 1)  # the level at the top is among those reported
     basis.validate()  # a Basis built in Python: symmetric, positive definite, CM-separable A
     system = basis.system
     if coordinates == "lab":
@@ -112,8 +123,8 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         rep.require_resolved(m)
         with np.errstate(over="ignore", invalid="ignore"):  # eigen.solve refuses an H that is not finite
             H = m["T"] + m["V"]
-        lab = eigen.solve(H, m["S"], threshold)
-        energy_lab = float(lab.energies[0])
+        lab = eigen.solve(H, m["S"], threshold, top + 1)
+        energy_lab = float(lab.energies[top])
     elif coordinates == "ti":
         c_A = require_shared_c_A(basis.c_A)
         rep = translationally_invariant(system)
@@ -124,23 +135,22 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         raise InputError(f"evaluate: coordinates = {coordinates!r}: must be 'lab' or 'ti'")
     with np.errstate(over="ignore", invalid="ignore"):
         H = m["T_ti"] + m["V"]
-    ti = eigen.solve(H, m["S"], threshold, roots)
+    ti = eigen.solve(H, m["S"], threshold, max(roots, max(targets) + 1))  # every targeted vector refined
     low = lowest(system)
     n2 = None if basis.family.conserves_L else laboratory(system).operator("n2", basis, system.cm_vector[None])[0]
     values = {name: expectation(rep, basis, ti.vectors[:, :roots], name) for name in operators}
     rho = None if radii is None else densities(rep, basis, ti.vectors[:, :roots], radii)
     levels = [level(ti, k, m, low.energy, threshold, n2, {name: v[k] for name, v in values.items()})
               | ({} if rho is None else {"densities": rho[k]}) for k in range(roots)]
-    ground = levels[0]
     if energy_lab is None:
-        energy_lab = ground["energy"] + 1.5 * c_A / system.m_total
+        energy_lab = levels[top]["energy"] + 1.5 * c_A / system.m_total
     extra = {}
     if targets != (0,):
         extra["targets"] = list(targets)
     if roots > 1:
         extra["levels"] = levels
         extra["transitions"] = [transition(a, b) for i, a in enumerate(levels) for b in levels[i + 1:]]
-    return {k: v for k, v in ground.items() if k != "root"} | extra | {
+    return levels[top] | extra | {
         "energy_lab": energy_lab,
         "threshold": low.energy,
         "threshold_fragments": low.fragments,
@@ -154,7 +164,8 @@ def evaluate(basis: Basis, coordinates: str = "lab", threshold: float = eigen.TH
         "coordinates": coordinates,
         "overlap_condition": ti.overlap_condition,
         "kept": ti.kept,
-        "coefficients": ti.vectors[:, 0],
+        "coefficients": ti.vectors[:, top],
+        "vectors": ti.vectors[:, list(targets)],
     }
 
 
