@@ -1,4 +1,4 @@
-"""Bound or not (issue 17): the lowest dissociation threshold of a system (`prebo.thresholds`), the
+"""Bound or not (issue 17): the lowest dissociation threshold of a system (`prebo.system.thresholds`), the
 user's threshold, and the result's verdict and warning — shown on an H⁻ basis that describes a
 hydrogen atom plus a distant electron, whose virial coefficient is as small as a bound state's."""
 import json
@@ -13,7 +13,7 @@ from prebo.cli import main
 from prebo.errors import InputError
 from prebo.io import toml
 from prebo.system.particles import KNOWN
-from prebo.thresholds import hydrogen_like, lowest
+from prebo.system.thresholds import hydrogen_like, lowest
 
 M = {name: mass for name, (mass, _, _) in KNOWN.items()}
 LI = {"name": "li", "mass": 12786.3933, "charge": 3, "spin": 1.5}  # a 7Li nucleus by hand

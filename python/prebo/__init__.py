@@ -10,7 +10,7 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.level`: the results of a basis's levels: `evaluate`, their energies; `properties`, a
   level's energy, expectation values and their corrections; `densities`, the distance
   distributions of levels;
-- `prebo.thresholds`: the lowest dissociation threshold, below which a state is bound;
+- `prebo.system.thresholds`: the lowest dissociation threshold, below which a state is bound;
 - `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
 - `prebo.cli`, `prebo.plot`: the command line and convergence plots;
 - `prebo.parallel`: MPI ranks sharing a run's integrals (`mpiexec -n R prebo run`; docs/mpi.md).

@@ -52,7 +52,7 @@ from ..basis import Basis
 from ..errors import CancellationError, InputError
 from ..integrals import laboratory, require_shared_c_A, translationally_invariant
 from ..optimise.settings import check
-from ..thresholds import candidates, lowest
+from ..system.thresholds import candidates, lowest
 from ..validation import Integer, checked
 from .expectation import densities, density_classes, expectation, operator
 

@@ -27,7 +27,7 @@ from ..io.files import remove_stale_temporaries
 from ..io.lock import owned
 from ..parallel import world
 from ..system import System
-from ..thresholds import lowest as lowest_threshold
+from ..system.thresholds import lowest as lowest_threshold
 from ..validation import path_name
 from .checkpoint import CHECKPOINT, LOWEST, checkpoint_in
 from .convergence import convergence

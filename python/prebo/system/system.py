@@ -23,7 +23,7 @@ ROOT_RANGE = Integer(0, MAX_SIZE - 1)
 #: a level's weight in the objective Σ w_k E_k (optimise/objective.py)
 WEIGHT_RANGE = Real(0.0, 1e6, hi_closed=True)
 #: a given dissociation threshold (Eh): fragments (bound: < 0) and free particles at rest (0) lie at
-#: or below 0 (prebo.thresholds)
+#: or below 0 (prebo.system.thresholds)
 THRESHOLD_RANGE = Real(-math.inf, 0.0, hi_closed=True)
 
 
@@ -36,7 +36,7 @@ class State:
     units of ħ); `parity`, +1 or -1 (N and parity Python or numpy integers, not bools); `spin`,
     {particle name: total spin S} of each group of identical particles (0, 1/2, 1, ...); a group
     not named gets its lowest total spin (singlet, doublet, para); `threshold`, a dissociation
-    threshold (Eh, ≤ 0) the user knows to lie below the hydrogen-like ones `prebo.thresholds`
+    threshold (Eh, ≤ 0) the user knows to lie below the hydrogen-like ones `prebo.system.thresholds`
     finds (e.g. Li⁺ + e for Li), or None; the levels the optimiser targets (optimise/objective.py):
     `root`, one eigenvalue index (0, the default: the lowest of the symmetry), or `roots`, a count
     K (the K lowest) or a list of distinct indices, with `weights` (positive, one per root; default

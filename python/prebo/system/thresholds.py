@@ -28,7 +28,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .system import Particle, System, reduced_mass
+from .particles import Particle, reduced_mass
+from .system import System
 
 
 @dataclass(frozen=True)
