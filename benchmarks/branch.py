@@ -1,6 +1,6 @@
 """A branch of a run: its checkpoint copied to another folder with settings changed, the cursor
 put at the start of a phase of the checkpoint's cycle and a wall-time budget of so many more
-seconds, for design changes measured from one start (benchmarks/README, "The H2 campaign").
+seconds, for design changes measured from one start (benchmarks/record/h2.md, "The H2 campaign").
 Resume the branch with `prebo run --resume DST`.
 
     python benchmarks/branch.py benchmarks/checkpoints/h2-cycles runs/k-moves --phase sweep --seconds 600 \

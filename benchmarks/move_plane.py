@@ -1,5 +1,6 @@
 """A momentum move (optimise/momentum.py) against the best step in the plane of its two parts,
-measured on a running run's own states (benchmarks/README, "A move in two directions").
+measured on a running run's own states (benchmarks/record/h2.md, "A move in two
+directions").
 
 `--watch FOLDER OUT`: copy FOLDER/basis.json into OUT each time its schedule's pass count
 changes (polled every 0.5 s), as `pPASSES_ELAPSED.json`. `A B`: two such copies, A right after a

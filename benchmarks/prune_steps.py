@@ -1,9 +1,9 @@
-"""One pruning of a run's basis, taken apart (benchmarks/README, "Pruning that refines after each
-removal"): `--grow N` growth steps past the size as methods.PruneStep makes them (the best of the
-run's trials, refined, then refined with its partners), then the removals back to the size, each
-of the function whose removal raises the energy least — as PruneStep.remove (the function it
+"""One pruning of a run's basis, taken apart (benchmarks/record/h2.md, "Pruning that refines after
+each removal"): `--grow N` growth steps past the size as methods.PruneStep makes them (the best of
+the run's trials, refined, then refined with its partners), then the removals back to the size,
+each of the function whose removal raises the energy least — as PruneStep.remove (the function it
 overlapped most then refined with its partners), or with `--plain` removed only (the code before
-session 26). First, what removing each function alone would cost (eigen.root_without_each);
+b0c1d27). First, what removing each function alone would cost (eigen.root_without_each);
 then per seed: each growth step's gain and seconds, each removal's cost, the net gain and the
 seconds.
 

@@ -172,11 +172,11 @@ def test_block_roots_below_the_basis_lowest_equal_the_full_solve():
 
 def test_a_block_root_at_a_decoupled_pole_is_found_without_evaluating_the_pole():
     """Root 1 of a block that does not couple to the basis's eigenvector 0 (|D|, |B| ~ 1e-16: the
-    H2⁺ N = 1 growth of session 30, where roots 0 and 1 of the basis were degenerate) lies at the
-    pole E_0 itself: Newton's method from the bracket (E_0, E_1) walks down to it and, the bracket
-    down to adjacent doubles, stops there instead of evaluating M at the pole (which failed with
-    "Eigenvalues did not converge") and returns that eigenvalue and eigenvector; root 0 lies
-    below, from the block."""
+    H2⁺ N = 1 growth of benchmarks/record/excited.md, "The H2⁺ N = 1 ladder", where roots 0 and 1
+    of the basis were degenerate) lies at the pole E_0 itself: Newton's method from the bracket
+    (E_0, E_1) walks down to it and, the bracket down to adjacent doubles, stops there instead of
+    evaluating M at the pole (which failed with "Eigenvalues did not converge") and returns that
+    eigenvalue and eigenvector; root 0 lies below, from the block."""
     E = np.array([-0.4241688756700338, 0.3563764008238357, 18.43415780833227, 32.65939824163085, 52.481723732873654])
     D = np.array([[-3.0305248997330683e-16, 0.10108217704915519, -0.17859746406168334, 0.0017532754031652832, -0.00716857196533346],
                   [-9.014130001409275e-17, 0.029657513811786624, -0.42710148038802553, 0.016274989555748083, -0.08959547016346289],

@@ -20,21 +20,21 @@ ACCEPTANCE = {
     "h-": ("H-", 1e-5),
     "h2plus-pecg": ("H2+", None),
     "h2plus-gvr": ("H2+", 5.2e-9),  # issue 4 run: 4.6e-9 above the reference with 180 functions
-    "h2plus-150": ("H2+", 1.13e-9),  # the H2+ 150 run's lowest state at 150 functions (benchmarks/README)
-    "h2plus-fecg": ("H2+", 5e-5),  # 4.72e-5 above after 1200 s of the defaults (benchmarks/README)
+    "h2plus-150": ("H2+", 1.13e-9),  # the H2+ 150 run's lowest state at 150 functions (benchmarks/record/h2.md)
+    "h2plus-fecg": ("H2+", 5e-5),  # 4.72e-5 above after 1200 s of the defaults (benchmarks/record/h2.md)
     "h2-pecg": ("H2", None),
-    "h2-fecg": ("H2", 5.5e-4),  # 5.47e-4 above after 1200 s of the defaults (benchmarks/README)
+    "h2-fecg": ("H2", 5.5e-4),  # 5.47e-4 above after 1200 s of the defaults (benchmarks/record/h2.md)
     # inputs without an [optimiser] table (examples/auto, issue 17: within 1e-6 relative)
     "auto-h": ("H", "rel:1e-6"),
     "auto-he": ("He", "rel:1e-6"),
     "auto-h-": ("H-", "rel:1e-6"),
     "auto-ps-": ("Ps-", "rel:1e-6"),
     "auto-h2+": ("H2+", "rel:1e-6"),
-    "auto-h2": ("H2", "rel:1e-6"),  # 6.2e-7 relative after 600 s with 300 functions (benchmarks/README)
-    "auto-he-400": ("He", 9e-10),  # 8.65e-10 above after 206 s (benchmarks/README)
-    "auto-he-700": ("He", 1e-10),  # 5.14e-11 above after 300 s, 1e-10 at 223 s (issue 17; benchmarks/README)
+    "auto-h2": ("H2", "rel:1e-6"),  # 6.2e-7 relative after 600 s with 300 functions (benchmarks/record/schedules.md)
+    "auto-he-400": ("He", 9e-10),  # 8.65e-10 above after 206 s (benchmarks/record/schedules.md)
+    "auto-he-700": ("He", 1e-10),  # 5.14e-11 above after 300 s, 1e-10 at 223 s (benchmarks/record/schedules.md)
     "auto-li-150": ("Li", 7.5e-5),  # 4.40e-5 above after 81 s; ecgpack's Li-100 accuracy (issue 17)
-    "auto-li": ("Li", "rel:1e-6"),  # 6.1e-7 relative after 600 s with 400 functions (benchmarks/README)
+    "auto-li": ("Li", "rel:1e-6"),  # 6.1e-7 relative after 600 s with 400 functions (benchmarks/record/schedules.md)
 }
 #: examples whose energy is not below their lowest dissociation threshold: 60 plain ECGs cannot
 #: localise H2+'s protons (examples/h2plus-pecg.toml), and stay 14 mEh above H + p

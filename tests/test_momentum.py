@@ -90,7 +90,7 @@ def test_the_reference_round_trips_through_the_checkpoint_and_another_run_s_is_r
     m = Momentum(basis.subset(slice(None)))
     back = Momentum.from_dict(m.to_dict(), basis, "checkpoint")
     assert np.array_equal(back.reference.A, basis.A) and np.array_equal(back.reference.u, basis.u)
-    assert Momentum.from_dict(None, basis, "checkpoint").reference is None  # checkpoints before session 24
+    assert Momentum.from_dict(None, basis, "checkpoint").reference is None  # checkpoints before 671d9a1
     for bad in (5, "x", [], {"functions": 3}):
         with pytest.raises(BasisFileError, match="checkpoint: momentum"):
             Momentum.from_dict(bad, basis, "checkpoint")

@@ -122,8 +122,9 @@ def test_growth_stalled_at_the_overlap_threshold_names_the_threshold():
 
 
 def test_growth_stalled_by_the_uncertainty_says_so():
-    """He's growth stalled at 580 functions with σ = 1.0e-13 Eh (benchmarks/README, issue 37): the
-    message, which blamed linear dependence alone, names the uncertainty and its price."""
+    """He's growth stalled at 580 functions with σ = 1.0e-13 Eh (benchmarks/record/schedules.md,
+    "Defaults that know the numerics"): the message, which blamed linear dependence alone, names
+    the uncertainty and its price."""
     from prebo.optimise.methods import stalled
     why = stalled(580, prebo.Optimiser(threshold=2.0**-53), 3.65e14, 1.0e-13)  # that run's threshold
     assert "gaining less than the energy's uncertainty σ = 1.0e-13 Eh and 100 times what it adds to σ" in why
