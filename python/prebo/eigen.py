@@ -45,8 +45,8 @@ Threads: below SERIAL_BELOW functions LAPACK and BLAS run on one thread (`lapack
 `solve` and around a whole optimisation). prebo's own parallelism is the Rust core's (rayon);
 OpenBLAS's threads spin between calls and compete with it and with any other job: on the 2-core
 machine refinement steps ran 1.4–1.5× faster (He, 400 functions) with one LAPACK thread, though
-a lone eigh of 500–3000 functions gains 1.4–1.8× from two (benchmarks/README, "Schedules that
-choose themselves"). The refined energies do not depend on the thread count.
+a lone eigh of 500–3000 functions gains 1.1–1.8× from two (benchmarks/record/schedules.md, "LAPACK
+threads"). The refined energies do not depend on the thread count.
 
 Uncertainty: to first order an element error changes the energy by δE = cᵀ(δH − E δS)c
 (cᵀSc = 1). With independent relative errors ε of the elements of S and of each term of H

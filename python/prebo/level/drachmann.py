@@ -14,8 +14,9 @@ ECG-GVR (eq. 38), tens of damped elements per product (H2-500's properties take 
 The bracket is multiplied by μ_ij/π, so its basis error is too: for two heavy particles that repel
 (p-p in H₂⁺ and H₂, d-t), whose contact density is tiny, a ~1000-fold amplified error swamps it and
 the regularised value is worse than the direct one, even negative (H₂⁺ in 400 floating ECGs: direct
-1.1e-6, regularised −2.0e-3 bohr⁻³; benchmarks/README.md). Such pairs keep the direct value: a pair
-is regularised where it attracts or holds one of the lightest particles (`regularisable`).
+1.1e-6, regularised −2.0e-3 bohr⁻³; benchmarks/record/relativistic.md, "⟨V/r_ij⟩ for floating ECGs
+and ECG-GVR"). Such pairs keep the direct value: a pair is regularised where it attracts or holds
+one of the lightest particles (`regularisable`).
 
 The same eigenvalue equation regularises ⟨p_i⁴⟩ (eq. 27'): T_TI = Σ_i p_i²/(2m_i) with the momenta
 in the centre-of-mass frame, so ⟨T_TI²⟩ = ⟨(E − V)²⟩ = E² − 2E⟨V⟩ + ⟨V²⟩, ⟨V²⟩ = Σ_{i<j} q_iq_j⟨V/r_ij⟩,

@@ -66,7 +66,7 @@ def reported(family, regularised: bool | None = None) -> list[str]:
     result.json): every one the family evaluates, Drachmann's terms, which serve the regularised
     ⟨δ³(r_ij)⟩ and ⟨p⁴⟩ alone, only if `regularised`; None: where ⟨V/r_ij⟩ is in closed form
     (`drachmann.CLOSED_FORM`). Elsewhere ⟨V/r_ij⟩ is a quadrature of tens of damped elements per
-    product (eq. 38): H2-500's properties take 55 s with them, 26 s without (benchmarks/README.md)."""
+    product (eq. 38): H2-500's properties take 55 s with them, 26 s without (benchmarks/record/relativistic.md, "Eq. (38) by even rules, and every property of H2-500 in 55 s")."""
     if regularised is None:
         regularised = family.name in drachmann.CLOSED_FORM
     return [name for name, op in OPERATORS.items()

@@ -8,16 +8,16 @@ L-BFGS step, or, at full size, one pruning: `pruned(size)` functions grown past 
 refined with its partners, as many removed again (each removal followed by a refinement of the
 function that overlapped most the one removed), and the basis before it restored unless the
 energy fell (methods.PrunePass; with the fixed schedule's pruning He with 500 functions gained
-2.8× as much as with the adaptive schedule in 150 s, benchmarks/README, "Grow and prune").
-After each pass the next one is of the kind whose last pass gained the most energy per second
-of wall time — except at full size after every momentum.EVERY passes that move functions
+2.8× as much as with the adaptive schedule in 150 s, benchmarks/record/schedules.md, "Pruning in the
+adaptive schedule"). After each pass the next one is of the kind whose last pass gained the most
+energy per second of wall time — except at full size after every momentum.EVERY passes that move functions
 (refinement, replacement, joint) since the last move or pruning, when the basis moves on along
 its displacement (momentum.py; a pass of kind "momentum", seconds long); kinds not yet tried come
 first. A move extrapolates the displacement of the passes before it, so its gain is theirs: it is
 shared among them in proportion to their own gains (a pass whose move has not come, yet or at
 all, counts with the factor its kind had from its last move). On the H2 run the moves after
 refinement gained 3–10× those after replacement sweeps, which the passes' own rates do not show
-(benchmarks/README, "A stale rate, and momentum every one, two or four passes"). A kind's rate is
+(benchmarks/record/h2.md, "A stale rate, and momentum every one, two or four passes"). A kind's rate is
 measured again only when it runs again, so the rate it keeps is that of an earlier, richer
 state: as the running kind's rate falls below it, the other kinds are tried again, and each stays
 in use as long as it pays best.
@@ -45,7 +45,7 @@ schedule (driver.py).
 
 The choices follow measured seconds, so two runs of one input take different paths and may end
 apart (H2 with 300 functions and 30 trials: 1.2e-6 and 2.4e-6 Eh above after 600 s;
-benchmarks/README, "Trials in the adaptive schedule"); a fixed schedule (any of sweeps, refine,
+benchmarks/record/schedules.md, "Trials in the adaptive schedule"); a fixed schedule (any of sweeps, refine,
 polish, cycles given) repeats bit for bit.
 
 The passes (`Pass`: stored as [kind, n_b, E before, E after, seconds before, seconds after,
@@ -98,19 +98,19 @@ RESTARTS = 2
 #: refinement EVALUATIONS energies with gradients, (1 + P) rows each, so a wider competition is nearly
 #: free and picks better functions (H2 with 300 functions after 600 s: 6.7e-7 and 7.2e-7 Eh above
 #: with 100 trials against 1.2e-6 and 2.4e-6 with 30; He with 400 in 300 s: 7.5e-10 and 8.7e-10
-#: against 1.3–2.1e-9 with 20; benchmarks/README, "Trials in the adaptive schedule")
+#: against 1.3–2.1e-9 with 20; benchmarks/record/schedules.md, "Trials in the adaptive schedule")
 TRIALS = 100
-#: energies per refinement of one function: L-BFGS converges a function in 15–40 (benchmarks/README)
+#: energies per refinement of one function: L-BFGS converges a function in 15–40 (benchmarks/record/refinement.md)
 EVALUATIONS = 30
 #: functions a refinement pass moves together: each with the GROUP − 1 it overlaps most
-#: (near-duplicate partners hold a lone function in place; benchmarks/README, "The H2 campaign" and
-#: issue 17's rows)
+#: (near-duplicate partners hold a lone function in place; benchmarks/record/h2.md, "The H2
+#: campaign"; benchmarks/record/schedules.md, "Groups in the adaptive schedule")
 GROUP = 3
 #: the share of an atom's growth trials that perturb functions of the basis at their own scale, its
 #: sweeps then trying moves of the function replaced only (sampler.py): He with 700 functions in
 #: 300 s, 5.1–6.0e-11 Eh above in three runs against 2.7–6.0e-10 with every trial drawn
-#: (benchmarks/README, "Trials near the basis"); 0 for molecules (H2⁺ from defaults ended at 5.5e-7
-#: with it, 5.6e-8 without: the perturbations keep u and K)
+#: (benchmarks/record/schedules.md, "Trials near the basis"); 0 for molecules (H2⁺ from defaults
+#: ended at 5.5e-7 with it, 5.6e-8 without: the perturbations keep u and K)
 NEAR = 0.5
 
 
@@ -417,7 +417,7 @@ class Adaptive:
 
         passes, start, nxt, stalled = ((block.get("passes"), block.get("start"), block.get("next"),
                                         block.get("stalled")) if isinstance(block, dict) else (None,) * 4)
-        restarts = block.get("restarts", 0) if isinstance(block, dict) else 0  # absent before session 21
+        restarts = block.get("restarts", 0) if isinstance(block, dict) else 0  # absent before 810d62f
         if not (isinstance(passes, list) and all(map(one, passes)) and isinstance(start, list) and len(start) == 2
                 and began(*start) and isinstance(nxt, dict)
                 and set(nxt) == {"refine", "sweep"} and all(map(count, nxt.values()))

@@ -20,9 +20,9 @@ phase of the cursor names the method (`methods`).
   removal raises the energy least (eigen.root_without_each), one per step back to the size,
   the function that overlapped it most then refined with its partners to take over its part
   (H2 with 500 ECG-GVR functions at 1.2e-8 Eh above, 12 grown and removed: the net gain 6.3–9.5e-11
-  Eh against −1.5e-11 … 7.7e-11 without; benchmarks/README, "Pruning that refines after each
+  Eh against −1.5e-11 … 7.7e-11 without; benchmarks/record/h2.md, "Pruning that refines after each
   removal"): pruning a basis grown past its size keeps the functions that matter and moves the
-  basis out of the basin refinement has settled in (benchmarks/README, "Grow and prune").
+  basis out of the basin refinement has settled in (benchmarks/record/h2.md, "Grow and prune").
 - `PrunePass` ("prune", a schedule whose pruning is one step, `whole_pruning`): a whole pruning,
   growth steps up to the cursor's target and the removals back to N_b, in one step, undone
   unless the energy fell: the schedule's size is a cap at every step and its energy never rises.
@@ -119,7 +119,7 @@ class Grow:
 #: internal exponents this many times c_A or more (or less) leave too few digits beside it in double
 #: precision: a trial's A = (internal part) + c_A μμᵀ loses its Cholesky factor or its integrals
 #: their digits (settings.py, C_A). Two particles of charges ±1 and masses m at c_A = 1 (1/a² = m²/4):
-#: m = 10⁴ grows, m = 3·10⁴ stalls at 4 functions, m = 10⁵ finds no function (measured, session 36)
+#: m = 10⁴ grows, m = 3·10⁴ stalls at 4 functions, m = 10⁵ finds no function (measured at a7fcde6)
 DIGITS_APART = 1e9
 
 
@@ -141,10 +141,10 @@ def unresolved(sampler, family: str) -> str:
 def stalled(nb: int, opts: Optimiser, condition: float = 0.0, sigma: float = 0.0) -> str:
     """Why growth stopped at `nb` functions, and the settings to change: at an overlap `condition`
     within a decade of 1/threshold a new function costs a dropped direction (eigen.solve), so no
-    trial lowers the energy (He at 427 functions, benchmarks/README, "Cheaper steps at large N");
+    trial lowers the energy (He at 427 functions, benchmarks/record/schedules.md, "Cheaper steps at large N");
     otherwise every trial was refused by the linear-dependence guard or gained too little beyond
     the energy's uncertainty `sigma` (Eh; Expansion.keep_if_lower: He at 580 functions with σ =
-    1.0e-13, benchmarks/README, "Defaults that know the numerics")."""
+    1.0e-13, benchmarks/record/schedules.md, "Defaults that know the numerics")."""
     if condition * opts.threshold >= 0.1:
         return (f"no trial of the last {STALL_STEPS} growth steps lowered the energy at {nb} functions: the "
                 f"overlap condition, {condition:.2e}, is near 1/threshold, where a new function costs a dropped "

@@ -9,9 +9,10 @@ vertex of the parabola through the energies at α = 0, ½, 1 (else the lowest of
 only if the energy falls (Expansion.replace_basis). A function whose channel or K differs from its reference, or that
 moved by MAX_STEP or more in θ (a replacement), stays where it is. H2 with 500 ECG-GVR functions
 at 4.3e-8 Eh above the exact energy: 600 group steps with a move after every 200 gained 1.82× as
-much as without (benchmarks/README, "The fresh run's tail, and momentum over the group
+much as without (benchmarks/record/h2.md, "The fresh run's tail, and momentum over the group
 refinements"); at 2.8e-8, a move after every two passes of 50 gained 1.23× as much in 1500 s as
-after every four, after every one 0.90× ("Momentum every one, two or four passes").
+after every four, after every one 0.90× (benchmarks/record/h2.md, "A stale rate, and momentum
+every one, two or four passes").
 """
 from __future__ import annotations
 
@@ -95,7 +96,7 @@ class Momentum:
 
     @classmethod
     def from_dict(cls, block, basis: Basis, where: str) -> "Momentum":
-        """The momentum of a checkpoint's "momentum" block (`to_dict`; absent before session 24) for
+        """The momentum of a checkpoint's "momentum" block (`to_dict`; absent before 671d9a1) for
         the run of `basis`; BasisFileError naming `where` for one that is not of this run."""
         if block is None:
             return cls()

@@ -22,7 +22,7 @@ factor around e^{±1} and the directions mixed, where a fresh draw samples the w
 K (Family.neighbours, the only moves in K besides a fresh draw: refinement changes θ only), then
 perturbations of it. On an optimised He basis of 700 functions, replacements by the best of 50
 perturbations gained 3.0e-10 Eh in 140 s, 20× what refinement gained per second there
-(benchmarks/README, "Trials near the basis").
+(benchmarks/record/schedules.md, "Trials near the basis").
 """
 from __future__ import annotations
 

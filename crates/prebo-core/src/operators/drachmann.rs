@@ -80,7 +80,8 @@ fn potential<const D: usize>(pairs: &[(Vector<D>, f64)], x: &[f64]) -> f64 {
 /// frame every one: both are `e_i − e_j`) takes each product with another pair from a table, and
 /// the table computes it once, integrated over the damping of the lighter pair of the two
 /// (`wᵀΛw = 1/(2μ_w)` the larger; of equal ones the first), whose integrand is the smoother
-/// (benchmarks/README.md: damping the protons' pair of H2 costs 2–3 times damping any other). That
+/// (benchmarks/record/relativistic.md, "Drachmann's terms with shared work": damping the protons'
+/// pair of H2 costs 2–3 times damping any other). That
 /// halves the quadratures of eq. (38) where every pair is asked for (⟨V²⟩ of the regularised
 /// ⟨p⁴⟩), and each product is the same bits whichever instances share the call (MPI ranks split
 /// them). Any other instance is `coulomb_inv_r`.
@@ -540,7 +541,7 @@ mod tests {
     /// Eq. (38) where the pairs are nearly uncorrelated in the Gaussian (ρ² from 6e-4 down to
     /// 7e-7, and 0), each product against eq. (19) to 1e-13: ECG-GVR at K = N = 0 by its own path
     /// and the generic one, floating ECGs at zero centres (measured: 9.1e-16 at most). Where
-    /// 1 − τ² was the difference cos φ − √(1 − ρ²) it lost about ε/ρ² (session 37's code: 2.7e-11
+    /// 1 − τ² was the difference cos φ − √(1 − ρ²) it lost about ε/ρ² (b25cc10's code: 2.7e-11
     /// at ρ² = 6e-6, 6.9e-13 at 7e-5).
     #[test]
     fn nearly_uncorrelated_pairs_match_eq_19() {
@@ -638,7 +639,7 @@ mod tests {
     /// K up to 15 along the heavy pair, held close (1 − ρ² down to ~1e-5), N = 0 and 1, with and
     /// without the CM elimination, every pair vector; to the generic path's own rounding there
     /// (`nearly_parallel_pairs_match_eq_19`) and what the quadrature promises: measured per product
-    /// up to 1.4e-14, 2.6e-12 and 3.8e-10 at tight = 10, 10³, 10⁵ (Coulomb, session 38), 7e-14,
+    /// up to 1.4e-14, 2.6e-12 and 3.8e-10 at tight = 10, 10³, 10⁵ (Coulomb, 30b3384), 7e-14,
     /// 2.2e-12 and 5.1e-10 (gradient).
     #[test]
     fn global_vector_functions_match_the_generic_path() {
