@@ -30,5 +30,7 @@ pub mod operators;
 pub mod path;
 pub mod scalar;
 pub mod secular;
+#[cfg(test)]
+pub(crate) mod test_support;
 
 pub use error::{CoreError, Result};

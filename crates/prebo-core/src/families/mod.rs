@@ -7,8 +7,8 @@
 //! and row gradients for any family; each family's `matrices`, `rows` and `row_gradient` call it
 //! or the family's own kernels.
 //!
-//! One folder per family, its kernels and gradients beside it: plain ECG (`plain::PlainEcg`),
-//! ECG-GVR (`gvr::EcgGvr`), floating ECG (`floating::FloatingEcg`). This module uses none of
+//! One folder per family, its kernels and gradients beside it: plain ECG (`pecg::Pecg`),
+//! ECG-GVR (`gvr::EcgGvr`), floating ECG (`fecg::Fecg`). This module uses none of
 //! them, nor `path`: a family uses the trait and the path, not the other way round.
 //!
 //! A new family in the core: `families/<name>/mod.rs` with the family type and its
@@ -20,17 +20,18 @@ use nalgebra::SMatrix;
 
 use crate::cache::{Cache, Keyed};
 use crate::ecg::{Element, Mat, Operators, Real, Vector};
-use crate::families::floating::fecg::Centres;
+use crate::families::fecg::kernel::Centres;
 use crate::error::{CoreError, Result};
 use crate::gradient::Dual;
 use crate::images::Transform;
 use crate::matrices::Matrices;
-use crate::operators::drachmann::{self, InverseProducts};
+use crate::operators::drachmann::coulomb::{self, InverseProducts};
+use crate::operators::drachmann::gradient;
 use crate::operators::{momentum, orbit, ElementFn};
 
-pub mod floating;
-pub mod gvr;
-pub mod plain;
+pub mod fecg;
+pub mod ecg_gvr;
+pub mod pecg;
 
 /// One array of a family's parameter tuple as the binding passes it (`Family::FIELDS`, in order).
 #[derive(Clone, Debug, PartialEq)]
@@ -219,11 +220,11 @@ pub trait Family<const D: usize>: Sized + 'static {
     /// operator `coulomb_inv_r`): by default eq. (38) over the family's own `1/|r_w'|` element of
     /// its damped functions (`drachmann::products_by_damping`); plain ECGs have them in closed form
     /// (eq. 19), ECG-GVR reads the damped elements off one factorisation.
-    const COULOMB: InverseProducts<D, Self> = drachmann::products_by_damping::<D, Self>;
+    const COULOMB: InverseProducts<D, Self> = coulomb::products_by_damping::<D, Self>;
     /// The element of `<∇φ_I| Λ/|r_w| |∇φ_J>` (`operators::drachmann`, operator `gradient_inv_r`):
     /// by default eq. (30) over the family's kinetic elements of its damped functions
     /// (`drachmann::gradient_inv_r`); ECG-GVR reads each node off one factorisation.
-    const GRADIENT: ElementFn<D, Self> = drachmann::gradient_inv_r::<D, Self>;
+    const GRADIENT: ElementFn<D, Self> = gradient::gradient_inv_r::<D, Self>;
     /// The element of `N_TI²` where the functions are not its eigenfunctions (`Angular`), `None`
     /// where they are (`N_TI² φ = N(N + 1) φ`).
     const ANGULAR: Option<Angular<D, Self>> = None;

@@ -11,7 +11,7 @@
 //! vectors per instance).
 use crate::ecg::Vector;
 use crate::error::{CoreError, Result};
-use crate::families::plain::PlainEcg;
+use crate::families::pecg::Pecg;
 use crate::families::Family;
 
 pub mod angular;
@@ -79,7 +79,7 @@ fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<
         (momentum::P2, 1, one_vector!(momentum::p2::<D, F>)),
         (momentum::P4, 1, one_vector!(momentum::p4::<D, F>)),
         (momentum::P2P2, 2, Some(Each(momentum::p2p2::<D, F>))),
-        (drachmann::COULOMB, 1, Some(All(drachmann::coulomb_all::<D, F>))),
+        (drachmann::COULOMB, 1, Some(All(drachmann::coulomb::coulomb_all::<D, F>))),
         (drachmann::GRADIENT, 1, Some(Each(F::GRADIENT))),
         (orbit::NAME, 3, Some(Each(F::ORBIT))),
         (angular::NAME, 1, F::ANGULAR.and_then(|_| one_vector!(angular::element::<D, F>))),
@@ -88,7 +88,7 @@ fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<
 
 /// The names of the registered operators.
 pub fn names() -> Vec<&'static str> {
-    registry::<1, PlainEcg>().into_iter().map(|(name, ..)| name).collect()
+    registry::<1, Pecg>().into_iter().map(|(name, ..)| name).collect()
 }
 
 /// The names of the registered operators the family `F` evaluates.
@@ -112,8 +112,8 @@ pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<(usize, Elemen
 #[cfg(test)]
 pub(crate) mod fixtures {
     use crate::ecg::{Mat, Operators, Vector};
-    use crate::families::floating::fecg::Centres;
-    use crate::families::gvr::gvr_element::{Gvr, GvrOps};
+    use crate::families::fecg::kernel::Centres;
+    use crate::families::ecg_gvr::element::{GvrFunction, GvrOps};
 
     pub const D: usize = 3;
 
@@ -135,9 +135,9 @@ pub(crate) mod fixtures {
         Centres::<N>::from_fn(|i, c| spread * (x + i as f64 * 1.1 + c as f64 * 0.37).cos())
     }
 
-    /// A plain ECG of the `PlainEcg` family (an ECG-GVR function at K = N = 0, `u` irrelevant).
-    pub fn plain<const N: usize>(a: Mat<N>, c_a: f64, go: &GvrOps<N>, index: usize) -> Gvr<N> {
-        Gvr::new(a, Vector::<N>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 }), 0, c_a, go, index).unwrap()
+    /// A plain ECG of the `Pecg` family (an ECG-GVR function at K = N = 0, `u` irrelevant).
+    pub fn plain<const N: usize>(a: Mat<N>, c_a: f64, go: &GvrOps<N>, index: usize) -> GvrFunction<N> {
+        GvrFunction::new(a, Vector::<N>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 }), 0, c_a, go, index).unwrap()
     }
 
     /// Kinetic `Λ = ½` and the Coulomb `pairs`.

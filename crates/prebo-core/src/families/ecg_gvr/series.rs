@@ -1,13 +1,13 @@
-//! The series of Ω (`gvr_element` module docs, docs/gvr.md) and the formulas built on it alone,
+//! The series of Ω (`element` module docs, docs/gvr.md) and the formulas built on it alone,
 //! written once for every value they are evaluated in (`Scalar`): `f64` and dual numbers in the
-//! generic element (`gvr_element::element`), lanes of symmetry images in the f64 kernel
-//! (`gvr_kernel`) and its row gradient (`gvr_gradient`). Each is one sequence of operations, so
+//! generic element (`element::element`), lanes of symmetry images in the f64 kernel
+//! (`kernel`) and its row gradient (`gradient`). Each is one sequence of operations, so
 //! every instance has the bits of the others.
 use std::ops::{Div, Mul};
 
 use crate::scalar::Scalar;
 
-/// `ĉ_k`, k = 0..=min(K_I, K_J) (`gvr_element` module docs), and the coefficients of the series of Ω's
+/// `ĉ_k`, k = 0..=min(K_I, K_J) (`element` module docs), and the coefficients of the series of Ω's
 /// derivatives (`omega`, `quadrature_partials`), for one pair (K_I, K_J) and N; all non-negative.
 /// At `r = ρ²`: `G = Σ ĉ_k r^k`, `G_x = Σ ĉ_k (K_I−k) r^k`, `G_y = Σ ĉ_k (K_J−k) r^k`,
 /// `G_z = Σ ĉ_k (N+2k) r^k`, for N = 0 divided by r (its k = 0 term vanishes).
@@ -69,7 +69,7 @@ pub(crate) fn horner<T: Scalar>(coef: &[f64], r: T) -> T {
 }
 
 /// One pair's series of Ω and of its first derivatives (`Coefficients`), borrowed: what `omega`
-/// reads, from `Coefficients::terms` or from the f64 kernel's table (`gvr_kernel::Series::terms`).
+/// reads, from `Coefficients::terms` or from the f64 kernel's table (`kernel::Series::terms`).
 #[derive(Clone, Copy)]
 pub(crate) struct Terms<'a> {
     pub(crate) ki: u32,

@@ -2,8 +2,9 @@
 //! and the same bits on every instruction set.
 use super::*;
 use crate::cache::Cache;
-use crate::families::plain::pecg::tests::{gaussian, operators, Rng};
-use crate::families::plain::{diagonal, PlainEcg};
+use crate::families::pecg::kernel::tests::{gaussian, operators};
+use crate::test_support::Rng;
+use crate::families::pecg::{diagonal, Pecg};
 use crate::families::{Directions, Exponents, Family};
 use crate::isa::best_isa;
 use crate::path;
@@ -23,7 +24,7 @@ fn symmetry<const D: usize>() -> Vec<(Mat<D>, f64)> {
 
 /// A random symmetric direction.
 fn direction<const D: usize>(rng: &mut Rng) -> Mat<D> {
-    let x = Mat::<D>::from_fn(|_, _| rng.normal());
+    let x = Mat::<D>::from_fn(|_, _| rng.signed());
     x + x.transpose()
 }
 
@@ -72,10 +73,10 @@ impl<const D: usize> Case<D> {
         let trial = Exponents { a: &ta, c_a: &tc };
         let basis = Exponents { a: &ba, c_a: &bc };
         let dir = Directions { a: &da, v: &[] };
-        let ctx = <PlainEcg as Family<D>>::context(self.ops.clone(), 0, &[]).unwrap();
+        let ctx = <Pecg as Family<D>>::context(self.ops.clone(), 0, &[]).unwrap();
         (
-            <PlainEcg as Family<D>>::row_gradient(&ctx, &self.sym, &trial, &dir, &basis, &Cache::default()).unwrap(),
-            path::row_gradient::<D, PlainEcg>(&ctx, &self.sym, &trial, &dir, &basis, &Cache::default()).unwrap(),
+            <Pecg as Family<D>>::row_gradient(&ctx, &self.sym, &trial, &dir, &basis, &Cache::default()).unwrap(),
+            path::row_gradient::<D, Pecg>(&ctx, &self.sym, &trial, &dir, &basis, &Cache::default()).unwrap(),
         )
     }
 
@@ -101,7 +102,7 @@ impl<const D: usize> Case<D> {
     fn diagonal_scale_of(&self, g: &Gaussian<D>) -> [f64; 4] {
         let mut positive = self.ops.clone();
         positive.pairs.iter_mut().for_each(|(_, q)| *q = q.abs());
-        let (e, v) = (pecg::element(g, g, &self.ops), pecg::element(g, g, &positive));
+        let (e, v) = (kernel::element(g, g, &self.ops), kernel::element(g, g, &positive));
         let c = self.sym.iter().map(|(_, c)| c.abs()).sum::<f64>();
         [e.s, e.t, e.t_ti, v.v].map(|x| c * x.abs())
     }
@@ -232,7 +233,7 @@ fn every_instruction_set_gives_the_same_bits() {
     same_bits::<5>();
 }
 
-/// The trial's diagonal from the bra-side kernel (`plain::diagonal`) against the dual path, for
+/// The trial's diagonal from the bra-side kernel (`kernel::diagonal`) against the dual path, for
 /// operators that commute with the operations: H2-like (two pairs of identical particles, the
 /// four operations of (1 − P₀₁)(1 + P₂₃)) and three identical particles with the cyclic
 /// shifts (P⁻¹ ≠ P, unequal coefficients); and none for operators that do not commute.

@@ -1,9 +1,10 @@
-//! The closed form against the Gauss–Legendre quadrature of `gvr_element` (the oracle), hand values,
+//! The closed form against the Gauss–Legendre quadrature of `element` (the oracle), hand values,
 //! and (ignored) the timing of both per pair.
 use super::*;
 use crate::ecg::{Mat, Operators};
-use crate::families::gvr::gvr_build::coulomb_partials;
-use crate::families::gvr::gvr_element::even_rule;
+use crate::families::ecg_gvr::build::coulomb_partials;
+use crate::families::ecg_gvr::element::even_rule;
+use crate::test_support::Rng;
 
 const D: usize = 3;
 
@@ -11,26 +12,12 @@ fn context(n_ang: u32, k_max: u32) -> GvrOps<D> {
     GvrOps::new(Operators { lambda: Mat::<D>::identity(), pairs: vec![], cm_mass: None }, n_ang, k_max).unwrap()
 }
 
-/// xorshift64*: deterministic numbers in [-1, 1) without a dependency.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-
-    fn vector(&mut self) -> [f64; 3] {
-        [self.next(), self.next(), self.next()]
-    }
-}
-
 /// Inputs of a valid covariance structure: `x = |p|²`, `y = |q|²`, `z = p·q`, `γ_I = p·e`,
 /// `γ_J = q·e` for a unit vector `e` (then `x', y' ≥ 0` and `x'y' ≥ z'²`).
 fn inputs(rng: &mut Rng) -> [f64; 5] {
     let dot = |a: &[f64; 3], b: &[f64; 3]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-    let (p, q, e) = (rng.vector(), rng.vector(), rng.vector());
+    let mut vector = || [rng.signed(), rng.signed(), rng.signed()];
+    let (p, q, e) = (vector(), vector(), vector());
     let e = e.map(|c| c / dot(&e, &e).sqrt());
     [dot(&p, &p), dot(&q, &q), dot(&p, &q), dot(&p, &e), dot(&q, &e)]
 }
@@ -117,7 +104,7 @@ fn cpu_ns() -> f64 {
     t.sec as f64 * 1e9 + t.nsec as f64
 }
 
-/// Today's `gvr_element::quadrature` in `f64` (the element's value path), line for line.
+/// Today's `element::quadrature` in `f64` (the element's value path), line for line.
 fn quadrature_value(inputs: [f64; 5], rule: &[(f64, f64)], c: &[f64], ki: i32, kj: i32, n: i32) -> f64 {
     let [x, y, z, gam_i, gam_j] = inputs;
     let rt = (x * y).sqrt();
@@ -164,7 +151,7 @@ fn time_pair(go: &GvrOps<D>, ki: u32, kj: u32, xs: &[[f64; 5]]) -> [f64; 3] {
     best
 }
 
-/// `cargo test --release -p prebo-core gvr_coulomb::tests::timing -- --ignored --nocapture`
+/// `cargo test --release -p prebo-core coulomb::tests::timing -- --ignored --nocapture`
 /// (one thread): ns per call, closed form vs today's quadrature, over the pairs of the H2
 /// checkpoint's row of function 100 (K = 19, N = 0) and over K_I = K_J = 0..=40.
 #[test]

@@ -1,13 +1,13 @@
-//! The plain-ECG family. Its matrices and rows come from the SIMD kernel (`pecg`, with the
-//! builds of `pecg_build`), its row gradients from the hand-derived kernel in the same lanes
-//! (`pecg_gradient`). Its generic elements (the diagonal of a row gradient by dual numbers where
+//! The plain-ECG family. Its matrices and rows come from the SIMD kernel (`kernel`, with the
+//! builds of `build`), its row gradients from the hand-derived kernel in the same lanes
+//! (`gradient`). Its generic elements (the diagonal of a row gradient by dual numbers where
 //! `diagonal` does not apply, extra operators) are the ECG-GVR elements at K = N = 0 with
-//! `u = e_1` (`gvr::gvr_element`), where `u` drops out and the elements are those of plain ECGs
-//! (`gvr_element` module docs: "For K = N = 0 this is the plain-ECG ..."): one generic element
+//! `u = e_1` (`ecg_gvr::element`), where `u` drops out and the elements are those of plain ECGs
+//! (`element` module docs: "For K = N = 0 this is the plain-ECG ..."): one generic element
 //! for both families, so the dual-number values stay those of that one code.
 use nalgebra::SMatrix;
 
-use super::gvr::gvr_element::{self, Gvr, GvrOps};
+use super::ecg_gvr::element::{self, GvrFunction, GvrOps};
 use crate::cache::Cache;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
 use crate::error::Result;
@@ -16,15 +16,15 @@ use crate::gradient::{seed_matrix, Dual};
 use crate::images::Images;
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
-use crate::operators::drachmann::{self, InverseProducts};
+use crate::operators::drachmann::coulomb::{self, InverseProducts};
 use crate::path;
 
-pub mod pecg;
-pub mod pecg_build;
-pub mod pecg_gradient;
+pub mod build;
+pub mod gradient;
+pub mod kernel;
 
 /// The plain-ECG family: parameters `A` (`k x n x n`) and `c_A` (`Exponents`).
-pub struct PlainEcg;
+pub struct Pecg;
 
 /// The plain ECGs of `p` with their images under `sym`, for the SIMD kernel.
 fn gaussians<const D: usize>(p: &Exponents, sym: &Symmetry<D>) -> Result<Images<Gaussian<D>>> {
@@ -38,14 +38,14 @@ fn gaussians<const D: usize>(p: &Exponents, sym: &Symmetry<D>) -> Result<Images<
     Images::new(f, sym, &())
 }
 
-impl<const D: usize> Family<D> for PlainEcg {
+impl<const D: usize> Family<D> for Pecg {
     const NAME: &'static str = "pecg";
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("c_A")];
-    /// Rows in full-build orientation from the SIMD kernel (`pecg_build::rows`).
+    /// Rows in full-build orientation from the SIMD kernel (`build::rows`).
     const ORIENTED: bool = true;
     /// Eq. (19) in closed form.
-    const COULOMB: InverseProducts<D, Self> = drachmann::inverse_products::<D, Self>;
-    type Function<T: Real> = Gvr<D, T>;
+    const COULOMB: InverseProducts<D, Self> = coulomb::inverse_products::<D, Self>;
+    type Function<T: Real> = GvrFunction<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = Exponents<'a>;
 
@@ -58,30 +58,30 @@ impl<const D: usize> Family<D> for PlainEcg {
         GvrOps::new(ops, 0, 0)
     }
 
-    fn functions(p: &Exponents, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
+    fn functions(p: &Exponents, go: &GvrOps<D>) -> Result<Vec<GvrFunction<D>>> {
         let a = p.exponents::<D>()?;
         let u = Vector::<D>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 });
         a.into_iter()
             .zip(p.c_a)
             .enumerate()
-            .map(|(i, (a, c))| Gvr::new(a, u, 0, *c, go, i))
+            .map(|(i, (a, c))| GvrFunction::new(a, u, 0, *c, go, i))
             .collect()
     }
 
-    fn element<T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
-        gvr_element::element(bra, ket, go)
+    fn element<T: Real>(bra: &GvrFunction<D, T>, ket: &GvrFunction<D, T>, go: &GvrOps<D>) -> Element<T> {
+        element::element(bra, ket, go)
     }
 
-    fn cast<T: Real>(f: &Gvr<D>) -> Gvr<D, T> {
+    fn cast<T: Real>(f: &GvrFunction<D>) -> GvrFunction<D, T> {
         f.cast()
     }
 
     /// Directions of `A` only (`dv` is ignored: u drops out).
-    fn seeded<const W: usize>(f: &Gvr<D>, da: &[Mat<D>], _: &[f64], go: &GvrOps<D>) -> Result<Gvr<D, Dual<W>>> {
-        Gvr::new(seed_matrix(&f.a, da), seed_matrix(&f.u, &[]), 0, f.c_a, go, 0)
+    fn seeded<const W: usize>(f: &GvrFunction<D>, da: &[Mat<D>], _: &[f64], go: &GvrOps<D>) -> Result<GvrFunction<D, Dual<W>>> {
+        GvrFunction::new(seed_matrix(&f.a, da), seed_matrix(&f.u, &[]), 0, f.c_a, go, 0)
     }
 
-    fn exponent(f: &Gvr<D>) -> &Mat<D> {
+    fn exponent(f: &GvrFunction<D>) -> &Mat<D> {
         &f.a
     }
 
@@ -93,16 +93,16 @@ impl<const D: usize> Family<D> for PlainEcg {
         ctx.without_pairs()
     }
 
-    fn shape(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, _w: &Vector<D>) -> Shape {
+    fn shape(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, _w: &Vector<D>) -> Shape {
         Shape::Polynomial(vec![<Self as Family<D>>::overlap(bra, ket, go)])
     }
 
-    fn damped<T: Real>(f: &Gvr<D>, m: &SMatrix<T, D, D>) -> Gvr<D, T> {
+    fn damped<T: Real>(f: &GvrFunction<D>, m: &SMatrix<T, D, D>) -> GvrFunction<D, T> {
         f.damped(m)
     }
 
     fn matrices(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &Exponents) -> Result<Matrices> {
-        Ok(pecg_build::matrices(&gaussians(basis, sym)?, &go.ops))
+        Ok(build::matrices(&gaussians(basis, sym)?, &go.ops))
     }
 
     fn rows(
@@ -114,10 +114,10 @@ impl<const D: usize> Family<D> for PlainEcg {
         cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
         let b = cache.get(basis, || gaussians(basis, sym))?;
-        Ok(pecg_build::rows(&gaussians(trials, sym)?, &b, &go.ops, position))
+        Ok(build::rows(&gaussians(trials, sym)?, &b, &go.ops, position))
     }
 
-    /// The row from `pecg_gradient` (directions of `A` only, as `seeded`), the basis in its lanes
+    /// The row from `gradient` (directions of `A` only, as `seeded`), the basis in its lanes
     /// kept in `cache`; the diagonal, where both sides move, from the same kernel (`diagonal`),
     /// or by dual numbers (`path::row_gradient` against no basis) where that does not apply.
     fn row_gradient(
@@ -136,9 +136,9 @@ impl<const D: usize> Family<D> for PlainEcg {
             None => path::row_gradient::<D, Self>(go, sym, trial, dir, &Exponents::default(), &Cache::default())?.1,
         };
         let kets = cache.get(basis, || {
-            Ok(pecg_gradient::Kets::new(&*cache.get(basis, || gaussians(basis, sym))?, best_isa()))
+            Ok(gradient::Kets::new(&*cache.get(basis, || gaussians(basis, sym))?, best_isa()))
         })?;
-        Ok((pecg_gradient::row_gradient(&f, &da, &kets, &go.ops), diag))
+        Ok((gradient::row_gradient(&f, &da, &kets, &go.ops), diag))
     }
 }
 
@@ -172,9 +172,9 @@ pub(crate) fn diagonal<const D: usize>(
     };
     let mut own = Images::new(vec![f.clone()], sym, &())?;
     let isa = best_isa();
-    let bra = pecg_gradient::row_gradient(f, da, &pecg_gradient::Kets::new(&own, isa), ops);
+    let bra = gradient::row_gradient(f, da, &gradient::Kets::new(&own, isa), ops);
     own.coef = inverse;
-    let ket = pecg_gradient::row_gradient(f, da, &pecg_gradient::Kets::new(&own, isa), ops);
+    let ket = gradient::row_gradient(f, da, &gradient::Kets::new(&own, isa), ops);
     let at = |m: &Matrices, r: usize| Element { s: m.s[r], t: m.t[r], t_ti: m.t_ti[r], v: m.v[r] };
     Ok(Some(
         (0..bra.rows)

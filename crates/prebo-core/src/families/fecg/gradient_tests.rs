@@ -4,23 +4,10 @@
 //! branch (`|m|` tiny) to `erf = 1`.
 use super::*;
 use crate::ecg::Vector;
-use crate::families::floating::{fecg, FloatingEcg};
+use crate::families::fecg::{kernel, Fecg};
 use crate::families::{Exponents, Family};
 use crate::path;
-
-/// xorshift64*: deterministic numbers in [0, 1) without a dependency.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        self.next() * 2.0 - 1.0
-    }
-}
+use crate::test_support::Rng;
 
 /// Flat parameters of `k` floating ECGs: `A = L Lᵀ + 0.2 I`, centres `base + jitter · random`
 /// (`base`: particle `i` at `(i - (D-1)/2) spread` along a random axis, the same for every function, so
@@ -33,14 +20,14 @@ struct Set {
 
 impl Set {
     fn new<const D: usize>(rng: &mut Rng, k: usize, spread: f64, jitter: f64) -> Self {
-        let axis = [rng.normal(), rng.normal(), 0.5 + rng.next()];
+        let axis = [rng.signed(), rng.signed(), 0.5 + rng.next()];
         let (mut a, mut c_a, mut s) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..k {
-            let l = Mat::<D>::from_fn(|i, j| if j <= i { rng.normal() } else { 0.0 });
+            let l = Mat::<D>::from_fn(|i, j| if j <= i { rng.signed() } else { 0.0 });
             a.extend((l * l.transpose() + Mat::<D>::identity() * 0.2).transpose().iter());
             c_a.push(0.3 + 2.0 * rng.next());
             for i in 0..D {
-                s.extend((0..3).map(|x| (i as f64 - (D - 1) as f64 / 2.0) * spread * axis[x] + jitter * rng.normal()));
+                s.extend((0..3).map(|x| (i as f64 - (D - 1) as f64 / 2.0) * spread * axis[x] + jitter * rng.signed()));
             }
         }
         Self { a, c_a, s }
@@ -50,8 +37,8 @@ impl Set {
         FecgParams { e: Exponents { a: &self.a, c_a: &self.c_a }, s: &self.s }
     }
 
-    fn function<const D: usize>(&self, i: usize) -> Fecg<D> {
-        <FloatingEcg as Family<D>>::functions(&self.params(), &ops_none::<D>()).unwrap().remove(i)
+    fn function<const D: usize>(&self, i: usize) -> FecgFunction<D> {
+        <Fecg as Family<D>>::functions(&self.params(), &ops_none::<D>()).unwrap().remove(i)
     }
 }
 
@@ -74,8 +61,8 @@ fn operators<const D: usize>(rng: &mut Rng, lab: bool) -> Operators<D> {
         let lambda = Mat::from_fn(|i, j| if i == j { 0.5 / masses[i] } else { 0.0 });
         Operators { lambda, pairs, cm_mass: Some(masses.iter().sum()) }
     } else {
-        let b = Mat::<D>::from_fn(|_, _| rng.normal());
-        let pairs = (0..3).map(|_| (Vector::<D>::from_fn(|_, _| rng.normal()), rng.normal())).collect();
+        let b = Mat::<D>::from_fn(|_, _| rng.signed());
+        let pairs = (0..3).map(|_| (Vector::<D>::from_fn(|_, _| rng.signed()), rng.signed())).collect();
         Operators { lambda: b * b.transpose() * 0.1 + Mat::identity() * 0.01, pairs, cm_mass: None }
     }
 }
@@ -91,9 +78,9 @@ fn symmetry<const D: usize>(sign: f64) -> Vec<(Mat<D>, f64)> {
 fn directions<const D: usize>(rng: &mut Rng, count: usize) -> (Vec<f64>, Vec<f64>) {
     let (mut da, mut ds) = (Vec::new(), Vec::new());
     for _ in 0..count {
-        let x = Mat::<D>::from_fn(|_, _| rng.normal());
+        let x = Mat::<D>::from_fn(|_, _| rng.signed());
         let a = x + x.transpose();
-        let s = Centres::<D>::from_fn(|_, _| rng.normal());
+        let s = Centres::<D>::from_fn(|_, _| rng.signed());
         let norm = (a.norm_squared() + s.norm_squared()).sqrt();
         da.extend((a / norm).transpose().iter());
         ds.extend((s / norm).transpose().iter());
@@ -109,9 +96,9 @@ fn column(m: &Matrices, k: usize, j: usize) -> [f64; 4] {
 /// The scale of symmetrised element `(I, J)` and, for unit directions, of its derivatives:
 /// `Σ_P |c_P| √(X_II X_JJ)` with the un-symmetrised diagonals (`V` with charges `|q|`, `T_TI`
 /// with the scale of `T`).
-fn scale<const D: usize>(fi: &Fecg<D>, fj: &Fecg<D>, ops: &Operators<D>, sym: &[(Mat<D>, f64)]) -> [f64; 4] {
+fn scale<const D: usize>(fi: &FecgFunction<D>, fj: &FecgFunction<D>, ops: &Operators<D>, sym: &[(Mat<D>, f64)]) -> [f64; 4] {
     let abs = Operators { pairs: ops.pairs.iter().map(|(w, q)| (*w, q.abs())).collect(), ..ops.clone() };
-    let (ei, ej) = (fecg::element(fi, fi, &abs), fecg::element(fj, fj, &abs));
+    let (ei, ej) = (kernel::element(fi, fi, &abs), kernel::element(fj, fj, &abs));
     let c: f64 = sym.iter().map(|(_, c)| c.abs()).sum();
     let g = |x: f64, y: f64| c * (x * y).abs().sqrt();
     [g(ei.s, ej.s), g(ei.t, ej.t), g(ei.t, ej.t), g(ei.v, ej.v)]
@@ -143,11 +130,11 @@ fn deviation<const D: usize>(
 
 /// `(min, max)` of `t = m²/c` over the Coulomb pairs of the trial against every image of the basis.
 fn coulomb_range<const D: usize>(set: &Set, ops: &Operators<D>, sym: &[(Mat<D>, f64)]) -> (f64, f64) {
-    let b = path::images::<D, FloatingEcg>(ops, sym, &set.params()).unwrap();
+    let b = path::images::<D, Fecg>(ops, sym, &set.params()).unwrap();
     let fi = set.function::<D>(0);
     let mut range = (f64::INFINITY, 0.0f64);
     for ket in b.images.iter().skip(1).flatten() {
-        let (_, binv, rbar) = fecg::pair(&fi, ket).unwrap();
+        let (_, binv, rbar) = kernel::pair(&fi, ket).unwrap();
         for (w, _) in &ops.pairs {
             let (_, c, m) = coulomb_moments(w, &binv, &rbar);
             range = (range.0.min(m.norm_squared() / c), range.1.max(m.norm_squared() / c));
@@ -172,8 +159,8 @@ fn against_dual<const D: usize>(n_dir: usize) -> (f64, f64) {
                 let trial = FecgParams { e: Exponents { a: &p.e.a[..D * D], c_a: &p.e.c_a[..1] }, s: &p.s[..3 * D] };
                 let basis = FecgParams { e: Exponents { a: &p.e.a[D * D..], c_a: &p.e.c_a[1..] }, s: &p.s[3 * D..] };
                 let dir = Directions { a: &da, v: &ds };
-                let (hand, hand_diag) = <FloatingEcg as Family<D>>::row_gradient(&ops, &sym, &trial, &dir, &basis, &Cache::default()).unwrap();
-                let (dual, dual_diag) = path::row_gradient::<D, FloatingEcg>(&ops, &sym, &trial, &dir, &basis, &Cache::default()).unwrap();
+                let (hand, hand_diag) = <Fecg as Family<D>>::row_gradient(&ops, &sym, &trial, &dir, &basis, &Cache::default()).unwrap();
+                let (dual, dual_diag) = path::row_gradient::<D, Fecg>(&ops, &sym, &trial, &dir, &basis, &Cache::default()).unwrap();
                 assert_eq!((hand.rows, hand.cols), (1 + n_dir, 6));
                 assert_eq!(hand_diag, dual_diag);
                 let (values, derivatives) = deviation(&set, &ops, &sym, &hand, &dual);
@@ -181,7 +168,7 @@ fn against_dual<const D: usize>(n_dir: usize) -> (f64, f64) {
                 assert!(values <= 1e-13, "{case}: values {values:e}");
                 assert!(derivatives <= 1e-12, "{case}: derivatives {derivatives:e}");
                 // the values are those of `rows` with the trial as bra (at position 0), bit for bit
-                let (rows, _) = <FloatingEcg as Family<D>>::rows(&ops, &sym, &trial, &basis, Some(0), &Cache::default()).unwrap();
+                let (rows, _) = <Fecg as Family<D>>::rows(&ops, &sym, &trial, &basis, Some(0), &Cache::default()).unwrap();
                 assert_eq!(rows.s.iter().chain(&rows.v).chain(&rows.t_ti).map(|x| x.to_bits()).collect::<Vec<_>>(),
                     hand.s[..6].iter().chain(&hand.v[..6]).chain(&hand.t_ti[..6]).map(|x| x.to_bits()).collect::<Vec<_>>());
                 let r = coulomb_range(&set, &ops, &sym);
@@ -215,10 +202,10 @@ fn agrees_with_central_differences() {
         let a: Vec<f64> = (0..D * D).map(|i| p.e.a[i] + h * da[k * D * D + i]).collect();
         let s: Vec<f64> = (0..3 * D).map(|i| p.s[i] + h * ds[k * 3 * D + i]).collect();
         let t = FecgParams { e: Exponents { a: &a, c_a: &p.e.c_a[..1] }, s: &s };
-        <FloatingEcg as Family<D>>::rows(&ops, &sym, &t, &basis, Some(0), &Cache::default()).unwrap().0
+        <Fecg as Family<D>>::rows(&ops, &sym, &t, &basis, Some(0), &Cache::default()).unwrap().0
     };
     let t0 = FecgParams { e: Exponents { a: &p.e.a[..D * D], c_a: &p.e.c_a[..1] }, s: &p.s[..3 * D] };
-    let (hand, _) = <FloatingEcg as Family<D>>::row_gradient(&ops, &sym, &t0, &Directions { a: &da, v: &ds }, &basis, &Cache::default()).unwrap();
+    let (hand, _) = <Fecg as Family<D>>::row_gradient(&ops, &sym, &t0, &Directions { a: &da, v: &ds }, &basis, &Cache::default()).unwrap();
     let h = 1e-5;
     let fi = set.function::<D>(0);
     for k in 0..4 {
@@ -257,7 +244,7 @@ fn coulomb_partials_match_40_digit_references() {
     // the series of F_1 joins the recursion (which is good to ~1e-14 at t = 0.01..0.1)
     for t in [0.01, 0.05, 0.0999] {
         let series = F1_SERIES.iter().rev().fold(0.0, |acc, a| acc * t + a);
-        let f0 = fecg::coulomb_factor(t, 1.0) * PI.sqrt() / 2.0;
+        let f0 = kernel::coulomb_factor(t, 1.0) * PI.sqrt() / 2.0;
         let recursion = (f0 - (-t as f64).exp()) / (2.0 * t);
         assert!((series - recursion).abs() < 1e-13 * series, "t = {t}: {series} vs {recursion}");
     }

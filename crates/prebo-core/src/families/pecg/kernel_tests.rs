@@ -2,6 +2,7 @@
 //! generic loops (bit for bit), and the logarithmic fallback of S.
 use super::*;
 use crate::ecg::{Mat, Vector};
+use crate::test_support::Rng;
 
 /// The former implementation (Cholesky factor and inverse from nalgebra, `exp`/`ln` for `S`).
 fn element_reference<const D: usize>(bra: &Gaussian<D>, ket: &Gaussian<D>, ops: &Operators<D>) -> Element {
@@ -29,26 +30,12 @@ fn element_reference<const D: usize>(bra: &Gaussian<D>, ket: &Gaussian<D>, ops: 
     Element { s, t, t_ti, v: v * s }
 }
 
-/// xorshift64*: deterministic numbers in [0, 1) without a dependency.
-pub(crate) struct Rng(pub(crate) u64);
-impl Rng {
-    pub(crate) fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub(crate) fn normal(&mut self) -> f64 {
-        self.next() * 2.0 - 1.0
-    }
-}
-
 /// A positive-definite exponent: L L^T + 0.05 I with scaled random L, and c_A.
 pub(crate) fn gaussian<const D: usize>(rng: &mut Rng, scale: f64) -> Gaussian<D> {
     let mut l = Mat::<D>::zeros();
     for i in 0..D {
         for j in 0..=i {
-            l[(i, j)] = rng.normal() * scale;
+            l[(i, j)] = rng.signed() * scale;
         }
     }
     let a = l * l.transpose() + Mat::<D>::identity() * 0.05;
@@ -74,13 +61,13 @@ pub(crate) fn operators<const D: usize>(rng: &mut Rng, lab: bool) -> Operators<D
         let mut b = Mat::<D>::zeros();
         for i in 0..D {
             for j in 0..D {
-                b[(i, j)] = rng.normal();
+                b[(i, j)] = rng.signed();
             }
         }
         lambda = b * b.transpose() * 0.1 + Mat::<D>::identity() * 0.01;
         for _ in 0..3 {
-            let w = Vector::<D>::from_fn(|_, _| rng.normal());
-            pairs.push((w, rng.normal()));
+            let w = Vector::<D>::from_fn(|_, _| rng.signed());
+            pairs.push((w, rng.signed()));
         }
     }
     Operators {

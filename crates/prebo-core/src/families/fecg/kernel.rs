@@ -31,7 +31,7 @@ pub type Centres<const D: usize, T = f64> = SMatrix<T, D, 3>;
 /// One floating ECG: exponent `A`, centres `s` (one 3-vector per coordinate), `c_A`.
 /// `T` is `f64`, or a dual number when derivatives with respect to `A` and `s` are wanted.
 #[derive(Clone, Debug)]
-pub struct Fecg<const D: usize, T: Real = f64> {
+pub struct FecgFunction<const D: usize, T: Real = f64> {
     pub a: SMatrix<T, D, D>,
     pub s: Centres<D, T>,
     pub c_a: f64,
@@ -42,7 +42,7 @@ pub struct Fecg<const D: usize, T: Real = f64> {
     pub s_a_s: T,
 }
 
-impl<const D: usize, T: Real> Fecg<D, T> {
+impl<const D: usize, T: Real> FecgFunction<D, T> {
     pub fn new(a: SMatrix<T, D, D>, s: Centres<D, T>, c_a: f64, index: usize) -> Result<Self> {
         let log_det = log_det_pd(&a).ok_or(CoreError::NotPositiveDefinite { function: index })?;
         let a_s = a * s;
@@ -51,11 +51,11 @@ impl<const D: usize, T: Real> Fecg<D, T> {
     }
 
     /// This function with dual-number entries of zero derivative.
-    pub fn cast<S: Real>(&self) -> Fecg<D, S>
+    pub fn cast<S: Real>(&self) -> FecgFunction<D, S>
     where
         T: Into<S>,
     {
-        Fecg {
+        FecgFunction {
             a: self.a.map(Into::into),
             s: self.s.map(Into::into),
             c_a: self.c_a,
@@ -66,12 +66,12 @@ impl<const D: usize, T: Real> Fecg<D, T> {
     }
 }
 
-impl<const D: usize> Fecg<D> {
+impl<const D: usize> FecgFunction<D> {
     /// `(r-s)^T A (r-s) + r^T M r = r^T (A+M) r - 2 r^T A s + s^T A s`: `A` grows, `A s`, `s^T A s`
     /// and `ln|A|` (the normalisation) stay (`Family::damped`); the centre moves to `(A+M)⁻¹ A s`,
     /// which the kinetic element reads (docs/properties-derivations.md, eq. 30).
-    pub fn damped<T: Real>(&self, m: &SMatrix<T, D, D>) -> Fecg<D, T> {
-        let mut g: Fecg<D, T> = self.cast();
+    pub fn damped<T: Real>(&self, m: &SMatrix<T, D, D>) -> FecgFunction<D, T> {
+        let mut g: FecgFunction<D, T> = self.cast();
         g.a += m;
         if let Some(chol) = g.a.cholesky() {
             g.s = chol.solve(&g.a_s);
@@ -99,14 +99,14 @@ impl Keyed for FecgParams<'_> {
     }
 }
 
-/// The functions of `p`, checked by `Fecg::new`.
-pub fn functions<const D: usize>(p: &FecgParams) -> Result<Vec<Fecg<D>>> {
+/// The functions of `p`, checked by `FecgFunction::new`.
+pub fn functions<const D: usize>(p: &FecgParams) -> Result<Vec<FecgFunction<D>>> {
     let a = p.e.exponents::<D>()?;
     let s = matrices_of::<D, 3>(p.s, p.len(), "centres")?;
-    (0..p.len()).map(|i| Fecg::new(a[i], s[i], p.e.c_a[i], i)).collect()
+    (0..p.len()).map(|i| FecgFunction::new(a[i], s[i], p.e.c_a[i], i)).collect()
 }
 
-impl<const D: usize, T: Real, Ctx> Transform<D, Ctx> for Fecg<D, T> {
+impl<const D: usize, T: Real, Ctx> Transform<D, Ctx> for FecgFunction<D, T> {
     /// `phi(T r)`: `A -> T^T A T`, `s -> T^{-1} s`.
     fn transformed(&self, t: &Mat<D>, _: &Ctx, index: usize) -> Result<Self> {
         let t_inv = t.try_inverse().ok_or_else(|| CoreError::Unsupported("singular symmetry operation".into()))?;
@@ -197,7 +197,7 @@ fn row<const D: usize>(m: &Centres<D>, i: usize) -> [f64; 3] {
 /// Cholesky factor in floating point (possible only for near-singular functions, whose
 /// elements are then NaN and the caller rejects them).
 #[inline]
-pub(crate) fn pair<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>) -> Option<(T, SMatrix<T, D, D>, Centres<D, T>)> {
+pub(crate) fn pair<const D: usize, T: Real>(bra: &FecgFunction<D, T>, ket: &FecgFunction<D, T>) -> Option<(T, SMatrix<T, D, D>, Centres<D, T>)> {
     let (binv, log_det) = inverse_log_det(&(bra.a + ket.a))?;
     let v = bra.a_s + ket.a_s;
     let rbar = mul(&binv, &v);
@@ -218,8 +218,8 @@ pub(crate) struct Kinetic<const D: usize, T: Real> {
 
 #[inline]
 pub(crate) fn kinetic<const D: usize, T: Real>(
-    bra: &Fecg<D, T>,
-    ket: &Fecg<D, T>,
+    bra: &FecgFunction<D, T>,
+    ket: &FecgFunction<D, T>,
     lambda: &Mat<D>,
     binv: &SMatrix<T, D, D>,
     rbar: &Centres<D, T>,
@@ -242,7 +242,7 @@ pub(crate) struct CmShift<T> {
 }
 
 #[inline]
-pub(crate) fn cm_shift<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, m: f64) -> CmShift<T> {
+pub(crate) fn cm_shift<const D: usize, T: Real>(bra: &FecgFunction<D, T>, ket: &FecgFunction<D, T>, m: f64) -> CmShift<T> {
     let (ci, cj) = (bra.c_a, ket.c_a);
     let sum = ci + cj;
     let mut e = [T::zero(); 3];
@@ -273,7 +273,7 @@ pub(crate) fn coulomb_moments<const D: usize, T: Real>(
 }
 
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised floating ECGs.
-pub fn element<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops: &Operators<D>) -> Element<T> {
+pub fn element<const D: usize, T: Real>(bra: &FecgFunction<D, T>, ket: &FecgFunction<D, T>, ops: &Operators<D>) -> Element<T> {
     let Some((s, binv, rbar)) = pair(bra, ket) else { return Element::nan() };
     let t = kinetic(bra, ket, &ops.lambda, &binv, &rbar).tau * s;
     let t_ti = match ops.cm_mass {
@@ -289,7 +289,7 @@ pub fn element<const D: usize, T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops:
 }
 
 /// `<phi_I| N_TI² |phi_J>` (module docs); `mu` = m/m_tot.
-pub fn angular<const D: usize>(bra: &Fecg<D>, ket: &Fecg<D>, mu: &Vector<D>) -> f64 {
+pub fn angular<const D: usize>(bra: &FecgFunction<D>, ket: &FecgFunction<D>, mu: &Vector<D>) -> f64 {
     let Some((s, binv, rbar)) = pair(bra, ket) else { return f64::NAN };
     let ti = bra.a_s - bra.c_a * mu * (mu.transpose() * bra.s);
     let tj = ket.a_s - ket.c_a * mu * (mu.transpose() * ket.s);

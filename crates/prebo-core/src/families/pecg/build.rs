@@ -1,11 +1,11 @@
 //! Symmetrised plain-ECG matrices and candidate rows with the SIMD kernel (`pecg`), parallel
-//! over rows with rayon: the overrides of `Family::matrices` and `Family::rows` for `PlainEcg`.
+//! over rows with rayon: the overrides of `Family::matrices` and `Family::rows` for `Pecg`.
 //!
 //! A symmetrised element is `Σ_P c_P <phi_I| O |P phi_J>` with the Young-operator
 //! coefficients `c_P` (python/prebo/system/symmetry.py) and `P phi_J` represented by the
 //! transformed exponent `P^T A_J P`, precomputed once per function and permutation.
 //!
-//! The builds evaluate one bra against `W` kets at a time with `pecg::lanes`: the images
+//! The builds evaluate one bra against `W` kets at a time with `kernel::lanes`: the images
 //! `P^T A_J P` are stored in structure-of-arrays blocks of `W` functions, and each row is
 //! computed by a function compiled for the best instruction set the CPU has (AVX-512:
 //! `W = 8`, AVX2: `W = 4`, otherwise plain x86-64 / other targets: `W = 4`; `isa`), chosen
@@ -17,7 +17,7 @@
 //! (`row`). Patched into the matrices they give the bits of a full build.
 use rayon::prelude::*;
 
-use super::pecg::{self, bra_lanes, Accumulator, Bra, Ket, KetLanes, Prepared};
+use super::kernel::{self, bra_lanes, Accumulator, Bra, Ket, KetLanes, Prepared};
 use crate::ecg::{Element, Gaussian, Mat, Operators};
 use crate::error::Result;
 use crate::images::{Images, Transform};
@@ -93,9 +93,9 @@ fn row_generic<const D: usize, const W: usize>(
     for (k, acc) in out.iter_mut().enumerate() {
         let base = (first + k - kets.first) * n_ops;
         let mut a = Accumulator::<W>::default();
-        let cm = pecg::cm_terms(bra, &kets.blocks[base], ops);
+        let cm = kernel::cm_terms(bra, &kets.blocks[base], ops);
         for (p, coef) in kets.coef.iter().enumerate() {
-            pecg::lanes::<D, W>(bra, &kets.blocks[base + p], ops, &cm, *coef, &mut a);
+            kernel::lanes::<D, W>(bra, &kets.blocks[base + p], ops, &cm, *coef, &mut a);
         }
         *acc = a;
     }
@@ -114,9 +114,9 @@ fn col_generic<const D: usize, const W: usize>(
     for (k, acc) in out.iter_mut().enumerate() {
         let bra = &bras[first + k];
         let mut a = Accumulator::<W>::default();
-        let cm = pecg::cm_terms(bra, &images[0], ops);
+        let cm = kernel::cm_terms(bra, &images[0], ops);
         for (ket, c) in images.iter().zip(coef) {
-            pecg::lanes::<D, W>(bra, ket, ops, &cm, *c, &mut a);
+            kernel::lanes::<D, W>(bra, ket, ops, &cm, *c, &mut a);
         }
         *acc = a;
     }
@@ -379,5 +379,5 @@ fn lane<const W: usize>(a: &Accumulator<W>, l: usize) -> Element {
 }
 
 #[cfg(test)]
-#[path = "pecg_build_tests.rs"]
+#[path = "build_tests.rs"]
 mod tests;

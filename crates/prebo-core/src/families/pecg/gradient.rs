@@ -9,14 +9,14 @@
 //!   `τ = Tr(Λ A_J) − Tr(Z Λ A_J)` and `dτ = Tr(dA Z Λ Z^T)`;
 //! - `V = Σ_w 2 q_w / sqrt(π c_w) S`, `c_w = w^T B w`, `dc_w = −h_w^T dA h_w` with `h_w = B w`,
 //!   so `d(2 q / sqrt(π c)) = 2 q / sqrt(π c) / (2 c) Tr(dA h h^T)`;
-//! - `T_TI = T − cm S` with the constant `cm` of `pecg::cm_terms`.
+//! - `T_TI = T − cm S` with the constant `cm` of `kernel::cm_terms`.
 //!
 //! Summed over the images with `c_P`, every derivative is `dX = ¾ Tr(A_I^{-1} dA) X + Tr(dA G_X)`
 //! with the symmetric matrices (upper triangles, accumulated per image)
 //! `G_S = −(3/2) Σ c S B`, `G_T = 6 Σ c S (Z Λ Z^T − (3/2) τ B)`,
 //! `G_V = Σ c S (Σ_w 2 q / sqrt(π c_w) / (2 c_w) h_w h_w^T − (3/2) v B)` with `v = V / S`,
 //! contracted once per element and direction. The operations are the same, in the same order,
-//! on every instruction set (`pecg_build`), so every path gives the same bits.
+//! on every instruction set (`build`), so every path gives the same bits.
 // index loops read best in these small dense kernels
 #![allow(clippy::needless_range_loop)]
 use std::f64::consts::PI;
@@ -24,7 +24,7 @@ use std::f64::consts::PI;
 use nalgebra::Cholesky;
 use rayon::prelude::*;
 
-use super::pecg::{self, Accumulator, Bra, KetLanes, Prepared};
+use super::kernel::{self, Accumulator, Bra, KetLanes, Prepared};
 use crate::ecg::{Element, Gaussian, Mat, Operators};
 use crate::images::Images;
 use crate::isa::{isa_available, Isa};
@@ -127,7 +127,7 @@ fn image<const D: usize, const W: usize>(
             }
         }
     }
-    let (b, det, dk) = pecg::inverse::<D, W>(&m);
+    let (b, det, dk) = kernel::inverse::<D, W>(&m);
     // Z = B A_J and τ = Σ_ac Z_ac (A_I Λ)_ac
     let mut z = [[[0.0f64; W]; D]; D];
     let mut tau = [0.0f64; W];
@@ -188,7 +188,7 @@ fn image<const D: usize, const W: usize>(
             }
         }
     }
-    let s = pecg::overlap::<D, W>(bra, ket, &det, &dk);
+    let s = kernel::overlap::<D, W>(bra, ket, &det, &dk);
     let (mut sc, mut tb, mut vb) = ([0.0f64; W], [0.0f64; W], [0.0f64; W]);
     for l in 0..W {
         let t = 6.0 * tau[l] * s[l];
@@ -230,7 +230,7 @@ fn block_generic<const D: usize, const W: usize>(
     ops: &Ops<D>,
     out: &mut [[Element; W]],
 ) {
-    let cm = pecg::cm_terms(&trial.bra, &kets[0], &ops.prep);
+    let cm = kernel::cm_terms(&trial.bra, &kets[0], &ops.prep);
     let zero = [[[0.0f64; W]; D]; D];
     let mut sums = Sums {
         el: Accumulator::<W>::default(),
@@ -390,5 +390,5 @@ fn blocks<const D: usize, const W: usize>(
 }
 
 #[cfg(test)]
-#[path = "pecg_gradient_tests.rs"]
+#[path = "gradient_tests.rs"]
 mod tests;

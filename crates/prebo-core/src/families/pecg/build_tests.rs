@@ -80,7 +80,7 @@ fn matrices_rows_and_elements_agree() {
     for i in 0..nb {
         for j in 0..nb {
             let k = i * nb + j;
-            let e = basis.element(&basis.functions[i.min(j)], i.max(j), |x, y| pecg::element(x, y, &ops));
+            let e = basis.element(&basis.functions[i.min(j)], i.max(j), |x, y| kernel::element(x, y, &ops));
             assert_eq!(
                 [m.s[k], m.t[k], m.t_ti[k], m.v[k]],
                 [e.s, e.t, e.t_ti, e.v],

@@ -1,18 +1,18 @@
 //! The ECG-GVR family (paper eqs. globalvector, ecg-gvr): ECGs times a power of a global vector,
 //! `|v|^{2K} (v_x + i v_y)^N exp(-r^T A r)`, `v = u^T r`.
 //!
-//! - `gvr_series`: the series Ω of the overlap and the formulas on it alone (`omega`,
+//! - `series`: the series Ω of the overlap and the formulas on it alone (`omega`,
 //!   `cm_kinetic`), written once for the generic element and the kernels;
-//! - `gvr_element`: the function (`Gvr`), its context (`GvrOps`: N and the Gauss–Legendre rules)
+//! - `element`: the function (`GvrFunction`), its context (`GvrOps`: N and the Gauss–Legendre rules)
 //!   and the generic element over `f64` or dual numbers (the derivation is in its docs);
-//! - `gvr_kernel`: the same element in `f64` lanes without allocation, and the Coulomb
-//!   τ-quadratures; `gvr_build`: matrices and rows with it, compiled per instruction set;
-//! - `gvr_gradient`: the row gradient by hand-derived reverse mode in the kernel's lanes;
-//! - `gvr_momentum`: `p_g²`, `p_g⁴` and the orbit–orbit operator from the overlap's generating
+//! - `kernel`: the same element in `f64` lanes without allocation, and the Coulomb
+//!   τ-quadratures; `build`: matrices and rows with it, compiled per instruction set;
+//! - `gradient`: the row gradient by hand-derived reverse mode in the kernel's lanes;
+//! - `momentum`: `p_g²`, `p_g⁴` and the orbit–orbit operator from the overlap's generating
 //!   function (eqs. 26–26c);
-//! - `gvr_drachmann`: `V/|r_w|` (eq. 38) from the Coulomb elements of damped functions as
+//! - `drachmann`: `V/|r_w|` (eq. 38) from the Coulomb elements of damped functions as
 //!   rank-one updates of one factorisation;
-//! - `gvr_coulomb` (tests only): the closed form of the Coulomb τ-integral.
+//! - `coulomb` (tests only): the closed form of the Coulomb τ-integral.
 use nalgebra::SMatrix;
 
 use crate::cache::Cache;
@@ -22,21 +22,22 @@ use crate::families::{columns, matrices_of, Column, Directions, Exponents, Famil
 use crate::gradient::{seed_matrix, Dual};
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
-use crate::operators::drachmann::InverseProducts;
+use crate::operators::drachmann::coulomb::InverseProducts;
 use crate::operators::ElementFn;
 use crate::path;
-use gvr_element::{element, functions, Gvr, GvrOps, GvrParams};
+use element::{element, functions, GvrFunction, GvrOps, GvrParams};
 
-pub mod gvr_build;
+pub mod build;
 /// The closed-form Coulomb τ-integral (docs/gvr.md): slower than the quadrature it checks.
 #[cfg(test)]
-mod gvr_coulomb;
-pub mod gvr_drachmann;
-pub mod gvr_element;
-pub mod gvr_gradient;
-pub mod gvr_kernel;
-pub mod gvr_momentum;
-pub mod gvr_series;
+mod coulomb;
+pub mod drachmann;
+pub mod element;
+pub mod gradient;
+pub mod kernel;
+pub mod momentum;
+pub mod series;
+pub mod tau;
 
 /// The ECG-GVR family: parameters `A` (`k x n x n`), `u` (`k x n`), `K`, `c_A` (`GvrParams`); N is
 /// the context's.
@@ -46,11 +47,11 @@ impl<const D: usize> Family<D> for EcgGvr {
     const NAME: &'static str = "ecg-gvr";
     const FIELDS: &'static [Field] =
         &[Field::floats("A"), Field::floats("u"), Field::naturals("K"), Field::floats("c_A")];
-    const MOMENTUM: Momentum<D, Self> = gvr_momentum::momentum::<D>;
-    const ORBIT: ElementFn<D, Self> = gvr_momentum::orbit::<D>;
-    const COULOMB: InverseProducts<D, Self> = gvr_drachmann::inverse_products::<D>;
-    const GRADIENT: ElementFn<D, Self> = gvr_drachmann::gradient_inv_r::<D>;
-    type Function<T: Real> = Gvr<D, T>;
+    const MOMENTUM: Momentum<D, Self> = momentum::momentum::<D>;
+    const ORBIT: ElementFn<D, Self> = momentum::orbit::<D>;
+    const COULOMB: InverseProducts<D, Self> = drachmann::inverse_products::<D>;
+    const GRADIENT: ElementFn<D, Self> = drachmann::gradient_inv_r::<D>;
+    type Function<T: Real> = GvrFunction<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = GvrParams<'a>;
 
@@ -65,24 +66,24 @@ impl<const D: usize> Family<D> for EcgGvr {
         GvrOps::new(ops, n_ang, k_max)
     }
 
-    fn functions(p: &GvrParams, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
+    fn functions(p: &GvrParams, go: &GvrOps<D>) -> Result<Vec<GvrFunction<D>>> {
         functions(p, go)
     }
 
-    fn element<T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
+    fn element<T: Real>(bra: &GvrFunction<D, T>, ket: &GvrFunction<D, T>, go: &GvrOps<D>) -> Element<T> {
         element(bra, ket, go)
     }
 
-    fn cast<T: Real>(f: &Gvr<D>) -> Gvr<D, T> {
+    fn cast<T: Real>(f: &GvrFunction<D>) -> GvrFunction<D, T> {
         f.cast()
     }
 
-    fn seeded<const W: usize>(f: &Gvr<D>, da: &[Mat<D>], du: &[f64], go: &GvrOps<D>) -> Result<Gvr<D, Dual<W>>> {
+    fn seeded<const W: usize>(f: &GvrFunction<D>, da: &[Mat<D>], du: &[f64], go: &GvrOps<D>) -> Result<GvrFunction<D, Dual<W>>> {
         let du: Vec<Vector<D>> = matrices_of::<D, 1>(du, da.len(), "global-vector directions")?;
-        Gvr::new(seed_matrix(&f.a, da), seed_matrix(&f.u, &du), f.k, f.c_a, go, 0)
+        GvrFunction::new(seed_matrix(&f.a, da), seed_matrix(&f.u, &du), f.k, f.c_a, go, 0)
     }
 
-    fn exponent(f: &Gvr<D>) -> &Mat<D> {
+    fn exponent(f: &GvrFunction<D>) -> &Mat<D> {
         &f.a
     }
 
@@ -95,24 +96,24 @@ impl<const D: usize> Family<D> for EcgGvr {
     }
 
     /// The kinetic element with `Λ = g g^T`, cheaper than `MOMENTUM`'s hyper-dual numbers.
-    fn momentum_square(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &Vector<D>) -> f64 {
+    fn momentum_square(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, g: &Vector<D>) -> f64 {
         element(bra, ket, &go.with_kinetic(g * g.transpose())).t
     }
 
-    fn shape(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &Vector<D>) -> Shape {
-        Shape::Polynomial(gvr_element::profile(bra, ket, go, w))
+    fn shape(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, w: &Vector<D>) -> Shape {
+        Shape::Polynomial(element::profile(bra, ket, go, w))
     }
 
-    fn damped<T: Real>(f: &Gvr<D>, m: &SMatrix<T, D, D>) -> Gvr<D, T> {
+    fn damped<T: Real>(f: &GvrFunction<D>, m: &SMatrix<T, D, D>) -> GvrFunction<D, T> {
         f.damped(m)
     }
 
-    /// The f64 kernel (`gvr_build`, `gvr_kernel`).
+    /// The f64 kernel (`build`, `kernel`).
     fn matrices(go: &GvrOps<D>, sym: &Symmetry<D>, basis: &GvrParams) -> Result<Matrices> {
-        gvr_build::matrices(go, sym, basis, best_isa())
+        build::matrices(go, sym, basis, best_isa())
     }
 
-    /// The f64 kernel, oriented as `path::rows` (`gvr_build`).
+    /// The f64 kernel, oriented as `path::rows` (`build`).
     fn rows(
         go: &GvrOps<D>,
         sym: &Symmetry<D>,
@@ -121,10 +122,10 @@ impl<const D: usize> Family<D> for EcgGvr {
         position: Option<usize>,
         cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
-        gvr_build::rows(go, sym, trials, basis, position, best_isa(), cache)
+        build::rows(go, sym, trials, basis, position, best_isa(), cache)
     }
 
-    /// The row by hand-derived reverse mode (`gvr_gradient`); the diagonal, where both sides
+    /// The row by hand-derived reverse mode (`gradient`); the diagonal, where both sides
     /// move, by dual numbers (`path::row_gradient` against no basis).
     fn row_gradient(
         go: &GvrOps<D>,
@@ -134,7 +135,7 @@ impl<const D: usize> Family<D> for EcgGvr {
         basis: &GvrParams,
         cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
-        let row = gvr_gradient::row_gradient(go, sym, trial, dir, basis, cache)?;
+        let row = gradient::row_gradient(go, sym, trial, dir, basis, cache)?;
         let (_, diag) = path::row_gradient::<D, Self>(go, sym, trial, dir, &GvrParams::default(), &Cache::default())?;
         Ok((row, diag))
     }

@@ -7,13 +7,13 @@
 //!     B_α⁻¹ = B⁻¹ − κ b bᵀ,   |B_α| = (1 + αq) |B|,   b = B⁻¹w,  q = wᵀb,  κ = α/(1 + αq),
 //! ```
 //!
-//! and the inputs of the Coulomb element (`gvr_element` module docs) for the pair `w'` move as
+//! and the inputs of the Coulomb element (`element` module docs) for the pair `w'` move as
 //! scalars: `x_α = x − κ(bᵀu_I)²/2`, likewise `y_α`, `z_α = z − κ(bᵀu_I)(bᵀu_J)/2`,
 //! `c'_α = c' − κ(bᵀw')²` and `(B_α⁻¹u_I)·w' = (B⁻¹u_I)·w' − κ(bᵀu_I)(bᵀw')`.
 //!
 //! `<∇φ_I| Λ/|r_w| |∇φ_J>` (`Family::GRADIENT`) needs at each node of eq. (30) the kinetic
 //! elements of `e^{−α r_w²}φ_I` with `φ_J` and of `φ_I` with `e^{−α r_w²}φ_J`. Both have
-//! `B_α = B + αwwᵀ`, so both have its `x, y, z`, `Ω` and its derivatives (`gvr_element` module
+//! `B_α = B + αwwᵀ`, so both have its `x, y, z`, `Ω` and its derivatives (`element` module
 //! docs), and the kinetic element is linear in `W = A_IΛA_J`, `A_JΛu_I` and `A_IΛu_J`: their mean
 //! is one element with `W + (α/2)(w (A_JΛw)ᵀ + (A_IΛw) wᵀ)`, `A_JΛu_I + (α/2)(wᵀΛu_I) w` and
 //! `A_IΛu_J + (α/2)(wᵀΛu_J) w`. The damped overlap `D = S_0(B_α) Ω` and `R = −∂D/∂α` follow
@@ -22,15 +22,15 @@
 //! held close (agreement with the generic path 1.4e-9 against 5.1e-10 at `A + 10⁵ wwᵀ`).
 use std::f64::consts::PI;
 
-use super::gvr_element::{kinetic, log_s0, quadrature, Gvr, GvrOps};
-use super::gvr_series::{cm_kinetic, omega, Coefficients};
+use super::element::{kinetic, log_s0, quadrature, GvrFunction, GvrOps};
+use super::series::{cm_kinetic, omega, Coefficients};
 use super::EcgGvr;
 use crate::ecg::{log_det_cholesky, Mat, Vector};
-use crate::operators::drachmann::{by_damping, kinetic_by_damping};
+use crate::operators::drachmann::{coulomb::by_damping, gradient::kinetic_by_damping};
 
 /// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` for normalised ECG-GVR functions and each Coulomb pair `w'_k`
 /// (bohr⁻², `drachmann::InverseProducts`); NaN where `A_I + A_J` does not factorise.
-pub fn inverse_products<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &Vector<D>, known: &[Option<f64>]) -> Vec<f64> {
+pub fn inverse_products<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, w: &Vector<D>, known: &[Option<f64>]) -> Vec<f64> {
     match damped_inverse(bra, ket, go, w) {
         Some(damped) => by_damping::<D, EcgGvr>(bra, ket, go, w, known, damped),
         None => vec![f64::NAN; go.ops.pairs.len()],
@@ -40,7 +40,7 @@ pub fn inverse_products<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<
 /// `(α, k) ↦ <φ_I| e^{−α r_w²}/|r_w'_k| |φ_J>` for normalised ECG-GVR functions and the Coulomb
 /// pairs `w'_k`, each read off the factorisation of `A_I + A_J` (module docs); None where it does
 /// not factorise.
-pub(crate) fn damped_inverse<'a, const D: usize>(bra: &'a Gvr<D>, ket: &'a Gvr<D>, go: &'a GvrOps<D>, w: &Vector<D>) -> Option<impl Fn(f64, usize) -> f64 + 'a> {
+pub(crate) fn damped_inverse<'a, const D: usize>(bra: &'a GvrFunction<D>, ket: &'a GvrFunction<D>, go: &'a GvrOps<D>, w: &Vector<D>) -> Option<impl Fn(f64, usize) -> f64 + 'a> {
     let chol = (bra.a + ket.a).cholesky()?;
     let (gi, gj, b) = (chol.solve(&bra.u), chol.solve(&ket.u), chol.solve(w));
     let (x, y, z) = (bra.u.dot(&gi) * 0.5, ket.u.dot(&gj) * 0.5, bra.u.dot(&gj) * 0.5);
@@ -66,7 +66,7 @@ pub(crate) fn damped_inverse<'a, const D: usize>(bra: &'a Gvr<D>, ket: &'a Gvr<D
 
 /// `<∇φ_I| Λ/|r_w| |∇φ_J>` for normalised ECG-GVR functions (hartree/bohr; `v = [w]`; module
 /// docs); NaN where `A_I + A_J` or a damped `B_α` does not factorise.
-pub fn gradient_inv_r<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
+pub fn gradient_inv_r<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
     let (w, lambda) = (&v[0], &go.ops.lambda);
     let series = Coefficients::new(bra.k, ket.k, go.n_ang);
     let terms = series.terms();

@@ -29,8 +29,8 @@ use std::ops::{Mul, Sub};
 use nalgebra::{Cholesky, Const, RealField, SMatrix, SVector};
 use num_dual::{Dual64, HyperDual64};
 
-use super::gvr_element::{legendre_rule, log_s0, Gvr, GvrOps};
-use super::gvr_series::{omega, Coefficients};
+use super::element::{legendre_rule, log_s0, GvrFunction, GvrOps};
+use super::series::{omega, Coefficients};
 use crate::ecg::{log_det_cholesky, Vector};
 use crate::scalar::Scalar;
 
@@ -59,8 +59,8 @@ fn dyad<T: Moving, const D: usize>(v: &Vector<D>, w: &Vector<D>, c: T) -> SMatri
 /// series and its scale L at B, and `S_0(B) e^L / (𝒩_I 𝒩_J)`, by which `at`'s ratios become
 /// normalised elements.
 struct Generating<'a, const D: usize> {
-    bra: &'a Gvr<D>,
-    ket: &'a Gvr<D>,
+    bra: &'a GvrFunction<D>,
+    ket: &'a GvrFunction<D>,
     chol: Cholesky<f64, Const<D>>,
     series: Coefficients,
     log_det: f64,
@@ -70,7 +70,7 @@ struct Generating<'a, const D: usize> {
 
 impl<'a, const D: usize> Generating<'a, D> {
     /// None where `A_I + A_J` does not factorise.
-    fn new(bra: &'a Gvr<D>, ket: &'a Gvr<D>, go: &GvrOps<D>) -> Option<Self> {
+    fn new(bra: &'a GvrFunction<D>, ket: &'a GvrFunction<D>, go: &GvrOps<D>) -> Option<Self> {
         let chol = (bra.a + ket.a).cholesky()?;
         let (ci, cj) = (chol.solve(&bra.u), chol.solve(&ket.u));
         let series = Coefficients::new(bra.k, ket.k, go.n_ang);
@@ -99,7 +99,7 @@ impl<'a, const D: usize> Generating<'a, D> {
 
 /// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` for normalised ECG-GVR functions (eq. 26b, with
 /// `h` in D_J and c_J; `Family::MOMENTUM`); NaN where `A_I + A_J` does not factorise.
-pub fn momentum<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &Vector<D>, h: &Vector<D>) -> (f64, f64) {
+pub fn momentum<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, g: &Vector<D>, h: &Vector<D>) -> (f64, f64) {
     let (hi, hj) = (bra.a * g, ket.a * h);
     let (ugi, ugj) = (bra.u.dot(g), ket.u.dot(h));
     let (ci, cj) = (-6.0 * g.dot(&hi), -6.0 * h.dot(&hj));
@@ -127,7 +127,7 @@ pub fn momentum<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, g: &
 /// u_I along A_J h and u_J along A_I g, `y_I·y_J` weights by `−∂_t` along `sym(A_I g, A_J h)` —
 /// and the `r̂r̂` part is the mixed derivative of `r_w·∇_gφ_I` (u_I along w, and `sym(w, A_I g)`)
 /// and `r_w·∇_hφ_J`. The τ-integrand is a polynomial of degree ≤ K_I + K_J + N + 2 in τ².
-pub fn orbit<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
+pub fn orbit<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
     let (w, g, h) = (&v[0], &v[1], &v[2]);
     let Some(gen) = Generating::new(bra, ket, go) else { return f64::NAN };
     let q = w.dot(&gen.chol.solve(w));

@@ -2,7 +2,7 @@
 //! bra, un-transformed) against every basis image, with the derivatives along P directions
 //! `(dA_p, du_p)` of its `A` and `u`. Same layout as `path::row_gradient`'s row.
 //!
-//! # Derivation (notation of `gvr_element` and docs/gvr.md)
+//! # Derivation (notation of `element` and docs/gvr.md)
 //! Every output `O ∈ {S, T, T_TI, V}` of one image is `O = e^{ln S_0 − n_I − n_J} F_O`, where
 //! `F_O` depends on the bra through `x, y, z`, `g_I = B⁻¹u_I`, `g_J = B⁻¹u_J`, `A_I` and `u_I`.
 //! With `M = B⁻¹`, `dM = −M dA M`, `d ln|B| = Tr(M dA)`, and the adjoints `x̄, ȳ, z̄` (of the
@@ -20,27 +20,28 @@
 //! each direction once per symmetrised element; `dn_I` (the bra's normalisation) once per call.
 //!
 //! - `S = e^{...} Ω`: `x̄ = s ω_x` etc. (`s` the element's `scale`, `ω_· = Ω_·/e^L`).
-//! - `T = e^{...} (c_Ω Ω + c_x Ω_x + c_y Ω_y + c_z Ω_z)` (`gvr_element` module docs): `x̄ = s(c_Ω ω_x +
+//! - `T = e^{...} (c_Ω Ω + c_x Ω_x + c_y Ω_y + c_z Ω_z)` (`element` module docs): `x̄ = s(c_Ω ω_x +
 //!   c_x ω_xx + c_y ω_xy + c_z ω_xz)` etc. with Ω's second derivatives (`hessian`); the scalars of
 //!   the `c`'s are bilinear in `g_I, g_J, u_I, A_I` (`kinetic`), and `Tr(A_IΛA_J M)` has the full
 //!   gradient `M A_J Λ A_J M` (explicit `M A_J Λ` plus `−M A_J Λ A_I M` through `M`).
 //! - `T_TI = T − T_cm`: the `c`'s of `cm_kinetic` subtracted, and `c_UI = 1ᵀu_I` adds to `ū`.
 //! - `V = s Σ_w 2q/√(πc) Q(x, y, z, γ_I, γ_J)` with `Q` the τ-integral over `e^L` and its
-//!   partials (`gvr_build::coulomb_partials`): `x̄ = V L_x + s Σ 2q/√(πc) Q_x` (`L_x = (K_I+N/2)/x`),
+//!   partials (`build::coulomb_partials`): `x̄ = V L_x + s Σ 2q/√(πc) Q_x` (`L_x = (K_I+N/2)/x`),
 //!   `γ = g·w/√(2c)` gives `ḡ += γ̄ w/√(2c)`, and `c = wᵀMw`, `dc = −(Mw)ᵀdA(Mw)`, with
 //!   `c̄ = −s 2q/√(πc) Q/(2c) − (γ̄_Iγ_I + γ̄_Jγ_J)/(2c)`.
 //!
 //! The algebra of one image runs on [`MAX_LANES`] symmetry images of a ket at once, structure of
-//! arrays (`lanes`, as `gvr_kernel::elements`; each lane with the bits of the one-image path),
+//! arrays (`lanes`, as `kernel::elements`; each lane with the bits of the one-image path),
 //! compiled per instruction set (`kernel`). The trial's diagonal (both sides move) stays on the
 //! dual-number path (`EcgGvr::row_gradient`).
 use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
-use super::gvr_element::{functions, log_s0, series_coefficients, Gvr, GvrOps, GvrParams};
-use super::gvr_kernel::{derivative_series, dot, integral_partials, inverse_log_det, mat_vec, padded_rule, Ket, Prepared, Side, MAX_LANES, MAX_PAIRS};
-use super::gvr_series::{horner, omega, Coefficients};
+use super::element::{functions, log_s0, series_coefficients, GvrFunction, GvrOps, GvrParams};
+use super::kernel::{dot, inverse_log_det, mat_vec, Ket, Prepared, Side, MAX_LANES, MAX_PAIRS};
+use super::tau::{derivative_series, integral_partials, padded_rule};
+use super::series::{horner, omega, Coefficients};
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Vector};
 use crate::error::Result;
@@ -112,11 +113,11 @@ impl<T: Lane, const D: usize> Adjoint<T, D> {
 }
 
 /// The pair's series: Ω's (`Coefficients`), its second derivatives' (`hessian`), and the
-/// Coulomb quadrature's `ĉ_k`, `(k+1) ĉ_{k+1}` and padded rule (`gvr_kernel::padded_rule`).
+/// Coulomb quadrature's `ĉ_k`, `(k+1) ĉ_{k+1}` and padded rule (`tau::padded_rule`).
 pub(crate) struct Series {
     coef: Coefficients,
     c: Vec<f64>,
-    /// `(k+1) ĉ_{k+1}`, the series of G' (`gvr_kernel::derivative_series`)
+    /// `(k+1) ĉ_{k+1}`, the series of G' (`kernel::derivative_series`)
     dc: Vec<f64>,
     /// `ĉ_k f(K_I−k, K_J−k, N+2k)` from `k = k_0` for the six second derivatives (`hessian`),
     /// with the power of ρ that multiplies each sum
@@ -206,7 +207,7 @@ fn images<const D: usize, const W: usize, T: Lane>(
     let first = [ox, oy, oz];
     let s = scale * om;
 
-    // kinetic (`gvr_element::element`): T/scale = λ ω_z − 4 p2 ω_x − 2 p3 ω_z − 4 p4 ω_y − 2 p5 ω_z
+    // kinetic (`element::element`): T/scale = λ ω_z − 4 p2 ω_x − 2 p3 ω_z − 4 p4 ω_y − 2 p5 ω_z
     //                                    + 12 tr ω + 8 p7 ω_x + 4 p8 ω_z + 8 p9 ω_y
     let lam_uj = &ket.lambda_u;
     let zl = mat_vec(&ket.a, &vector(|i| T::splat(bra.lambda_u[i]))); // A_J Λ u_I
@@ -238,7 +239,7 @@ fn images<const D: usize, const W: usize, T: Lane>(
     let mut adj_t = kin;
     adj_t.xyz = xyz_bar(c_t, first, &hess, scale);
 
-    // T_TI = T − T_cm: T_cm/scale = Σ c_cm · (ω, ω_x, ω_y, ω_z) (`gvr_series::cm_kinetic`)
+    // T_TI = T − T_cm: T_cm/scale = Σ c_cm · (ω, ω_x, ω_y, ω_z) (`series::cm_kinetic`)
     let (t_ti, adj_ti) = match go.ops.cm_mass {
         Some(mt) => {
             let (ci, cj, cui, cuj) = (T::splat(bra.c_a), ket.c_a, T::splat(bra.c_u), ket.c_u);
@@ -304,7 +305,7 @@ fn kinetic<T: Lane, const D: usize>(
 }
 
 /// `V` of `T::L` images and its adjoints (module docs): every pair of every lane in one call of
-/// the quadrature with partials (`gvr_kernel::integral_partials`).
+/// the quadrature with partials (`kernel::integral_partials`).
 #[inline(always)]
 fn coulomb<const D: usize, const W: usize, T: Lane>(
     go: &GvrOps<D>,
@@ -476,9 +477,9 @@ fn kernel<const D: usize>() -> GradientFn<D> {
     plain::gradient::<D>
 }
 
-/// `(G_n, g_n)` of the bra's `n_I = ln <φ|φ>^{1/2}` (`Gvr::new`): with `h = A⁻¹u`,
+/// `(G_n, g_n)` of the bra's `n_I = ln <φ|φ>^{1/2}` (`GvrFunction::new`): with `h = A⁻¹u`,
 /// `x_n = uᵀh/4`, `n_I = −3/4 ln|A| + (K + N/2) ln x_n + const`.
-fn log_norm_gradient<const D: usize>(bra: &Gvr<D>, n_ang: u32) -> Grad<D> {
+fn log_norm_gradient<const D: usize>(bra: &GvrFunction<D>, n_ang: u32) -> Grad<D> {
     let ainv = bra.a.cholesky().expect("a checked function").inverse();
     let h = ainv * bra.u;
     let xn = bra.u.dot(&h) * 0.25;
@@ -487,7 +488,7 @@ fn log_norm_gradient<const D: usize>(bra: &Gvr<D>, n_ang: u32) -> Grad<D> {
 }
 
 /// The row of `EcgGvr::row_gradient` (module docs): the `(1 + P) x nb` row and its derivatives;
-/// the prepared basis kept in `cache` (shared with `gvr_build::rows`).
+/// the prepared basis kept in `cache` (shared with `build::rows`).
 pub fn row_gradient<const D: usize>(
     go: &GvrOps<D>,
     sym: &Symmetry<D>,
@@ -533,5 +534,5 @@ pub fn row_gradient<const D: usize>(
 }
 
 #[cfg(test)]
-#[path = "gvr_gradient_tests.rs"]
+#[path = "gradient_tests.rs"]
 mod tests;

@@ -2,7 +2,7 @@
 //! per element gives the gradients of `S`, `T`, `T_TI` and `V` with respect to the bra's `A_I`
 //! and `s_I`, which are then contracted with every direction `(dA_p, ds_p)`. The same row as
 //! `path::row_gradient` (the dual-number path, kept as the reference and for the diagonal,
-//! `FloatingEcg::row_gradient`).
+//! `Fecg::row_gradient`).
 //!
 //! Notation of `fecg` (module docs, docs/gvr.md "Floating ECGs"): `B = A_I + A_J`,
 //! `v = A_I s_I + A_J s_J`, `r̄ = B⁻¹v`, `d_I = r̄ - s_I`, `d_J = r̄ - s_J`, `W = A_I Λ A_J`,
@@ -26,7 +26,7 @@ use std::f64::consts::PI;
 use nalgebra::Cholesky;
 use rayon::prelude::*;
 
-use super::fecg::{cm_shift, coulomb_factor, coulomb_moments, functions, kinetic, pair, Centres, Fecg, FecgParams};
+use super::kernel::{cm_shift, coulomb_factor, coulomb_moments, functions, kinetic, pair, Centres, FecgFunction, FecgParams};
 use crate::cache::Cache;
 use crate::ecg::{mul, Element, Mat, Operators};
 use crate::error::{CoreError, Result};
@@ -72,7 +72,7 @@ const F1_SERIES: [f64; 11] = {
     a
 };
 
-/// `f = erf(|m|/√c)/|m|` (`fecg::coulomb_factor`) with `∂f/∂(m²)` and `∂f/∂c`. With
+/// `f = erf(|m|/√c)/|m|` (`kernel::coulomb_factor`) with `∂f/∂(m²)` and `∂f/∂c`. With
 /// `f = 2/√(πc) F_0(t)`, `t = m²/c` and the Boys functions `F_0' = -F_1`,
 /// `F_1 = (F_0 - e^{-t})/(2t)`: `∂f/∂(m²) = -2/√(πc) F_1(t)/c`, `∂f/∂c = -e^{-t}/(√π c^{3/2})`.
 /// `F_1` by its series below `t = 0.1`, where the recursion would lose digits to cancellation.
@@ -90,10 +90,10 @@ fn coulomb_partials(m2: f64, c: f64) -> (f64, f64, f64) {
 }
 
 /// Adds `coef <bra|O|ket>` to `e` and `coef` times its gradients (module docs, without the
-/// normalisation's `¾ Tr(A_I⁻¹dA)`) to `g`; the values are those of `fecg::element`, bit for bit.
+/// normalisation's `¾ Tr(A_I⁻¹dA)`) to `g`; the values are those of `kernel::element`, bit for bit.
 fn add_element<const D: usize>(
-    bra: &Fecg<D>,
-    ket: &Fecg<D>,
+    bra: &FecgFunction<D>,
+    ket: &FecgFunction<D>,
     ops: &Operators<D>,
     coef: f64,
     e: &mut Element,
@@ -206,5 +206,5 @@ pub fn row_gradient<const D: usize>(
 }
 
 #[cfg(test)]
-#[path = "fecg_gradient_tests.rs"]
+#[path = "gradient_tests.rs"]
 mod tests;

@@ -6,36 +6,20 @@
 //! `‖A_I⁻¹‖‖dA‖ + (2K_I + N + 1)‖du‖/‖u_I‖` (the relative change of φ_I per unit step).
 use super::*;
 use crate::ecg::Operators;
-use crate::families::gvr::gvr_element::element;
-use crate::families::gvr::EcgGvr;
+use crate::families::ecg_gvr::element::element;
+use crate::families::ecg_gvr::EcgGvr;
 use crate::families::{Exponents, Family};
 use crate::path;
-
-/// xorshift64*: deterministic numbers in [0, 1) without a dependency.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        self.next() * 2.0 - 1.0
-    }
-    fn k(&mut self, k_max: u32) -> u32 {
-        (self.next() * (k_max + 1) as f64) as u32 % (k_max + 1)
-    }
-}
+use crate::test_support::Rng;
 
 fn spd<const D: usize>(rng: &mut Rng, scale: f64) -> Mat<D> {
-    let l = Mat::<D>::from_fn(|i, j| if j <= i { rng.normal() * scale } else { 0.0 });
+    let l = Mat::<D>::from_fn(|i, j| if j <= i { rng.signed() * scale } else { 0.0 });
     l * l.transpose() + Mat::<D>::identity() * 0.05
 }
 
 /// Symmetric Λ, every pair `e_i − e_j` and one dense `w`, positive charges; `cm_mass` or none.
 fn operators<const D: usize>(rng: &mut Rng, cm: bool) -> Operators<D> {
-    let b = Mat::<D>::from_fn(|_, _| rng.normal());
+    let b = Mat::<D>::from_fn(|_, _| rng.signed());
     let mut pairs = Vec::new();
     for i in 0..D {
         for j in i + 1..D {
@@ -43,7 +27,7 @@ fn operators<const D: usize>(rng: &mut Rng, cm: bool) -> Operators<D> {
             pairs.push((w, 0.5 + 1.5 * rng.next()));
         }
     }
-    pairs.push((Vector::<D>::from_fn(|_, _| rng.normal()), 0.5 + rng.next()));
+    pairs.push((Vector::<D>::from_fn(|_, _| rng.signed()), 0.5 + rng.next()));
     Operators { lambda: b * b.transpose() * 0.1 + Mat::<D>::identity() * 0.01, pairs, cm_mass: cm.then_some(3.5) }
 }
 
@@ -63,7 +47,7 @@ impl Flat {
             let a = spd::<D>(rng, spread);
             f.a.extend(a.transpose().iter());
             f.c_a.push(0.2 + rng.next());
-            f.v.extend((0..D).map(|_| rng.normal()));
+            f.v.extend((0..D).map(|_| rng.signed()));
         }
         f
     }
@@ -87,9 +71,9 @@ fn symmetry<const D: usize>(rng: &mut Rng) -> Vec<(Mat<D>, f64)> {
         let p = |k: usize| if k < 2 { 1 - k } else { k };
         f64::from(p(i) == j)
     });
-    let mut near = || (Mat::<D>::identity() + Mat::<D>::from_fn(|_, _| 0.3 * rng.normal()), 0.5 * rng.normal());
+    let mut near = || (Mat::<D>::identity() + Mat::<D>::from_fn(|_, _| 0.3 * rng.signed()), 0.5 * rng.signed());
     let maps = [near(), near(), near(), near()];
-    let c = rng.normal();
+    let c = rng.signed();
     [(Mat::identity(), 1.0), (swap, c)].into_iter().chain(maps).collect()
 }
 
@@ -97,10 +81,10 @@ fn symmetry<const D: usize>(rng: &mut Rng) -> Vec<(Mat<D>, f64)> {
 /// `A` through its Cholesky factor, i.e. its lower triangle), du alone, and both.
 fn directions<const D: usize>(rng: &mut Rng) -> (Vec<f64>, Vec<f64>) {
     let sym = |rng: &mut Rng| {
-        let m = Mat::<D>::from_fn(|_, _| rng.normal());
+        let m = Mat::<D>::from_fn(|_, _| rng.signed());
         (m + m.transpose()) * 0.5
     };
-    let vec = |rng: &mut Rng| Vector::<D>::from_fn(|_, _| rng.normal());
+    let vec = |rng: &mut Rng| Vector::<D>::from_fn(|_, _| rng.signed());
     let dirs = [
         (sym(rng), Vector::<D>::zeros()),
         (Mat::<D>::zeros(), vec(rng)),
@@ -152,9 +136,9 @@ fn against_dual_path<const D: usize>() {
             let ops = operators::<D>(&mut rng, cm);
             let go = GvrOps::new(ops, n_ang, 40).unwrap();
             let sym = symmetry::<D>(&mut rng);
-            let k_trial = [0, 40, rng.k(40)][n_ang as usize];
+            let k_trial = [0, 40, rng.natural(40)][n_ang as usize];
             let trial = Flat::random::<D>(&mut rng, &[k_trial]);
-            let ks: Vec<u32> = [0, 1, 40].into_iter().chain((0..4).map(|_| rng.k(40))).collect();
+            let ks: Vec<u32> = [0, 1, 40].into_iter().chain((0..4).map(|_| rng.natural(40))).collect();
             let basis = Flat::random::<D>(&mut rng, &ks);
             let dir = directions::<D>(&mut rng);
             let d = Directions { a: &dir.0, v: &dir.1 };
@@ -234,7 +218,7 @@ fn images_in_lanes_have_the_bits_of_one_by_one() {
     let mut rng = Rng(17);
     let go = GvrOps::new(operators::<D>(&mut rng, true), 1, 40).unwrap();
     let sym = symmetry::<D>(&mut rng);
-    let k = rng.k(40);
+    let k = rng.natural(40);
     let trial = Flat::random::<D>(&mut rng, &[k]);
     let basis = Flat::random::<D>(&mut rng, &[0, 7, 40]);
     let bra = &Side::new(&go, &sym, &trial.params()).unwrap().functions[0];

@@ -1,21 +1,13 @@
-//! The f64 kernel against `gvr_element::element` (the generic path), the same bits on every instruction
+//! The f64 kernel against `element::element` (the generic path), the same bits on every instruction
 //! set, and rows patched into matrices with the bits of a full build.
 use super::*;
 use crate::ecg::{Mat, Operators, Vector};
-use crate::families::gvr::gvr_kernel;
-use crate::families::gvr::EcgGvr;
+use crate::families::ecg_gvr::kernel;
+use crate::families::ecg_gvr::EcgGvr;
 use crate::families::{Exponents, Family};
 use crate::isa::best_isa;
 use crate::path;
-
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-}
+use crate::test_support::Rng;
 
 /// Flat parameters of `nb` random functions: `A = L Lᵀ + 0.05`, `u`, K in `0..=k_max`, `c_A`.
 struct Basis {
@@ -29,12 +21,12 @@ impl Basis {
     fn random<const D: usize>(rng: &mut Rng, nb: usize, k_max: u32) -> Self {
         let mut b = Basis { a: vec![], c_a: vec![], u: vec![], k: vec![] };
         for _ in 0..nb {
-            let l = Mat::<D>::from_fn(|r, c| if c <= r { rng.next() } else { 0.0 });
+            let l = Mat::<D>::from_fn(|r, c| if c <= r { rng.signed() } else { 0.0 });
             let a = l * l.transpose() + Mat::<D>::identity() * 0.05;
             b.a.extend(a.transpose().iter());
-            b.u.extend((0..D).map(|_| rng.next()));
-            b.c_a.push(0.5 + rng.next().abs());
-            b.k.push(((rng.next().abs() * (k_max + 1) as f64) as u32).min(k_max));
+            b.u.extend((0..D).map(|_| rng.signed()));
+            b.c_a.push(0.5 + rng.signed().abs());
+            b.k.push(((rng.signed().abs() * (k_max + 1) as f64) as u32).min(k_max));
         }
         b
     }
@@ -71,7 +63,7 @@ fn system<const D: usize>(rng: &mut Rng, cm: bool) -> (Vec<(Mat<D>, f64)>, Opera
         sym.push((perm(&swap23), 0.6));
         sym.push((perm(&both), -0.4));
     }
-    let masses: Vec<f64> = (0..D).map(|i| if i < D / 2 { 1836.15 } else { 1.0 + 0.3 * rng.next().abs() }).collect();
+    let masses: Vec<f64> = (0..D).map(|i| if i < D / 2 { 1836.15 } else { 1.0 + 0.3 * rng.signed().abs() }).collect();
     let q: Vec<f64> = (0..D).map(|i| if i < D / 2 { 1.0 } else { -1.0 }).collect();
     let mut pairs = Vec::new();
     for i in 0..D {
@@ -184,8 +176,8 @@ fn rows_patched_into_matrices_give_the_full_build() {
     }
 }
 
-/// Symmetry images in lanes (`gvr_kernel::symmetrised`, four at a time, the rest one by one)
-/// against the images one by one (`gvr_kernel::element`), bit for bit: one, four and six
+/// Symmetry images in lanes (`kernel::symmetrised`, four at a time, the rest one by one)
+/// against the images one by one (`kernel::element`), bit for bit: one, four and six
 /// images, and four where one image's `A_I + A_J` is not positive definite (every lane again
 /// one by one, that image's element NaN).
 #[test]
@@ -204,9 +196,9 @@ fn images_in_lanes_have_the_bits_of_one_by_one() {
         for (bra, (ket, coef)) in side.functions.iter().zip(side.images.iter().zip(std::iter::repeat(&side.coef))) {
             let mut one_by_one = Element::zero();
             for (k, c) in ket.iter().zip(coef) {
-                one_by_one += (*c, gvr_kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass));
+                one_by_one += (*c, kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass));
             }
-            let lanes = gvr_kernel::symmetrised::<4, 4>(bra, ket, coef, &table, &pairs, go.ops.cm_mass);
+            let lanes = kernel::symmetrised::<4, 4>(bra, ket, coef, &table, &pairs, go.ops.cm_mass);
             assert_eq!(bits(lanes), bits(one_by_one), "{images} images");
         }
     }
@@ -215,12 +207,12 @@ fn images_in_lanes_have_the_bits_of_one_by_one() {
     images[2].a = std::array::from_fn(|i| std::array::from_fn(|j| -2.0 * side.functions[0].a[i][j]));
     let bra = &side.functions[0];
     let each: Vec<Element> =
-        images.iter().map(|k| gvr_kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass)).collect();
+        images.iter().map(|k| kernel::element::<4, 4>(bra, k, &table, &pairs, go.ops.cm_mass)).collect();
     assert!(each[2].s.is_nan() && each.iter().enumerate().all(|(i, e)| i == 2 || e.s.is_finite()));
     let mut one_by_one = Element::zero();
     for (e, c) in each.into_iter().zip(&side.coef) {
         one_by_one += (*c, e);
     }
-    let lanes = gvr_kernel::symmetrised::<4, 4>(bra, &images, &side.coef, &table, &pairs, go.ops.cm_mass);
+    let lanes = kernel::symmetrised::<4, 4>(bra, &images, &side.coef, &table, &pairs, go.ops.cm_mass);
     assert_eq!(bits(lanes), bits(one_by_one));
 }

@@ -1,9 +1,9 @@
 //! The floating-ECG family (paper section FECG): ECGs with centres,
 //! `exp(-(r - s)^T (A ⊗ I_3) (r - s))`.
 //!
-//! - `fecg`: the function (`Fecg`), the generic element over `f64` or dual numbers (the formulas
+//! - `kernel`: the function (`FecgFunction`), the generic element over `f64` or dual numbers (the formulas
 //!   are in its docs) and `<N_TI²>` (`angular`);
-//! - `fecg_gradient`: the row gradient by hand-derived derivatives.
+//! - `gradient`: the row gradient by hand-derived derivatives.
 //!
 //! Matrices and rows come from the generic path (`path`).
 use nalgebra::SMatrix;
@@ -15,20 +15,20 @@ use crate::families::{columns, matrices_of, Angular, Column, Directions, Exponen
 use crate::gradient::{seed_matrix, Dual};
 use crate::matrices::Matrices;
 use crate::path;
-use fecg::{element, functions, pair, Centres, Fecg, FecgParams};
+use kernel::{element, functions, pair, Centres, FecgFunction, FecgParams};
 
-pub mod fecg;
-pub mod fecg_gradient;
+pub mod gradient;
+pub mod kernel;
 
 /// The floating-ECG family: parameters `A` (`k x n x n`), centres `s` (`k x n x 3`), `c_A`
 /// (`FecgParams`).
-pub struct FloatingEcg;
+pub struct Fecg;
 
-impl<const D: usize> Family<D> for FloatingEcg {
+impl<const D: usize> Family<D> for Fecg {
     const NAME: &'static str = "fecg";
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("s"), Field::floats("c_A")];
-    const ANGULAR: Option<Angular<D, Self>> = Some(fecg::angular::<D>);
-    type Function<T: Real> = Fecg<D, T>;
+    const ANGULAR: Option<Angular<D, Self>> = Some(kernel::angular::<D>);
+    type Function<T: Real> = FecgFunction<D, T>;
     type Context = Operators<D>;
     type Params<'a> = FecgParams<'a>;
 
@@ -41,32 +41,32 @@ impl<const D: usize> Family<D> for FloatingEcg {
         Ok(ops)
     }
 
-    fn functions(p: &FecgParams, _: &Operators<D>) -> Result<Vec<Fecg<D>>> {
+    fn functions(p: &FecgParams, _: &Operators<D>) -> Result<Vec<FecgFunction<D>>> {
         functions(p)
     }
 
-    fn element<T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, ops: &Operators<D>) -> Element<T> {
+    fn element<T: Real>(bra: &FecgFunction<D, T>, ket: &FecgFunction<D, T>, ops: &Operators<D>) -> Element<T> {
         element(bra, ket, ops)
     }
 
-    fn overlap<T: Real>(bra: &Fecg<D, T>, ket: &Fecg<D, T>, _: &Operators<D>) -> T {
+    fn overlap<T: Real>(bra: &FecgFunction<D, T>, ket: &FecgFunction<D, T>, _: &Operators<D>) -> T {
         pair(bra, ket).map_or(re(f64::NAN), |(s, _, _)| s)
     }
 
-    fn cast<T: Real>(f: &Fecg<D>) -> Fecg<D, T> {
+    fn cast<T: Real>(f: &FecgFunction<D>) -> FecgFunction<D, T> {
         f.cast()
     }
 
-    fn seeded<const W: usize>(f: &Fecg<D>, da: &[Mat<D>], ds: &[f64], _: &Operators<D>) -> Result<Fecg<D, Dual<W>>> {
+    fn seeded<const W: usize>(f: &FecgFunction<D>, da: &[Mat<D>], ds: &[f64], _: &Operators<D>) -> Result<FecgFunction<D, Dual<W>>> {
         let ds: Vec<Centres<D>> = matrices_of::<D, 3>(ds, da.len(), "centre directions")?;
-        Fecg::new(seed_matrix(&f.a, da), seed_matrix(&f.s, &ds), f.c_a, 0)
+        FecgFunction::new(seed_matrix(&f.a, da), seed_matrix(&f.s, &ds), f.c_a, 0)
     }
 
-    fn exponent(f: &Fecg<D>) -> &Mat<D> {
+    fn exponent(f: &FecgFunction<D>) -> &Mat<D> {
         &f.a
     }
 
-    fn centres(f: &Fecg<D>) -> Centres<D> {
+    fn centres(f: &FecgFunction<D>) -> Centres<D> {
         f.s
     }
 
@@ -78,11 +78,11 @@ impl<const D: usize> Family<D> for FloatingEcg {
         Operators { pairs: vec![], ..ctx.clone() }
     }
 
-    fn shape(_bra: &Fecg<D>, _ket: &Fecg<D>, _ctx: &Operators<D>, _w: &Vector<D>) -> Shape {
+    fn shape(_bra: &FecgFunction<D>, _ket: &FecgFunction<D>, _ctx: &Operators<D>, _w: &Vector<D>) -> Shape {
         Shape::Exponential
     }
 
-    fn damped<T: Real>(f: &Fecg<D>, m: &SMatrix<T, D, D>) -> Fecg<D, T> {
+    fn damped<T: Real>(f: &FecgFunction<D>, m: &SMatrix<T, D, D>) -> FecgFunction<D, T> {
         f.damped(m)
     }
 
@@ -101,7 +101,7 @@ impl<const D: usize> Family<D> for FloatingEcg {
         path::rows::<D, Self>(ops, sym, trials, basis, position, cache)
     }
 
-    /// The row from the hand-derived gradient (`fecg_gradient`); the diagonal, where both sides
+    /// The row from the hand-derived gradient (`gradient`); the diagonal, where both sides
     /// move, by dual numbers (`path::row_gradient` against no basis).
     fn row_gradient(
         ops: &Operators<D>,
@@ -111,7 +111,7 @@ impl<const D: usize> Family<D> for FloatingEcg {
         basis: &FecgParams,
         cache: &Cache,
     ) -> Result<(Matrices, Vec<Element>)> {
-        let row = fecg_gradient::row_gradient(ops, sym, trial, dir, basis, cache)?;
+        let row = gradient::row_gradient(ops, sym, trial, dir, basis, cache)?;
         let (_, diag) = path::row_gradient::<D, Self>(ops, sym, trial, dir, &FecgParams::default(), &Cache::default())?;
         Ok((row, diag))
     }

@@ -1,4 +1,4 @@
-//! Symmetrised ECG-GVR matrices and oriented rows with the f64 kernel (`gvr_kernel`), in
+//! Symmetrised ECG-GVR matrices and oriented rows with the f64 kernel (`kernel`), in
 //! parallel with rayon: the overrides of `Family::matrices` and `Family::rows` for `EcgGvr`.
 //!
 //! The functions and their symmetry images are built as by `path` (`path::images`), prepared
@@ -9,10 +9,11 @@
 //! AVX-512, 4 otherwise) and chosen by `isa::best_isa`; all give the same bits.
 use rayon::prelude::*;
 
-use super::gvr_element::{GvrOps, GvrParams};
-use super::gvr_kernel::{symmetrised, Pairs, Prepared, Side, Table};
+use super::element::{GvrOps, GvrParams};
+use super::kernel::{symmetrised, Pairs, Prepared, Side};
+use super::tau::Table;
 #[cfg(test)]
-use super::{gvr_kernel::{derivative_series, integral_partials, padded_rule}, gvr_series::Coefficients};
+use super::{series::Coefficients, tau::{derivative_series, integral_partials, padded_rule}};
 use crate::assemble;
 use crate::cache::Cache;
 use crate::ecg::Element;
@@ -84,7 +85,7 @@ fn kernel<const D: usize>(isa: Isa) -> ElementFn<D> {
     plain::element::<D>
 }
 
-/// The Coulomb τ-integrals with their partial derivatives (`gvr_kernel::integral_partials`) for
+/// The Coulomb τ-integrals with their partial derivatives (`kernel::integral_partials`) for
 /// each of `inputs`, on the best instruction set (`isa::best_isa`, read once per process): the
 /// tests' entry point (the row gradient calls them inside its kernel).
 #[cfg(test)]
@@ -128,10 +129,10 @@ pub(crate) fn partials_with(
 }
 
 /// The Coulomb τ-integral `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ / e^L` of one pair
-/// (K_I, K_J) for each of `inputs` = `[x, y, z, γ_I, γ_J]` (`gvr_element::quadrature`), with its partial
-/// derivatives with respect to the five inputs (the maths of `gvr_element::quadrature_partials`), into
-/// `out`: nodes in lanes of the f64 kernel (`gvr_kernel::integral_partials`, `partials`).
-/// The tests' entry point; the row gradient keeps its rules per pair (`gvr_gradient`).
+/// (K_I, K_J) for each of `inputs` = `[x, y, z, γ_I, γ_J]` (`element::quadrature`), with its partial
+/// derivatives with respect to the five inputs (the maths of `element::quadrature_partials`), into
+/// `out`: nodes in lanes of the f64 kernel (`kernel::integral_partials`, `partials`).
+/// The tests' entry point; the row gradient keeps its rules per pair (`gradient`).
 #[cfg(test)]
 pub(crate) fn coulomb_partials<const D: usize>(
     go: &GvrOps<D>,
@@ -211,5 +212,5 @@ pub fn rows<const D: usize>(
 }
 
 #[cfg(test)]
-#[path = "gvr_build_tests.rs"]
+#[path = "build_tests.rs"]
 mod tests;

@@ -35,7 +35,7 @@
 //!
 //! CM elimination (paper eq. GENCONSTR:ecggvr, generalised to c_U ≠ 0 and unequal c_A):
 //! the same expression with `Λ = 1 1^T/(2 m_tot)`; with `A 1 = c_A m/m_tot`, `1^T u = c_U`,
-//! `s = c_I + c_J` it collapses to the closed form of `gvr_series::cm_kinetic`.
+//! `s = c_I + c_J` it collapses to the closed form of `series::cm_kinetic`.
 //!
 //! Coulomb `<1/|w^T r|>`: `1/r = (2/√π)∫exp(-t²r²)dt` and `τ² = t²c/(1+t²c)`, `c = w^T B^{-1} w`:
 //!
@@ -52,7 +52,7 @@ use std::ops::{Mul, Sub};
 
 use nalgebra::{Cholesky, SMatrix, SVector};
 
-use super::gvr_series::{cm_kinetic, horner, omega, series_at_one, Coefficients};
+use super::series::{cm_kinetic, horner, omega, series_at_one, Coefficients};
 use crate::ecg::{chain, dot_f, inverse_log_det, log_det_cholesky, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
 use crate::cache::Keyed;
@@ -62,7 +62,7 @@ use crate::images::Transform;
 /// One ECG-GVR function: exponent `A`, global vector `u`, power `K`, and its CM parameters.
 /// `T` is `f64`, or a dual number when derivatives with respect to `A` and `u` are wanted.
 #[derive(Clone, Debug)]
-pub struct Gvr<const D: usize, T: Real = f64> {
+pub struct GvrFunction<const D: usize, T: Real = f64> {
     pub a: SMatrix<T, D, D>,
     pub u: SVector<T, D>,
     pub k: u32,
@@ -120,7 +120,7 @@ impl<const D: usize> GvrOps<D> {
     }
 }
 
-impl<const D: usize, T: Real> Gvr<D, T> {
+impl<const D: usize, T: Real> GvrFunction<D, T> {
     /// Checks `A` (positive definite), `u` (non-zero) and `K` (within the prepared range).
     pub fn new(a: SMatrix<T, D, D>, u: SVector<T, D>, k: u32, c_a: f64, go: &GvrOps<D>, index: usize) -> Result<Self> {
         if k > go.k_max() {
@@ -141,11 +141,11 @@ impl<const D: usize, T: Real> Gvr<D, T> {
     }
 
     /// This function with dual-number entries of zero derivative.
-    pub fn cast<S: Real>(&self) -> Gvr<D, S>
+    pub fn cast<S: Real>(&self) -> GvrFunction<D, S>
     where
         T: Into<S>,
     {
-        Gvr {
+        GvrFunction {
             a: self.a.map(Into::into),
             u: self.u.map(Into::into),
             k: self.k,
@@ -156,11 +156,11 @@ impl<const D: usize, T: Real> Gvr<D, T> {
     }
 }
 
-impl<const D: usize> Gvr<D> {
+impl<const D: usize> GvrFunction<D> {
     /// `phi(r) exp(-r^T (M ⊗ I_3) r)` with the normalisation constants of `phi` kept
     /// (`Family::damped`): `A → A + M`.
-    pub fn damped<T: Real>(&self, m: &SMatrix<T, D, D>) -> Gvr<D, T> {
-        let mut g: Gvr<D, T> = self.cast();
+    pub fn damped<T: Real>(&self, m: &SMatrix<T, D, D>) -> GvrFunction<D, T> {
+        let mut g: GvrFunction<D, T> = self.cast();
         g.a += m;
         g
     }
@@ -189,12 +189,12 @@ impl Keyed for GvrParams<'_> {
     }
 }
 
-/// The functions of `p`, checked by `Gvr::new`.
-pub fn functions<const D: usize>(p: &GvrParams, go: &GvrOps<D>) -> Result<Vec<Gvr<D>>> {
+/// The functions of `p`, checked by `GvrFunction::new`.
+pub fn functions<const D: usize>(p: &GvrParams, go: &GvrOps<D>) -> Result<Vec<GvrFunction<D>>> {
     let a = p.e.exponents::<D>()?;
     let u = matrices_of::<D, 1>(p.u, p.len(), "global vectors")?;
     check(p.k.len(), p.len(), "powers K")?;
-    (0..p.len()).map(|i| Gvr::new(a[i], u[i], p.k[i], p.e.c_a[i], go, i)).collect()
+    (0..p.len()).map(|i| GvrFunction::new(a[i], u[i], p.k[i], p.e.c_a[i], go, i)).collect()
 }
 
 /// `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ / e^L` (module docs) for the inputs
@@ -268,7 +268,7 @@ pub(crate) fn log_s0<T: Sub<f64, Output = T> + Mul<f64, Output = T>, const D: us
 }
 
 /// `<phi_I| 1, T, V |phi_J>` for one pair of normalised ECG-GVR functions.
-pub fn element<const D: usize, T: Real>(bra: &Gvr<D, T>, ket: &Gvr<D, T>, go: &GvrOps<D>) -> Element<T> {
+pub fn element<const D: usize, T: Real>(bra: &GvrFunction<D, T>, ket: &GvrFunction<D, T>, go: &GvrOps<D>) -> Element<T> {
     let ops = &go.ops;
     let n = go.n_ang;
     // A_I + A_J is positive definite, but for near-singular functions its factorisation can
@@ -340,7 +340,7 @@ pub(crate) fn kinetic<T: Real, const D: usize>(lam: T, v: [&SVector<T, D>; 4], w
 /// Coulomb element: `G = S_0 Ω(x' + vγ_I², y' + vγ_J², z' + vγ_Iγ_J)`, `x' = x − γ_I²`,
 /// `y' = y − γ_J²`, `z' = z − γ_Iγ_J` (the covariances conditioned on `r_w = 0`), expanded in v
 /// term by term of Ω scaled by `x`, `y`, `√(xy)` as `omega` scales it.
-pub fn profile<const D: usize>(bra: &Gvr<D>, ket: &Gvr<D>, go: &GvrOps<D>, w: &Vector<D>) -> Vec<f64> {
+pub fn profile<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, w: &Vector<D>) -> Vec<f64> {
     let n = go.n_ang;
     let Some((binv, log_det)) = inverse_log_det(&(bra.a + ket.a)) else {
         return vec![f64::NAN; (bra.k + ket.k + n) as usize + 1];
@@ -392,7 +392,7 @@ fn times(a: &mut Vec<f64>, b: &[f64]) {
     }
 }
 
-impl<const D: usize, T: Real> Transform<D, GvrOps<D>> for Gvr<D, T> {
+impl<const D: usize, T: Real> Transform<D, GvrOps<D>> for GvrFunction<D, T> {
     /// `phi(T r)`: `A -> T^T A T`, `u -> T^T u`.
     fn transformed(&self, t: &Mat<D>, go: &GvrOps<D>, index: usize) -> Result<Self> {
         let t: SMatrix<T, D, D> = t.map(re);
@@ -436,8 +436,8 @@ pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::families::gvr::gvr_build::{self, coulomb_partials};
-    use crate::families::gvr::gvr_kernel::{derivative_series, padded_rule};
+    use crate::families::ecg_gvr::build::{self, coulomb_partials};
+    use crate::families::ecg_gvr::tau::{derivative_series, padded_rule};
     use crate::isa::Isa;
 
     #[test]
@@ -524,7 +524,7 @@ mod tests {
                 let (tau2, weight) = padded_rule(rule);
                 for isa in [Isa::Plain, Isa::Avx2, Isa::Avx512] {
                     let mut o = vec![(0.0, [0.0; 5]); inputs.len()];
-                    gvr_build::partials_with(isa, (&series.c, &derivative_series(&series.c)), (ki, kj, n), &tau2, &weight, &inputs, &mut o);
+                    build::partials_with(isa, (&series.c, &derivative_series(&series.c)), (ki, kj, n), &tau2, &weight, &inputs, &mut o);
                     assert_eq!(o, out, "{isa:?}");
                 }
             }

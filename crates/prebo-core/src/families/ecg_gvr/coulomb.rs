@@ -1,6 +1,6 @@
 //! Closed form of the ECG-GVR Coulomb τ-integral (docs/gvr.md, "Coulomb: closed form").
 //!
-//! `gvr_element` reduces `<φ_I| 1/|wᵀr| |φ_J>` to `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ`.
+//! `element` reduces `<φ_I| 1/|wᵀr| |φ_J>` to `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ`.
 //! With `t = τ²`, `s = 1 − t`, the argument is the convex combination `s P + t P'` of
 //! `P = (x, y, z)` and `P' = (x − γ_I², y − γ_J², z − γ_Iγ_J)` (the covariances of `a`, `b` given
 //! `wᵀr`). `Ω` is homogeneous of degree `M = K_I + K_J + N`, so
@@ -15,9 +15,9 @@
 //! Σ_k ĉ_k (XY)^{m−k} (Z²)^k`, `m = min(K_I, K_J)`, with `X = s x + t x'` etc. linear forms:
 //! Horner in `k` over polynomials in `(s, t)`. `X, Y` and `XY` have non-negative coefficients;
 //! after the sign flip `z → −z` (`Ω(x, y, −z) = (−1)^N Ω`) so that `z ≥ 0`, only a negative
-//! `z'` brings signs into `Z`. Like `gvr_element::quadrature` the result is divided by
+//! `z'` brings signs into `Z`. Like `element::quadrature` the result is divided by
 //! `e^L = x^{K_I+N/2} y^{K_J+N/2}`: `P` and `P'` enter scaled by `(1/x, 1/y, 1/√(xy))`.
-use super::gvr_element::{series_coefficients, GvrOps};
+use super::element::{series_coefficients, GvrOps};
 
 /// Scratch length kept on the stack (`M + 3 ≤ STACK`, K up to about 45); larger `M` use the heap.
 const STACK: usize = 96;
@@ -27,7 +27,7 @@ pub struct ClosedForm {
     ki: u32,
     kj: u32,
     n: u32,
-    /// `ĉ_k`, k = 0..=min(K_I, K_J) (`gvr_series::Coefficients`)
+    /// `ĉ_k`, k = 0..=min(K_I, K_J) (`series::Coefficients`)
     c: Vec<f64>,
     /// `β_j`, j = 0..=M
     beta: Vec<f64>,
@@ -55,7 +55,7 @@ impl ClosedForm {
     }
 
     /// `∫_0^1 Ω(x − τ²γ_I², y − τ²γ_J², z − τ²γ_Iγ_J) dτ / e^L` for the inputs `[x, y, z, γ_I, γ_J]`,
-    /// the value of `gvr_build::coulomb_partials`.
+    /// the value of `build::coulomb_partials`.
     pub fn integral(&self, inputs: [f64; 5]) -> f64 {
         let len = self.beta.len() + 2;
         if len <= STACK {
@@ -130,7 +130,7 @@ fn times_quadratic(e: &mut [f64], d: usize, q: [f64; 3]) {
     e[0] *= q[0];
 }
 
-/// The closed form of `gvr_build::coulomb_partials`'s value for each of `inputs`, into `out`.
+/// The closed form of `build::coulomb_partials`'s value for each of `inputs`, into `out`.
 pub fn coulomb_values<const D: usize>(go: &GvrOps<D>, ki: u32, kj: u32, inputs: &[[f64; 5]], out: &mut [f64]) {
     let form = ClosedForm::new(go, ki, kj);
     for (x, o) in inputs.iter().zip(out.iter_mut()) {
@@ -139,5 +139,5 @@ pub fn coulomb_values<const D: usize>(go: &GvrOps<D>, ki: u32, kj: u32, inputs: 
 }
 
 #[cfg(test)]
-#[path = "gvr_coulomb_tests.rs"]
+#[path = "coulomb_tests.rs"]
 mod tests;
