@@ -1,6 +1,6 @@
 //! The engine: one basis family in one coordinate representation, with every build the
 //! binding offers. Flat row-major arrays in and out, a basis as the arrays of its family's
-//! parameter tuple (`families::Column`, read by `Family::params`); the coordinate dimension `n`
+//! parameter tuple (`params::Column`, read by `Family::params`); the coordinate dimension `n`
 //! and the family are dispatched once per call to the const-generic, family-generic builds.
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Vector, MAX_DIM};
@@ -8,9 +8,11 @@ use crate::error::{CoreError, Result};
 use crate::families::fecg::Fecg;
 use crate::families::ecg_gvr::EcgGvr;
 use crate::families::pecg::Pecg;
-use crate::families::{check, Column, Directions, Family, Field, Parameters};
+use crate::families::Family;
+use crate::params::{check, Column, Directions, Field, Parameters};
 use crate::matrices::Matrices;
-use crate::operators::{self, density};
+use crate::operators::{density, Specialised};
+use crate::registry;
 use crate::path;
 
 /// The basis families.
@@ -37,12 +39,12 @@ impl Kind {
         }
     }
 
-    /// The registered operators the family evaluates (`operators::derived`).
+    /// The registered operators the family evaluates (`registry::derived`).
     pub fn operators(self) -> Vec<&'static str> {
         match self {
-            Kind::Pecg => operators::derived::<Pecg>(),
-            Kind::EcgGvr => operators::derived::<EcgGvr>(),
-            Kind::FecgFunction => operators::derived::<Fecg>(),
+            Kind::Pecg => registry::derived::<Pecg>(),
+            Kind::EcgGvr => registry::derived::<EcgGvr>(),
+            Kind::FecgFunction => registry::derived::<Fecg>(),
         }
     }
 
@@ -194,8 +196,8 @@ fn row_gradient_d<const D: usize, F: Family<D>>(
     F::row_gradient(&F::context(ops, e.n_ang, &[&trial, &basis])?, &sym, &trial, dir, &basis, &e.cache)
 }
 
-fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
-    let (arity, elements) = operators::lookup::<D, F>(name)?;
+fn operator_d<const D: usize, F: Specialised<D>>(e: &Engine, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
+    let (arity, elements) = registry::lookup::<D, F>(F::NAME, F::NAME, name)?;
     let basis = F::params(basis)?;
     let (ops, sym) = e.rep.operators::<D>();
     path::operator::<D, F>(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis, |bra, ket, ctx, v| elements.of(bra, ket, ctx, v), arity, w)

@@ -8,7 +8,7 @@ use convert::{blocks, columns, dict, floats, floats_shaped, matrix, Result, Rows
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use prebo_core::engine::{self, Kind, Representation};
-use prebo_core::families::Directions;
+use prebo_core::params::Directions;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 

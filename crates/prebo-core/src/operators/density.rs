@@ -74,7 +74,8 @@ mod tests {
     use super::*;
     use crate::families::fecg::kernel::{Centres, FecgFunction};
     use crate::families::fecg::Fecg;
-    use crate::families::ecg_gvr::element::{gauss_legendre, GvrFunction, GvrOps};
+    use crate::families::ecg_gvr::element::{GvrFunction, GvrOps};
+    use crate::quadrature::gauss_legendre;
     use crate::families::ecg_gvr::EcgGvr;
     use crate::families::pecg::Pecg;
     use crate::operators::delta;

@@ -2,10 +2,10 @@
 //! D-vectors `g`, `h`, with `<φ_I| p_g² p_h² |φ_J> = <Δ_g φ_I|Δ_h φ_J>` (docs/properties-derivations.md,
 //! eq. 20). In the laboratory frame `g = e_i − μ_i 1` (`μ_i = m_i/m_tot`) gives particle i's
 //! momentum in the centre-of-mass frame, the `p_i` of the mass–velocity term (§5). `g` transforms
-//! like `∇`, not like `r`: in coordinates `x = U_x r` it is `U_x g`. The elements are the family's
-//! (`Family::MOMENTUM`): for a Gaussian about centres (plain and floating ECGs) `gaussian`
-//! (eq. 25'), for ECG-GVR the overlap's generating function (eq. 26b, `momentum`), its `p_g²`
-//! the kinetic element with `Λ = g g^T`.
+//! like `∇`, not like `r`: in coordinates `x = U_x r` it is `U_x g`. The generic elements are
+//! those of a Gaussian about centres (plain and floating ECGs; `gaussian`, eq. 25'); ECG-GVR has
+//! its own (`families/ecg_gvr/operators.rs`: the overlap's generating function, eq. 26b, its
+//! `p_g²` the kinetic element with `Λ = g g^T`), given to `p4_of` and `p2p2_of`.
 use crate::ecg::Vector;
 use crate::families::Family;
 
@@ -13,26 +13,47 @@ pub const P2: &str = "p2";
 pub const P4: &str = "p4";
 pub const P2P2: &str = "p2p2";
 
-/// `<φ_I| p_g² |φ_J>` for normalised functions ((ħ/bohr)²; `Family::momentum_square`).
+/// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` of normalised functions of family `F`, for
+/// `p_g = −i Σ_k g_k ∇_k` with D-vectors `g` and `h` (docs/properties-derivations.md §5): at
+/// `h = g` the elements of `p_g²` and `p_g⁴`.
+pub type Momentum<const D: usize, F> = fn(
+    &<F as Family<D>>::Function<f64>,
+    &<F as Family<D>>::Function<f64>,
+    &<F as Family<D>>::Context,
+    &Vector<D>,
+    &Vector<D>,
+) -> (f64, f64);
+
+/// `<φ_I| p_g² |φ_J>` for normalised functions ((ħ/bohr)²; `gaussian`).
 pub fn p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
-    F::momentum_square(bra, ket, ctx, g)
+    gaussian::<D, F>(bra, ket, ctx, g, g).0
 }
 
-/// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴; `Family::MOMENTUM`).
-pub fn p4<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
-    (F::MOMENTUM)(bra, ket, ctx, g, g).1
+/// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴) from the momentum elements `m`.
+pub fn p4_of<const D: usize, F: Family<D>>(m: Momentum<D, F>, bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
+    m(bra, ket, ctx, g, g).1
 }
 
 /// `<φ_I| (p_g² p_h² + p_h² p_g²)/2 |φ_J>` for normalised functions, `v = [g, h]` ((ħ/bohr)⁴;
-/// symmetric in I ↔ J as in g ↔ h): for two particles' momenta, a term of the regularised
-/// `<p_i⁴>` (docs/properties-derivations.md §6).
-pub fn p2p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
+/// symmetric in I ↔ J as in g ↔ h) from the momentum elements `m`: for two particles' momenta, a
+/// term of the regularised `<p_i⁴>` (docs/properties-derivations.md §6).
+pub fn p2p2_of<const D: usize, F: Family<D>>(m: Momentum<D, F>, bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
     let (g, h) = (&v[0], &v[1]);
-    0.5 * ((F::MOMENTUM)(bra, ket, ctx, g, h).1 + (F::MOMENTUM)(bra, ket, ctx, h, g).1)
+    0.5 * (m(bra, ket, ctx, g, h).1 + m(bra, ket, ctx, h, g).1)
 }
 
-/// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` of a Gaussian about centres (`Family::MOMENTUM`'s
-/// default): with `Δ_gφ_I = (4|a|² − 6α) φ_I`, `a = (A_I g)ᵀ(r − s_I)`, `α = gᵀA_Ig`, and likewise
+/// `p4_of` a Gaussian about centres (`gaussian`).
+pub fn p4<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
+    p4_of::<D, F>(gaussian::<D, F>, bra, ket, ctx, g)
+}
+
+/// `p2p2_of` a Gaussian about centres (`gaussian`).
+pub fn p2p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
+    p2p2_of::<D, F>(gaussian::<D, F>, bra, ket, ctx, v)
+}
+
+/// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` of a Gaussian about centres (plain and
+/// floating ECGs): with `Δ_gφ_I = (4|a|² − 6α) φ_I`, `a = (A_I g)ᵀ(r − s_I)`, `α = gᵀA_Ig`, and likewise
 /// `b`, `β` of `h` and `φ_J`, Gaussian moments under `φ_Iφ_J` (means ā, b̄ at r̄; per-component
 /// variances σ_a, σ_b and covariance σ_ab with `C = (A_I + A_J)⁻¹/2`) give
 ///
@@ -82,7 +103,15 @@ mod tests {
     use crate::families::ecg_gvr::{momentum, EcgGvr};
     use crate::families::pecg::Pecg;
     use crate::operators::fixtures::{centres, close, exponent, gauss_hermite, plain, D};
-    use crate::operators::{lookup, names};
+    use crate::families::ecg_gvr;
+    use crate::operators::Specialised;
+    use crate::registry::{lookup, names};
+
+    /// The element of operator `name` the registry gives the family `F` (its own, else the
+    /// generic one) at the vectors `v`.
+    fn registered<const N: usize, F: Specialised<N>>(name: &str, bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<N>]) -> f64 {
+        lookup::<N, F>(F::NAME, F::NAME, name).unwrap().1.of(bra, ket, ctx, &[v.to_vec()])[0]
+    }
 
     /// Kinetic `Λ = g g^T`, no Coulomb pairs.
     fn squared<const N: usize>(g: &Vector<N>) -> Operators<N> {
@@ -281,7 +310,7 @@ mod tests {
             let gvr_ops = GvrOps::new(ops.clone(), 1, 3).unwrap();
             let (ui, uj) = (Vector::<D>::new(0.4, -1.0, 0.6), Vector::<D>::new(-0.9, 0.2, 0.7));
             let (gi, gj) = (GvrFunction::new(ai, ui, 2, ci, &gvr_ops, 0).unwrap(), GvrFunction::new(aj, uj, 3, cj, &gvr_ops, 1).unwrap());
-            let got = (0..D).map(|i| p2::<D, EcgGvr>(&gi, &gj, &gvr_ops, &g(i)) / (2.0 * m[i])).sum::<f64>();
+            let got = (0..D).map(|i| registered::<D, EcgGvr>(P2, &gi, &gj, &gvr_ops, &[g(i)]) / (2.0 * m[i])).sum::<f64>();
             let want = <EcgGvr as Family<D>>::element(&gi, &gj, &gvr_ops).t_ti;
             assert!(close(got, want, 1e-12), "ECG-GVR: {got} vs {want}");
             worst = worst.max((got / want - 1.0).abs());
@@ -315,7 +344,7 @@ mod tests {
                     let (ui, uj) = (Vector::<D>::new(0.4, -1.0, 0.6), Vector::<D>::new(-0.9, 0.2, 0.7 + si));
                     let fi = GvrFunction::new(exponent(si), ui, ki, 1.0, &go, 0).unwrap();
                     let fj = GvrFunction::new(exponent(sj), uj, kj, 1.0, &go, 1).unwrap();
-                    let want = p2::<D, EcgGvr>(&fi, &fj, &go, &g);
+                    let want = registered::<D, EcgGvr>(P2, &fi, &fj, &go, &[g]);
                     let got = momentum::momentum(&fi, &fj, &go, &g, &g).0;
                     assert!(close(got, want, 1e-12), "N = {n}, K = ({ki}, {kj}): {got} vs {want}");
                     worst = worst.max((got / want - 1.0).abs());
@@ -394,19 +423,19 @@ mod tests {
             let (gi, gj) = (plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1));
             let q = quadrature::<4>(&ai, &zero, &aj, &zero, &|r| (real(&ai, &zero, r, &g), real(&aj, &zero, r, &h)));
             let s = <Pecg as Family<2>>::overlap(&gi, &gj, &go);
-            check("plain", <Pecg as Family<2>>::MOMENTUM(&gi, &gj, &go, &g, &h), s, q);
+            check("plain", gaussian::<2, Pecg>(&gi, &gj, &go, &g, &h), s, q);
             let (ci, cj) = (centres::<2>(0.3, 1.5), centres::<2>(2.1, 1.5));
             let (fi, fj) = (FecgFunction::new(ai, ci, 1.0, 0).unwrap(), FecgFunction::new(aj, cj, 1.0, 1).unwrap());
             let q = quadrature::<4>(&ai, &ci, &aj, &cj, &|r| (real(&ai, &ci, r, &g), real(&aj, &cj, r, &h)));
             let s = <Fecg as Family<2>>::overlap(&fi, &fj, &ops);
-            check("floating", <Fecg as Family<2>>::MOMENTUM(&fi, &fj, &ops, &g, &h), s, q);
+            check("floating", gaussian::<2, Fecg>(&fi, &fj, &ops, &g, &h), s, q);
             let (ui, uj) = (Vector::<2>::new(0.7, -0.4), Vector::<2>::new(0.3, 0.9));
             let (vi, vj) = (GvrFunction::new(ai, ui, 1, 1.0, &go, 0).unwrap(), GvrFunction::new(aj, uj, 1, 1.0, &go, 1).unwrap());
             let q = quadrature::<6>(&ai, &zero, &aj, &zero, &|r| (gvr_laplacian(&ai, &ui, 1, 1, r, &g), gvr_laplacian(&aj, &uj, 1, 1, r, &h)));
             let s = <EcgGvr as Family<2>>::overlap(&vi, &vj, &go);
-            check("ECG-GVR", <EcgGvr as Family<2>>::MOMENTUM(&vi, &vj, &go, &g, &h), s, q);
+            check("ECG-GVR", ecg_gvr::momentum::momentum::<2>(&vi, &vj, &go, &g, &h), s, q);
             for (bra, ket) in [(&gi, &gj), (&vi, &vj)] {
-                let x = [(bra, ket, [g, h]), (ket, bra, [g, h]), (bra, ket, [h, g])].map(|(b, k, v)| p2p2::<2, EcgGvr>(b, k, &go, &v));
+                let x = [(bra, ket, [g, h]), (ket, bra, [g, h]), (bra, ket, [h, g])].map(|(b, k, v)| registered::<2, EcgGvr>(P2P2, b, k, &go, &v));
                 assert!(close(x[1], x[0], 1e-13) && close(x[2], x[0], 1e-13), "{x:?}");
             }
         }
@@ -417,9 +446,9 @@ mod tests {
     fn every_family_evaluates_p2_p4_and_p2p2() {
         assert!(names().contains(&P2) && names().contains(&P4) && names().contains(&P2P2));
         for name in [P2, P4, P2P2] {
-            assert!(lookup::<D, Pecg>(name).is_ok() && lookup::<D, Fecg>(name).is_ok());
-            assert!(lookup::<D, EcgGvr>(name).is_ok());
+            assert!(lookup::<D, Pecg>("pecg", "pecg", name).is_ok() && lookup::<D, Fecg>("fecg", "fecg", name).is_ok());
+            assert!(lookup::<D, EcgGvr>("ecg-gvr", "ecg-gvr", name).is_ok());
         }
-        assert!(lookup::<D, Pecg>(P2P2).is_ok_and(|(arity, _)| arity == 2));
+        assert!(lookup::<D, Pecg>("pecg", "pecg", P2P2).is_ok_and(|(arity, _)| arity == 2));
     }
 }

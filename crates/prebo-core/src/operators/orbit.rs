@@ -11,7 +11,7 @@
 //! of five Boys functions (eq. 36); plain ECGs `16 τ S/√(πq)` (eq. 37).
 //!
 //! This is the element of the families whose gradients are a Gaussian times a linear polynomial,
-//! plain and floating ECGs (one formula; a plain ECG has no centres), and `Family::ORBIT`'s
+//! plain and floating ECGs (one formula; a plain ECG has no centres), and ECG-GVR's own
 //! default. ECG-GVR gradients carry the derivatives of `|v|^{2K}(v_x + i v_y)^N`: their element
 //! is the overlap's generating function's (`momentum::orbit`, eq. 26c).
 use std::f64::consts::PI;
@@ -73,10 +73,11 @@ mod tests {
 
     use super::*;
     use crate::ecg::{Mat, Operators};
-    use crate::families::ecg_gvr::element::{even_rule, GvrFunction, GvrOps};
+    use crate::families::ecg_gvr::element::{GvrFunction, GvrOps};
+    use crate::quadrature::even_rule;
     use crate::families::fecg::kernel::{Centres, FecgFunction};
     use crate::families::fecg::Fecg;
-    use crate::families::ecg_gvr::EcgGvr;
+    use crate::families::ecg_gvr::{self, EcgGvr};
     use crate::families::pecg::Pecg;
     use crate::operators::fixtures::{centres, close, exponent, gauss_hermite, plain, separable};
 
@@ -292,7 +293,7 @@ mod tests {
         for (case, powers) in [(1, 0, 1), (1, 1, 0), (0, 0, 2), (0, 0, 0)].into_iter().enumerate() {
             let a = [exponent::<2>(0.3 + case as f64), exponent::<2>(1.7 + case as f64)];
             let (go, [fi, fj]) = gvr_pair(a, powers, 0.4 * case as f64);
-            let got = <EcgGvr as Family<2>>::ORBIT(&fi, &fj, &go, &v);
+            let got = ecg_gvr::momentum::orbit::<2>(&fi, &fj, &go, &v);
             let zero = Centres::<2>::zeros();
             let (si, sj) = ((&fi.u, fi.k, go.n_ang), (&fj.u, fj.k, go.n_ang));
             let want = quadrature::<2, 5>((&fi.a, &zero, Some(si)), (&fj.a, &zero, Some(sj)), &v, 4, 1.0)
@@ -308,13 +309,13 @@ mod tests {
         let (go, [gi, gj], _, _, v) = three();
         let [w, g, h] = v;
         let (gvr_go, [fi, fj]) = gvr_pair([gi.a, gj.a], (0, 0, 0), 0.0);
-        let (got, want) = (<EcgGvr as Family<3>>::ORBIT(&fi, &fj, &gvr_go, &v), element::<3, Pecg>(&gi, &gj, &go, &v));
+        let (got, want) = (ecg_gvr::momentum::orbit::<3>(&fi, &fj, &gvr_go, &v), element::<3, Pecg>(&gi, &gj, &go, &v));
         assert!(close(got, want, 1e-13), "K = N = 0: {got} vs {want}");
         let mut worst = (got / want - 1.0).abs();
         let (gvr_go, [fi, fj]) = gvr_pair([gi.a, gj.a], (2, 1, 1), 0.7);
         for v in [[w, g, h], [w, g * 0.3 - h, h * 1.7 + g]] {
             let x = [(&fi, &fj, v), (&fj, &fi, v), (&fi, &fj, [v[0], v[2], v[1]])]
-                .map(|(bra, ket, v)| <EcgGvr as Family<3>>::ORBIT(bra, ket, &gvr_go, &v));
+                .map(|(bra, ket, v)| ecg_gvr::momentum::orbit::<3>(bra, ket, &gvr_go, &v));
             assert!(close(x[1], x[0], 1e-12) && close(x[2], x[0], 1e-12), "{x:?}");
             worst = worst.max((x[1] / x[0] - 1.0).abs()).max((x[2] / x[0] - 1.0).abs());
         }
@@ -336,7 +337,7 @@ mod tests {
         eprintln!("orbit-orbit of exp(−a r² − c_A R²) against −8a√(2a/π): {:.1e}", (got / want - 1.0).abs());
     }
 
-    /// Drachmann's `<∇φ_I| Λ/r_w |∇φ_J>` (`drachmann::gradient_inv_r`) of floating ECGs, whose
+    /// Drachmann's `<∇φ_I| Λ/r_w |∇φ_J>` (`drachmann::gradient::gradient_inv_r`) of floating ECGs, whose
     /// damped functions move their centres (`FecgFunction::damped`), against the `δ_ab/r` part of this
     /// quadrature with `Λ = g gᵀ`: centres 0.3 to 2.5 apart, three particles, CM-separable exponents.
     #[test]

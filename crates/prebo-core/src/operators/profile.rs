@@ -13,7 +13,7 @@
 use std::sync::OnceLock;
 
 use crate::ecg::{Mat, Vector};
-use crate::families::ecg_gvr::element::gauss_legendre;
+use crate::quadrature::gauss_legendre;
 use crate::families::{Family, Shape};
 
 /// `G(u)` of one pair of functions and one vector `w`.

@@ -18,7 +18,7 @@ use crate::assemble;
 use crate::cache::Cache;
 use crate::ecg::Element;
 use crate::error::Result;
-use crate::families::Symmetry;
+use crate::params::Symmetry;
 #[cfg(test)]
 use crate::isa::process_isa;
 use crate::isa::Isa;

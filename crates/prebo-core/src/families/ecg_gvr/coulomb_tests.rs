@@ -3,7 +3,7 @@
 use super::*;
 use crate::ecg::{Mat, Operators};
 use crate::families::ecg_gvr::build::coulomb_partials;
-use crate::families::ecg_gvr::element::even_rule;
+use crate::quadrature::even_rule;
 use crate::test_support::Rng;
 
 const D: usize = 3;

@@ -1,5 +1,5 @@
-//! `<φ_I| V/|r_w| |φ_J>` of ECG-GVR functions (`Family::COULOMB`; docs/properties-derivations.md
-//! eq. 38): the quadrature of `drachmann::by_damping` over the Coulomb elements of the damped
+//! `<φ_I| V/|r_w| |φ_J>` of ECG-GVR functions (its `coulomb_inv_r`, `operators.rs`; docs/properties-derivations.md
+//! eq. 38): the quadrature of `drachmann::coulomb::by_damping` over the Coulomb elements of the damped
 //! functions `e^{−α r_w²} φ_J`, each read off one factorisation of `B = A_I + A_J` instead of its
 //! own. Damping adds `α w wᵀ` to `B`, so (Sherman–Morrison, the matrix determinant lemma)
 //!
@@ -11,7 +11,7 @@
 //! scalars: `x_α = x − κ(bᵀu_I)²/2`, likewise `y_α`, `z_α = z − κ(bᵀu_I)(bᵀu_J)/2`,
 //! `c'_α = c' − κ(bᵀw')²` and `(B_α⁻¹u_I)·w' = (B⁻¹u_I)·w' − κ(bᵀu_I)(bᵀw')`.
 //!
-//! `<∇φ_I| Λ/|r_w| |∇φ_J>` (`Family::GRADIENT`) needs at each node of eq. (30) the kinetic
+//! `<∇φ_I| Λ/|r_w| |∇φ_J>` (its `gradient_inv_r`, `operators.rs`) needs at each node of eq. (30) the kinetic
 //! elements of `e^{−α r_w²}φ_I` with `φ_J` and of `φ_I` with `e^{−α r_w²}φ_J`. Both have
 //! `B_α = B + αwwᵀ`, so both have its `x, y, z`, `Ω` and its derivatives (`element` module
 //! docs), and the kinetic element is linear in `W = A_IΛA_J`, `A_JΛu_I` and `A_IΛu_J`: their mean

@@ -39,13 +39,13 @@ use std::f64::consts::PI;
 use rayon::prelude::*;
 
 use super::element::{functions, log_s0, series_coefficients, GvrFunction, GvrOps, GvrParams};
-use super::kernel::{dot, inverse_log_det, mat_vec, Ket, Prepared, Side, MAX_LANES, MAX_PAIRS};
-use super::tau::{derivative_series, integral_partials, padded_rule};
+use super::kernel::{dot, inverse_log_det, mat_vec, Ket, Prepared, Side, MAX_LANES};
+use super::tau::{derivative_series, integral_partials, padded_rule, MAX_PAIRS};
 use super::series::{horner, omega, Coefficients};
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Vector};
 use crate::error::Result;
-use crate::families::{check, matrices_of, Directions, Parameters, Symmetry};
+use crate::params::{check, matrices_of, Directions, Parameters, Symmetry};
 use crate::isa::{process_isa, Isa};
 use crate::lanes::{array as vector, matrix, Lane, Lanes};
 use crate::matrices::Matrices;

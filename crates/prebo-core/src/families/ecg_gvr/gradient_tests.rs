@@ -8,7 +8,8 @@ use super::*;
 use crate::ecg::Operators;
 use crate::families::ecg_gvr::element::element;
 use crate::families::ecg_gvr::EcgGvr;
-use crate::families::{Exponents, Family};
+use crate::families::Family;
+use crate::params::Exponents;
 use crate::path;
 use crate::test_support::Rng;
 

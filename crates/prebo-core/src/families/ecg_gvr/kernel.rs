@@ -18,12 +18,12 @@ use std::f64::consts::PI;
 
 use super::element::{functions, log_s0, GvrFunction, GvrOps, GvrParams};
 use super::series::{cm_kinetic, omega};
-use crate::ecg::{Element, Operators, MAX_DIM};
+use crate::ecg::{Element, Operators};
 use crate::error::Result;
-use crate::families::Symmetry;
+use crate::params::Symmetry;
 use crate::images::Images;
 use crate::lanes::{Lane, Lanes};
-use super::tau::{integrals, Table};
+use super::tau::{integrals, Table, MAX_PAIRS};
 
 /// One function (or symmetry image) prepared for the kernel.
 #[derive(Clone, Debug)]
@@ -96,9 +96,6 @@ impl<const D: usize> Pairs<D> {
         Self { pairs }
     }
 }
-
-/// Most Coulomb pairs of a call (stack storage): the pairs of `MAX_DIM` particles.
-pub const MAX_PAIRS: usize = MAX_DIM * (MAX_DIM - 1) / 2;
 
 /// `B⁻¹` (full) and `|B|` of `B = L D Lᵀ`, with the pivots; `None` unless every pivot of every
 /// lane is positive and finite.

@@ -5,25 +5,25 @@
 //!   `cm_kinetic`), written once for the generic element and the kernels;
 //! - `element`: the function (`GvrFunction`), its context (`GvrOps`: N and the Gauss–Legendre rules)
 //!   and the generic element over `f64` or dual numbers (the derivation is in its docs);
-//! - `kernel`: the same element in `f64` lanes without allocation, and the Coulomb
-//!   τ-quadratures; `build`: matrices and rows with it, compiled per instruction set;
+//! - `kernel`: the same element in `f64` lanes without allocation, its Coulomb τ-quadratures in
+//!   `tau`; `build`: matrices and rows with it, compiled per instruction set;
 //! - `gradient`: the row gradient by hand-derived reverse mode in the kernel's lanes;
 //! - `momentum`: `p_g²`, `p_g⁴` and the orbit–orbit operator from the overlap's generating
 //!   function (eqs. 26–26c);
 //! - `drachmann`: `V/|r_w|` (eq. 38) from the Coulomb elements of damped functions as
 //!   rank-one updates of one factorisation;
+//! - `operators`: the family's own operator elements (`momentum`, `drachmann`) for the registry;
 //! - `coulomb` (tests only): the closed form of the Coulomb τ-integral.
 use nalgebra::SMatrix;
 
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Column, Directions, Exponents, Family, Field, Momentum, Shape, Symmetry};
+use crate::families::{Family, Shape};
+use crate::params::{columns, matrices_of, Column, Directions, Exponents, Field, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
-use crate::operators::drachmann::coulomb::InverseProducts;
-use crate::operators::ElementFn;
 use crate::path;
 use element::{element, functions, GvrFunction, GvrOps, GvrParams};
 
@@ -36,6 +36,7 @@ pub mod element;
 pub mod gradient;
 pub mod kernel;
 pub mod momentum;
+pub mod operators;
 pub mod series;
 pub mod tau;
 
@@ -47,10 +48,6 @@ impl<const D: usize> Family<D> for EcgGvr {
     const NAME: &'static str = "ecg-gvr";
     const FIELDS: &'static [Field] =
         &[Field::floats("A"), Field::floats("u"), Field::naturals("K"), Field::floats("c_A")];
-    const MOMENTUM: Momentum<D, Self> = momentum::momentum::<D>;
-    const ORBIT: ElementFn<D, Self> = momentum::orbit::<D>;
-    const COULOMB: InverseProducts<D, Self> = drachmann::inverse_products::<D>;
-    const GRADIENT: ElementFn<D, Self> = drachmann::gradient_inv_r::<D>;
     type Function<T: Real> = GvrFunction<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = GvrParams<'a>;
@@ -93,11 +90,6 @@ impl<const D: usize> Family<D> for EcgGvr {
 
     fn kinetic_only(ctx: &Self::Context) -> Self::Context {
         ctx.without_pairs()
-    }
-
-    /// The kinetic element with `Λ = g g^T`, cheaper than `MOMENTUM`'s hyper-dual numbers.
-    fn momentum_square(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, g: &Vector<D>) -> f64 {
-        element(bra, ket, &go.with_kinetic(g * g.transpose())).t
     }
 
     fn shape(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, w: &Vector<D>) -> Shape {

@@ -29,7 +29,8 @@ use std::ops::{Mul, Sub};
 use nalgebra::{Cholesky, Const, RealField, SMatrix, SVector};
 use num_dual::{Dual64, HyperDual64};
 
-use super::element::{legendre_rule, log_s0, GvrFunction, GvrOps};
+use super::element::{log_s0, GvrFunction, GvrOps};
+use crate::quadrature::legendre_rule;
 use super::series::{omega, Coefficients};
 use crate::ecg::{log_det_cholesky, Vector};
 use crate::scalar::Scalar;
@@ -98,7 +99,7 @@ impl<'a, const D: usize> Generating<'a, D> {
 }
 
 /// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` for normalised ECG-GVR functions (eq. 26b, with
-/// `h` in D_J and c_J; `Family::MOMENTUM`); NaN where `A_I + A_J` does not factorise.
+/// `h` in D_J and c_J; `operators::momentum::Momentum`); NaN where `A_I + A_J` does not factorise.
 pub fn momentum<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, g: &Vector<D>, h: &Vector<D>) -> (f64, f64) {
     let (hi, hj) = (bra.a * g, ket.a * h);
     let (ugi, ugj) = (bra.u.dot(g), ket.u.dot(h));

@@ -16,11 +16,14 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::element::GvrOps;
-use super::kernel::MAX_PAIRS;
 use super::series::{Coefficients, Terms};
+use crate::ecg::MAX_DIM;
 
 /// The widest lane count (AVX-512); rules are padded to a multiple of it.
 pub const MAX_W: usize = 8;
+
+/// Most Coulomb pairs of a call (stack storage): the pairs of `MAX_DIM` particles.
+pub const MAX_PAIRS: usize = MAX_DIM * (MAX_DIM - 1) / 2;
 
 /// A slice of the table's storage.
 #[derive(Clone, Copy, Debug, Default)]

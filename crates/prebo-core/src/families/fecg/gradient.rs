@@ -30,7 +30,7 @@ use super::kernel::{cm_shift, coulomb_factor, coulomb_moments, functions, kineti
 use crate::cache::Cache;
 use crate::ecg::{mul, Element, Mat, Operators};
 use crate::error::{CoreError, Result};
-use crate::families::{check, matrices_of, Directions, Parameters, Symmetry};
+use crate::params::{check, matrices_of, Directions, Parameters, Symmetry};
 use crate::images::Images;
 use crate::matrices::Matrices;
 

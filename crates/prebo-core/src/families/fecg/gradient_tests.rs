@@ -5,7 +5,8 @@
 use super::*;
 use crate::ecg::Vector;
 use crate::families::fecg::{kernel, Fecg};
-use crate::families::{Exponents, Family};
+use crate::families::Family;
+use crate::params::Exponents;
 use crate::path;
 use crate::test_support::Rng;
 

@@ -23,7 +23,7 @@ use nalgebra::SMatrix;
 use crate::ecg::{dot_f, inverse_log_det, log_det_pd, mul, re, Element, Mat, Operators, Real, Vector};
 use crate::error::{CoreError, Result};
 use crate::cache::Keyed;
-use crate::families::{matrices_of, Exponents, Parameters};
+use crate::params::{matrices_of, Exponents, Parameters};
 use crate::images::Transform;
 
 pub type Centres<const D: usize, T = f64> = SMatrix<T, D, 3>;

@@ -3,7 +3,8 @@
 //!
 //! - `kernel`: the function (`FecgFunction`), the generic element over `f64` or dual numbers (the formulas
 //!   are in its docs) and `<N_TI²>` (`angular`);
-//! - `gradient`: the row gradient by hand-derived derivatives.
+//! - `gradient`: the row gradient by hand-derived derivatives;
+//! - `operators`: `<N_TI²>` for the registry.
 //!
 //! Matrices and rows come from the generic path (`path`).
 use nalgebra::SMatrix;
@@ -11,7 +12,8 @@ use nalgebra::SMatrix;
 use crate::cache::Cache;
 use crate::ecg::{re, Element, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{columns, matrices_of, Angular, Column, Directions, Exponents, Family, Field, Shape, Symmetry};
+use crate::families::{Family, Shape};
+use crate::params::{columns, matrices_of, Column, Directions, Exponents, Field, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::matrices::Matrices;
 use crate::path;
@@ -19,6 +21,7 @@ use kernel::{element, functions, pair, Centres, FecgFunction, FecgParams};
 
 pub mod gradient;
 pub mod kernel;
+pub mod operators;
 
 /// The floating-ECG family: parameters `A` (`k x n x n`), centres `s` (`k x n x 3`), `c_A`
 /// (`FecgParams`).
@@ -27,7 +30,6 @@ pub struct Fecg;
 impl<const D: usize> Family<D> for Fecg {
     const NAME: &'static str = "fecg";
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("s"), Field::floats("c_A")];
-    const ANGULAR: Option<Angular<D, Self>> = Some(kernel::angular::<D>);
     type Function<T: Real> = FecgFunction<D, T>;
     type Context = Operators<D>;
     type Params<'a> = FecgParams<'a>;

@@ -1,4 +1,4 @@
-//! Symmetrised plain-ECG matrices and candidate rows with the SIMD kernel (`pecg`), parallel
+//! Symmetrised plain-ECG matrices and candidate rows with the SIMD kernel (`kernel`), parallel
 //! over rows with rayon: the overrides of `Family::matrices` and `Family::rows` for `Pecg`.
 //!
 //! A symmetrised element is `Σ_P c_P <phi_I| O |P phi_J>` with the Young-operator

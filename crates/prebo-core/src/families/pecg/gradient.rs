@@ -2,7 +2,7 @@
 //! kernel: the trial `phi_I` as bra against `W` basis images `P phi_J` at a time, derivatives
 //! along directions `dA_p` (symmetric) of `A_I` (issue 15).
 //!
-//! With `B = (A_I + A_J)^{-1}` (`pecg`, same factorisation) and `Z = B A_J`:
+//! With `B = (A_I + A_J)^{-1}` (`kernel`, same factorisation) and `Z = B A_J`:
 //! - `ln S = ¾ ln|A_I| + ¾ ln|A_J| − (3/2) ln|A_I + A_J| + const`, so
 //!   `dS = ¾ Tr(A_I^{-1} dA) S − (3/2) Tr(B dA) S` (the first term once per trial and direction);
 //! - `T = 6 τ S`, `τ = Tr(B A_I Λ A_J) = Σ_ac Z_ac (A_I Λ)_ac`; as `B A_I = 1 − Z`,

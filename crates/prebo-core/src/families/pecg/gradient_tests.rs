@@ -5,7 +5,8 @@ use crate::cache::Cache;
 use crate::families::pecg::kernel::tests::{gaussian, operators};
 use crate::test_support::Rng;
 use crate::families::pecg::{diagonal, Pecg};
-use crate::families::{Directions, Exponents, Family};
+use crate::families::Family;
+use crate::params::{Directions, Exponents};
 use crate::isa::best_isa;
 use crate::path;
 

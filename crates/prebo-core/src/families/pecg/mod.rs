@@ -4,24 +4,26 @@
 //! `diagonal` does not apply, extra operators) are the ECG-GVR elements at K = N = 0 with
 //! `u = e_1` (`ecg_gvr::element`), where `u` drops out and the elements are those of plain ECGs
 //! (`element` module docs: "For K = N = 0 this is the plain-ECG ..."): one generic element
-//! for both families, so the dual-number values stay those of that one code.
+//! for both families, so the dual-number values stay those of that one code. Its own operator
+//! element (`V/|r_w|` by eq. 19) is in `operators`.
 use nalgebra::SMatrix;
 
 use super::ecg_gvr::element::{self, GvrFunction, GvrOps};
 use crate::cache::Cache;
 use crate::ecg::{Element, Gaussian, Mat, Operators, Real, Vector};
 use crate::error::Result;
-use crate::families::{check, columns, Column, Directions, Exponents, Family, Field, Parameters, Shape, Symmetry};
+use crate::families::{Family, Shape};
+use crate::params::{check, columns, Column, Directions, Exponents, Field, Parameters, Symmetry};
 use crate::gradient::{seed_matrix, Dual};
 use crate::images::Images;
 use crate::isa::best_isa;
 use crate::matrices::Matrices;
-use crate::operators::drachmann::coulomb::{self, InverseProducts};
 use crate::path;
 
 pub mod build;
 pub mod gradient;
 pub mod kernel;
+pub mod operators;
 
 /// The plain-ECG family: parameters `A` (`k x n x n`) and `c_A` (`Exponents`).
 pub struct Pecg;
@@ -43,8 +45,6 @@ impl<const D: usize> Family<D> for Pecg {
     const FIELDS: &'static [Field] = &[Field::floats("A"), Field::floats("c_A")];
     /// Rows in full-build orientation from the SIMD kernel (`build::rows`).
     const ORIENTED: bool = true;
-    /// Eq. (19) in closed form.
-    const COULOMB: InverseProducts<D, Self> = coulomb::inverse_products::<D, Self>;
     type Function<T: Real> = GvrFunction<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = Exponents<'a>;

@@ -4,7 +4,7 @@ use std::f64::consts::PI;
 use std::sync::OnceLock;
 
 use crate::ecg::Vector;
-use crate::families::ecg_gvr::element::{gauss_legendre, legendre_rule};
+use crate::quadrature::{gauss_legendre, legendre_rule};
 use crate::families::Family;
 use crate::operators::{inverse, inverse_square};
 
@@ -16,16 +16,23 @@ fn whitening<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Func
 }
 
 /// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` for each Coulomb pair `(w'_k, q_k)` of the context (bohr⁻²);
-/// where `known[k]` is given it is returned instead, not computed (`coulomb_all` passes what it
-/// has, or needs not). A family's `Family::COULOMB`.
+/// where `known[k]` is given it is returned instead, not computed (`all_of` passes what it
+/// has, or needs not). Any family's `products_by_damping`; a family's own in its folder
+/// (`families/<name>/operators.rs`).
 pub type InverseProducts<const D: usize, F> =
     fn(&<F as Family<D>>::Function<f64>, &<F as Family<D>>::Function<f64>, &<F as Family<D>>::Context, &Vector<D>, &[Option<f64>]) -> Vec<f64>;
 
 /// `<φ_I| V/|r_w| |φ_J> = Σ_k q_k <φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` (hartree/bohr; `v = [w]`) from the
-/// family's `Family::COULOMB`.
-pub fn coulomb_inv_r<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
+/// products `products`.
+pub fn coulomb_inv_r<const D: usize, F: Family<D>>(
+    products: InverseProducts<D, F>,
+    bra: &F::Function<f64>,
+    ket: &F::Function<f64>,
+    ctx: &F::Context,
+    v: &[Vector<D>],
+) -> f64 {
     let pairs = &F::operators(ctx).pairs;
-    potential(pairs, &F::COULOMB(bra, ket, ctx, &v[0], &vec![None; pairs.len()]))
+    potential(pairs, &products(bra, ket, ctx, &v[0], &vec![None; pairs.len()]))
 }
 
 /// `Σ_k q_k x_k` over the Coulomb pairs `(w'_k, q_k)`.
@@ -41,8 +48,14 @@ pub(super) fn potential<const D: usize>(pairs: &[(Vector<D>, f64)], x: &[f64]) -
 /// (benchmarks/README.md: damping the protons' pair of H2 costs 2–3 times damping any other). That
 /// halves the quadratures of eq. (38) where every pair is asked for (⟨V²⟩ of the regularised
 /// ⟨p⁴⟩), and each product is the same bits whichever instances share the call (MPI ranks split
-/// them). Any other instance is `coulomb_inv_r`.
-pub fn coulomb_all<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, instances: &[Vec<Vector<D>>]) -> Vec<f64> {
+/// them). Any other instance is `coulomb_inv_r`. From the products `products`.
+pub fn all_of<const D: usize, F: Family<D>>(
+    products: InverseProducts<D, F>,
+    bra: &F::Function<f64>,
+    ket: &F::Function<f64>,
+    ctx: &F::Context,
+    instances: &[Vec<Vector<D>>],
+) -> Vec<f64> {
     let ops = F::operators(ctx);
     let (pairs, n) = (&ops.pairs, ops.pairs.len());
     let light: Vec<f64> = pairs.iter().map(|(w, _)| w.dot(&(ops.lambda * w))).collect();
@@ -65,7 +78,7 @@ pub fn coulomb_all<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F
         if skip.iter().all(Option::is_some) {
             continue;
         }
-        let x = F::COULOMB(bra, ket, ctx, &pairs[k].0, &skip);
+        let x = products(bra, ket, ctx, &pairs[k].0, &skip);
         for l in (0..n).filter(|&l| need[k * n + l]) {
             table[k * n + l] = x[l];
             table[l * n + k] = x[l];
@@ -75,10 +88,15 @@ pub fn coulomb_all<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F
         .iter()
         .zip(&at)
         .map(|(v, c)| match c {
-            None => coulomb_inv_r::<D, F>(bra, ket, ctx, v),
+            None => coulomb_inv_r::<D, F>(products, bra, ket, ctx, v),
             Some(c) => potential(pairs, &table[c * n..(c + 1) * n]),
         })
         .collect()
+}
+
+/// `all_of` any family's products by damping (`products_by_damping`): the generic element.
+pub fn all<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, instances: &[Vec<Vector<D>>]) -> Vec<f64> {
+    all_of::<D, F>(products_by_damping::<D, F>, bra, ket, ctx, instances)
 }
 
 /// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` of plain ECGs by eq. (19) (`InverseProducts`).
@@ -91,7 +109,7 @@ pub fn inverse_products<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ke
 }
 
 /// `<φ_I| 1/(|r_w| |r_w'_k|) |φ_J>` of any family by eq. (38) over the family's own `1/|r_w'|`
-/// element of its damped functions (`InverseProducts`; module docs; `Family::COULOMB`'s default).
+/// element of its damped functions (`InverseProducts`; module docs).
 pub fn products_by_damping<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, w: &Vector<D>, known: &[Option<f64>]) -> Vec<f64> {
     let (ww, pairs) = (w * w.transpose(), &F::operators(ctx).pairs);
     by_damping::<D, F>(bra, ket, ctx, w, known, |alpha, k| inverse::element::<D, F>(bra, &F::damped(ket, &(ww * alpha)), ctx, &pairs[k].0))

@@ -5,14 +5,14 @@ use std::f64::consts::PI;
 use nalgebra::{Const, U1};
 
 use crate::ecg::{Mat, Vector};
-use crate::families::ecg_gvr::element::legendre_rule;
+use crate::quadrature::legendre_rule;
 use crate::families::fecg::kernel::erf;
 use crate::families::{Family, Shape};
 use crate::gradient::{seed, Dual};
 use crate::operators::profile::Profile;
 
 /// `<∇φ_I| Λ/|r_w| |∇φ_J>` (hartree/bohr; `v = [w]`; module docs) from the family's kinetic
-/// elements of its damped functions (`Family::GRADIENT`'s default).
+/// elements of its damped functions (the generic element; ECG-GVR has its own, `ecg_gvr::drachmann`).
 pub fn gradient_inv_r<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
     let w = &v[0];
     let ww = w * w.transpose();

@@ -18,9 +18,9 @@
 //!   growing size until two agree to 1e-11 (`even`), else panels halved until two rules agree
 //!   (`adaptive`); `by_damping`. It costs tens of the family's `1/|r_w'|` elements per pair, up to
 //!   hundreds where a floating ECG's centres or nearly parallel pairs shape the integrand; ECG-GVR
-//!   reads them off one factorisation of `A_I + A_J` (`Family::COULOMB`, `ecg_gvr::drachmann`).
+//!   reads them off one factorisation of `A_I + A_J` (`ecg_gvr::drachmann`).
 //!   `<1/(|r_kl| |r_w|)>` is symmetric in the two vectors, so the operator takes all its instances
-//!   at once (`coulomb_all`) and computes each product of two Coulomb pairs once, over the damping
+//!   at once (`coulomb::all`) and computes each product of two Coulomb pairs once, over the damping
 //!   of the lighter pair: every pair asked for costs half the quadratures.
 //! - `gradient_inv_r`: `<∇φ_I| Λ/|r_w| |∇φ_J>` with the `Λ` of the context's `T_TI` (the CM part
 //!   removed: `1^T w = 0`, so `w^T Λ w = 1/(2μ_ij)` either way), from `1/|y| = π^{−1/2}∫t^{−1/2}e^{−ty²}dt`

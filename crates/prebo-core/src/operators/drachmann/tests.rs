@@ -21,11 +21,12 @@ use crate::ecg::Operators;
 use crate::families::fecg::Fecg;
 use crate::families::ecg_gvr::element::GvrOps;
 use crate::families::pecg::Pecg;
-use crate::operators::lookup;
+use crate::registry::lookup;
 use crate::families::fecg::kernel::{Centres, FecgFunction};
-use crate::families::ecg_gvr::drachmann::damped_inverse;
-use crate::families::ecg_gvr::element::{gauss_legendre, GvrFunction};
-use crate::families::ecg_gvr::EcgGvr;
+use crate::families::ecg_gvr::drachmann::{damped_inverse, inverse_products as gvr_products};
+use crate::families::ecg_gvr::element::GvrFunction;
+use crate::quadrature::gauss_legendre;
+use crate::families::ecg_gvr::{self, EcgGvr};
 use crate::operators::fixtures::{self, close, plain, separable};
 use crate::operators::inverse_square;
 
@@ -49,7 +50,7 @@ fn laboratory<const N: usize>(masses: [f64; N], charges: [f64; N], cm: bool) -> 
 }
 
 /// `<φ_I| V/|r_w| |φ_J>` by the generic eq. (38) (`products_by_damping`), whatever the
-/// family's own `Family::COULOMB`.
+/// family's own products (`families/<name>/operators.rs`).
 fn coulomb_by_damping<const N: usize, F: Family<N>>(fi: &F::Function<f64>, fj: &F::Function<f64>, ctx: &F::Context, v: &[Vector<N>]) -> f64 {
     let pairs = &F::operators(ctx).pairs;
     potential(pairs, &products_by_damping::<N, F>(fi, fj, ctx, &v[0], &vec![None; pairs.len()]))
@@ -130,7 +131,7 @@ fn check_plain<const N: usize>(masses: [f64; N], charges: [f64; N], pairs: &[(us
             for &(i, j) in pairs {
                 let w = Vector::<N>::from_fn(|k, _| (k == i) as i32 as f64 - (k == j) as i32 as f64);
                 let label = format!("N = {N}, CM {cm}, seeds ({si}, {sj}), pair ({i}, {j})");
-                let got = coulomb_inv_r::<N, Pecg>(&gi, &gj, &go, &[w]);
+                let got = coulomb_inv_r::<N, Pecg>(inverse_products::<N, Pecg>, &gi, &gj, &go, &[w]);
                 let want = coulomb_by_quadrature::<N, Pecg>(&gi, &gj, &go, &w, 80);
                 assert!(close(got, want, 1e-9), "{label}: coulomb_inv_r {got} vs {want}");
                 let got = gradient_inv_r::<N, Pecg>(&gi, &gj, &go, &[w]);
@@ -141,8 +142,8 @@ fn check_plain<const N: usize>(masses: [f64; N], charges: [f64; N], pairs: &[(us
                 let gvr = gradient_inv_r::<N, EcgGvr>(&gi, &gj, &go, &[w]);
                 assert!(close(gvr, got, 1e-13), "{label}: ECG-GVR {gvr} vs {got}");
                 // eq. (38) on the same functions against eq. (19), generic and ECG-GVR's own
-                let want = coulomb_inv_r::<N, Pecg>(&gi, &gj, &go, &[w]);
-                for got in [coulomb_by_damping::<N, EcgGvr>(&gi, &gj, &go, &[w]), coulomb_inv_r::<N, EcgGvr>(&gi, &gj, &go, &[w])] {
+                let want = coulomb_inv_r::<N, Pecg>(inverse_products::<N, Pecg>, &gi, &gj, &go, &[w]);
+                for got in [coulomb_by_damping::<N, EcgGvr>(&gi, &gj, &go, &[w]), coulomb_inv_r::<N, EcgGvr>(gvr_products::<N>, &gi, &gj, &go, &[w])] {
                     assert!(close(got, want, 1e-12), "{label}: eq. (38) {got} vs eq. (19) {want}");
                 }
             }
@@ -226,7 +227,7 @@ fn nearly_uncorrelated_pairs_match_eq_19() {
         let none = [None; 3];
         let want = inverse_products::<3, Pecg>(&gi, &gj, &go, &w, &none);
         let paths = [
-            ("ECG-GVR's own", <EcgGvr as Family<3>>::COULOMB(&gi, &gj, &go, &w, &none)),
+            ("ECG-GVR's own", gvr_products::<3>(&gi, &gj, &go, &w, &none)),
             ("generic, ECG-GVR", products_by_damping::<3, EcgGvr>(&gi, &gj, &go, &w, &none)),
             ("generic, floating", products_by_damping::<3, Fecg>(&fi, &fj, &ops, &w, &none)),
         ];
@@ -254,11 +255,11 @@ fn nearly_parallel_pairs_match_eq_19() {
         let (gi, gj) = (plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1));
         let (fi, fj) = (FecgFunction::new(ai, Centres::<3>::zeros(), 1.0, 0).unwrap(), FecgFunction::new(aj, Centres::<3>::zeros(), 1.0, 1).unwrap());
         for w in [Vector::<3>::new(1.0, 0.0, -1.0), Vector::<3>::new(0.0, 1.0, -1.0), heavy] {
-            let want = coulomb_inv_r::<3, Pecg>(&gi, &gj, &go, &[w]);
+            let want = coulomb_inv_r::<3, Pecg>(inverse_products::<3, Pecg>, &gi, &gj, &go, &[w]);
             let tol = 1e-12 + 1e-15 * tight;
             let got = coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]);
             assert!(close(got, want, tol), "A + {tight} w wᵀ, w = {w:?}: ECG-GVR {got} vs {want}");
-            let got = coulomb_inv_r::<3, EcgGvr>(&gi, &gj, &go, &[w]);
+            let got = coulomb_inv_r::<3, EcgGvr>(gvr_products::<3>, &gi, &gj, &go, &[w]);
             assert!(close(got, want, tol), "A + {tight} w wᵀ, w = {w:?}: ECG-GVR's own {got} vs {want}");
             let got = coulomb_by_damping::<3, Fecg>(&fi, &fj, &ops, &[w]);
             assert!(close(got, want, tol), "A + {tight} w wᵀ, w = {w:?}: floating {got} vs {want}");
@@ -292,7 +293,7 @@ fn floating_and_global_vector_functions_match_the_double_integral() {
             let gj = GvrFunction::new(aj, Vector::<3>::new(-0.7, 0.2, 0.9), kj, 1.3, &go, 1).unwrap();
             for w in pairs {
                 let want = coulomb_by_quadrature::<3, EcgGvr>(&gi, &gj, &go, &w, 40);
-                for got in [coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]), coulomb_inv_r::<3, EcgGvr>(&gi, &gj, &go, &[w])] {
+                for got in [coulomb_by_damping::<3, EcgGvr>(&gi, &gj, &go, &[w]), coulomb_inv_r::<3, EcgGvr>(gvr_products::<3>, &gi, &gj, &go, &[w])] {
                     assert!(close(got, want, 1e-10), "K = ({ki}, {kj}), N = {n_ang}, CM {cm}, w = {w:?}: {got} vs {want}");
                 }
             }
@@ -300,8 +301,8 @@ fn floating_and_global_vector_functions_match_the_double_integral() {
     }
 }
 
-/// ECG-GVR's own eqs. (38) and (30) (`Family::COULOMB`: rank-one updates of one factorisation;
-/// `Family::GRADIENT`: one element per node for both damped functions) against the generic ones
+/// ECG-GVR's own eqs. (38) and (30) (`ecg_gvr::drachmann::inverse_products`: rank-one updates of one factorisation;
+/// `ecg_gvr::drachmann::gradient_inv_r`: one element per node for both damped functions) against the generic ones
 /// (`coulomb_by_damping`, `gradient_inv_r`: each damped function its own element) where a
 /// molecule's would differ if either rounded badly:
 /// K up to 15 along the heavy pair, held close (1 − ρ² down to ~1e-5), N = 0 and 1, with and
@@ -327,7 +328,7 @@ fn global_vector_functions_match_the_generic_path() {
                     let binv = (ai + aj).try_inverse().unwrap();
                     let ww = w * w.transpose();
                     let damped = damped_inverse(&gi, &gj, &go, &w).unwrap();
-                    let (got, want) = (<EcgGvr as Family<3>>::COULOMB(&gi, &gj, &go, &w, &[None; 3]), products_by_damping::<3, EcgGvr>(&gi, &gj, &go, &w, &[None; 3]));
+                    let (got, want) = (gvr_products::<3>(&gi, &gj, &go, &w, &[None; 3]), products_by_damping::<3, EcgGvr>(&gi, &gj, &go, &w, &[None; 3]));
                     for (k, (wp, _)) in ops.pairs.iter().enumerate() {
                         // the integrands (α = τ²/(q(1 − τ²))): the two paths round apart as the
                         // condition of A_I + A_J (~ `tight`) and of the damping grow (at τ = 0.99
@@ -346,10 +347,10 @@ fn global_vector_functions_match_the_generic_path() {
                         // ECG-GVR's own two orientations, which round little (damping the heavy
                         // pair or the other agree to 7.5e-13 at 10⁵, the generic path's to 1.7e-10)
                         let c = ops.pairs.iter().position(|(v, _)| *v == w).unwrap();
-                        let mirror = <EcgGvr as Family<3>>::COULOMB(&gi, &gj, &go, wp, &[None; 3])[c];
+                        let mirror = gvr_products::<3>(&gi, &gj, &go, wp, &[None; 3])[c];
                         assert!(close(got[k], mirror, 1e-13 + 2.0 * promised), "<1/(r_w r_w')> damping w or w', {label}, w' = {wp:?}: {} vs {mirror}", got[k]);
                     }
-                    let (got, want) = (<EcgGvr as Family<3>>::GRADIENT(&gi, &gj, &go, &[w]), gradient_inv_r::<3, EcgGvr>(&gi, &gj, &go, &[w]));
+                    let (got, want) = (ecg_gvr::drachmann::gradient_inv_r::<3>(&gi, &gj, &go, &[w]), gradient_inv_r::<3, EcgGvr>(&gi, &gj, &go, &[w]));
                     assert!(close(got, want, 1e-12 + 1e-14 * tight), "gradient: K = ({ki}, {kj}), N = {n_ang}, CM {cm}, A + {tight} w wᵀ, w = {w:?}: {got} vs {want}");
                 }
             }
@@ -357,7 +358,7 @@ fn global_vector_functions_match_the_generic_path() {
     }
 }
 
-/// Every instance at once (`coulomb_all`, each product of two pairs computed once) against each
+/// Every instance at once (`all`, each product of two pairs computed once) against each
 /// alone (`coulomb_inv_r`), for floating ECGs with centres and ECG-GVR, three particles in the
 /// laboratory frame: the instances every Coulomb pair, one of them twice and reversed, and a
 /// vector that is none; and the same bits for an instance in any company (MPI ranks split the
@@ -379,11 +380,11 @@ fn all_instances_at_once_match_each_alone() {
         }
     };
     let (fi, fj) = (FecgFunction::new(ai, fixtures::centres(0.3, 1.5), 0.7, 0).unwrap(), FecgFunction::new(aj, fixtures::centres(2.1, 1.5), 1.3, 1).unwrap());
-    check(&|v| coulomb_all::<3, Fecg>(&fi, &fj, &ops, v), &|v| coulomb_inv_r::<3, Fecg>(&fi, &fj, &ops, v), "floating");
+    check(&|v| all::<3, Fecg>(&fi, &fj, &ops, v), &|v| coulomb_inv_r::<3, Fecg>(products_by_damping::<3, Fecg>, &fi, &fj, &ops, v), "floating");
     let go = GvrOps::new(ops.clone(), 1, 3).unwrap();
     let gi = GvrFunction::new(ai, Vector::<3>::new(0.3, 1.0, -0.4), 2, 0.7, &go, 0).unwrap();
     let gj = GvrFunction::new(aj, Vector::<3>::new(-0.7, 0.2, 0.9), 3, 1.3, &go, 1).unwrap();
-    check(&|v| coulomb_all::<3, EcgGvr>(&gi, &gj, &go, v), &|v| coulomb_inv_r::<3, EcgGvr>(&gi, &gj, &go, v), "global vector");
+    check(&|v| all_of::<3, EcgGvr>(gvr_products::<3>, &gi, &gj, &go, v), &|v| coulomb_inv_r::<3, EcgGvr>(gvr_products::<3>, &gi, &gj, &go, v), "global vector");
 }
 
 #[test]
@@ -402,6 +403,6 @@ fn boys_functions_match_quadrature() {
 #[test]
 fn every_family_has_them() {
     for name in [COULOMB, GRADIENT] {
-        assert!(lookup::<3, Pecg>(name).is_ok() && lookup::<3, EcgGvr>(name).is_ok() && lookup::<3, Fecg>(name).is_ok());
+        assert!(lookup::<3, Pecg>("pecg", "pecg", name).is_ok() && lookup::<3, EcgGvr>("ecg-gvr", "ecg-gvr", name).is_ok() && lookup::<3, Fecg>("fecg", "fecg", name).is_ok());
     }
 }
