@@ -132,7 +132,7 @@ def profile(p, w):
 
 
 def omega(ki, kj, n, x, y, z):
-    """Ω = Σ_k ĉ_k x^{K_I−k} y^{K_J−k} z^{N+2k} (docs/gvr.md; the ratio of gvr_series.rs)."""
+    """Ω = Σ_k ĉ_k x^{K_I−k} y^{K_J−k} z^{N+2k} (docs/gvr.md; the ratio of families/ecg_gvr/series.rs)."""
     total, ck = 0.0 * x, 1.0
     for k in range(min(ki, kj) + 1):
         total = total + ck * x ** (ki - k) * y ** (kj - k) * z ** (n + 2 * k)

@@ -4,10 +4,10 @@ far from a tight reference, for ladders of even Gauss–Legendre rules against t
 
     python benchmarks/quadrature_rules.py [--basis benchmarks/checkpoints/h2-auto] [--seeds 11 12] [--products 200]
 
-A transcription of ECG-GVR's damped Coulomb element (`gvr_drachmann::damped_inverse`, without the
+A transcription of ECG-GVR's damped Coulomb element (`ecg_gvr::drachmann::damped_inverse`, without the
 normalisation, which every rule shares) on random products of the basis: a pair of functions
 (the ket under a random one of the four permutations of H2), a pair vector w and a Coulomb pair
-w', w the lighter (it damps, as `coulomb_all` chooses). Prints, per ladder, the mean number of
+w', w the lighter (it damps, as `drachmann::coulomb::all` chooses). Prints, per ladder, the mean number of
 damped elements per product, the largest relative distance from panels to 1e-15, and how often
 it fell back to the panels; the panels alone last. About 4 minutes for 400 products.
 """
@@ -37,7 +37,7 @@ def pair_vector(i: int, j: int) -> np.ndarray:
 
 
 def series(ki: int, kj: int) -> np.ndarray:
-    """ĉ_k of Ω (N = 0; gvr_series::Coefficients)."""
+    """ĉ_k of Ω (N = 0; ecg_gvr::series::Coefficients)."""
     c, ck = [], 1.0
     for k in range(min(ki, kj) + 1):
         c.append(ck)

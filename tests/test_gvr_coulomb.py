@@ -7,7 +7,7 @@ M = K_I + K_J + N, so with t = τ², s = 1 − t, P = (x, y, z), P' = P − (γ_
     Ω(sP + tP') = Σ_j e_j s^j t^{M−j},   ∫_0^1 Ω dτ = Σ_j e_j β_j,   β_j = B(j+1, M−j+1/2)/2.
 
 ``closed_form`` implements this (the e_j by direct expansion of every term of Ω, not by the
-Horner scheme of crates/prebo-core/src/families/gvr/gvr_coulomb.rs) and is checked, at 50 digits, against
+Horner scheme of crates/prebo-core/src/families/ecg_gvr/coulomb.rs) and is checked, at 50 digits, against
 
 * the τ-integral itself, by an mpmath Gauss–Legendre rule exact for the degree-2M polynomial,
   for (K_I, K_J) up to 40 and N = 0, 1, 2, at 1e-30;

@@ -85,7 +85,7 @@ impl std::fmt::Debug for Cache {
 mod tests {
     use super::*;
 
-    /// Parameters `A` and `c_A`, keyed as `families::Exponents`.
+    /// Parameters `A` and `c_A`, keyed as `params::Exponents`.
     struct Params<'a> {
         a: &'a [f64],
         c_a: &'a [f64],

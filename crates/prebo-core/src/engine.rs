@@ -1,16 +1,18 @@
 //! The engine: one basis family in one coordinate representation, with every build the
 //! binding offers. Flat row-major arrays in and out, a basis as the arrays of its family's
-//! parameter tuple (`families::Column`, read by `Family::params`); the coordinate dimension `n`
+//! parameter tuple (`params::Column`, read by `Family::params`); the coordinate dimension `n`
 //! and the family are dispatched once per call to the const-generic, family-generic builds.
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Vector, MAX_DIM};
 use crate::error::{CoreError, Result};
-use crate::families::floating::FloatingEcg;
-use crate::families::gvr::EcgGvr;
-use crate::families::plain::PlainEcg;
-use crate::families::{check, Column, Directions, Family, Field, Parameters};
+use crate::families::fecg::Fecg;
+use crate::families::ecg_gvr::EcgGvr;
+use crate::families::pecg::Pecg;
+use crate::families::Family;
+use crate::params::{check, Column, Directions, Field, Parameters};
 use crate::matrices::Matrices;
-use crate::operators::{self, density};
+use crate::operators::{density, Specialised};
+use crate::registry;
 use crate::path;
 
 /// The basis families.
@@ -18,12 +20,12 @@ use crate::path;
 pub enum Kind {
     Pecg,
     EcgGvr,
-    Fecg,
+    FecgFunction,
 }
 
 impl Kind {
     pub fn from_name(name: &str) -> Result<Self> {
-        [Kind::Pecg, Kind::EcgGvr, Kind::Fecg]
+        [Kind::Pecg, Kind::EcgGvr, Kind::FecgFunction]
             .into_iter()
             .find(|k| k.name() == name)
             .ok_or_else(|| CoreError::Unsupported(format!("basis family {name:?} (pecg, ecg-gvr or fecg)")))
@@ -31,36 +33,36 @@ impl Kind {
 
     pub fn name(self) -> &'static str {
         match self {
-            Kind::Pecg => <PlainEcg as Family<1>>::NAME,
+            Kind::Pecg => <Pecg as Family<1>>::NAME,
             Kind::EcgGvr => <EcgGvr as Family<1>>::NAME,
-            Kind::Fecg => <FloatingEcg as Family<1>>::NAME,
+            Kind::FecgFunction => <Fecg as Family<1>>::NAME,
         }
     }
 
-    /// The registered operators the family evaluates (`operators::derived`).
+    /// The registered operators the family evaluates (`registry::derived`).
     pub fn operators(self) -> Vec<&'static str> {
         match self {
-            Kind::Pecg => operators::derived::<PlainEcg>(),
-            Kind::EcgGvr => operators::derived::<EcgGvr>(),
-            Kind::Fecg => operators::derived::<FloatingEcg>(),
+            Kind::Pecg => registry::derived::<Pecg>(),
+            Kind::EcgGvr => registry::derived::<EcgGvr>(),
+            Kind::FecgFunction => registry::derived::<Fecg>(),
         }
     }
 
     /// The arrays of the family's parameter tuple (`Family::FIELDS`).
     pub fn fields(self) -> &'static [Field] {
         match self {
-            Kind::Pecg => <PlainEcg as Family<1>>::FIELDS,
+            Kind::Pecg => <Pecg as Family<1>>::FIELDS,
             Kind::EcgGvr => <EcgGvr as Family<1>>::FIELDS,
-            Kind::Fecg => <FloatingEcg as Family<1>>::FIELDS,
+            Kind::FecgFunction => <Fecg as Family<1>>::FIELDS,
         }
     }
 
     /// Whether rows reproduce full-build bits (`Family::ORIENTED`).
     pub fn oriented(self) -> bool {
         match self {
-            Kind::Pecg => <PlainEcg as Family<1>>::ORIENTED,
+            Kind::Pecg => <Pecg as Family<1>>::ORIENTED,
             Kind::EcgGvr => <EcgGvr as Family<1>>::ORIENTED,
-            Kind::Fecg => <FloatingEcg as Family<1>>::ORIENTED,
+            Kind::FecgFunction => <Fecg as Family<1>>::ORIENTED,
         }
     }
 }
@@ -135,9 +137,9 @@ pub struct Engine {
 macro_rules! dispatch {
     ($e:expr, $f:ident ( $($arg:expr),* )) => {
         match $e.kind {
-            Kind::Pecg => dispatch!(@dim $e, $f, PlainEcg, ($($arg),*)),
+            Kind::Pecg => dispatch!(@dim $e, $f, Pecg, ($($arg),*)),
             Kind::EcgGvr => dispatch!(@dim $e, $f, EcgGvr, ($($arg),*)),
-            Kind::Fecg => dispatch!(@dim $e, $f, FloatingEcg, ($($arg),*)),
+            Kind::FecgFunction => dispatch!(@dim $e, $f, Fecg, ($($arg),*)),
         }
     };
     (@dim $e:expr, $f:ident, $fam:ty, ($($arg:expr),*)) => {
@@ -194,8 +196,8 @@ fn row_gradient_d<const D: usize, F: Family<D>>(
     F::row_gradient(&F::context(ops, e.n_ang, &[&trial, &basis])?, &sym, &trial, dir, &basis, &e.cache)
 }
 
-fn operator_d<const D: usize, F: Family<D>>(e: &Engine, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
-    let (arity, elements) = operators::lookup::<D, F>(name)?;
+fn operator_d<const D: usize, F: Specialised<D>>(e: &Engine, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
+    let (arity, elements) = registry::lookup::<D, F>(F::NAME, F::NAME, name)?;
     let basis = F::params(basis)?;
     let (ops, sym) = e.rep.operators::<D>();
     path::operator::<D, F>(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis, |bra, ket, ctx, v| elements.of(bra, ket, ctx, v), arity, w)

@@ -1,4 +1,4 @@
-//! Values of the ECG-GVR kernel (`families::gvr::gvr_kernel::element`): one element (`f64`), or
+//! Values of the ECG-GVR kernel (`families::ecg_gvr::kernel::element`): one element (`f64`), or
 //! the elements of one bra with `L` symmetry images of a ket at once ([`Lanes`]), structure of
 //! arrays. Every operation is the scalar one, lane by lane (no fused multiply-add, the libm
 //! `ln`/`exp` called per lane), so each lane has the bits of the scalar kernel on every

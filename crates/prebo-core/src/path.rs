@@ -9,7 +9,8 @@ use crate::assemble;
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Vector};
 use crate::error::Result;
-use crate::families::{check, Directions, Family, Parameters, Symmetry};
+use crate::families::Family;
+use crate::params::{check, Directions, Parameters, Symmetry};
 use crate::gradient::{self, Dual};
 use crate::images::Images;
 use crate::matrices::Matrices;
@@ -161,6 +162,30 @@ pub fn operator<const D: usize, F: Family<D>>(
         }
     });
     Ok(out)
+}
+
+/// The `nb_bra x nb_ket` matrix (row-major) of an operator between two bases of family `F`:
+/// `Σ_P c_P <phi_I| O |P phi'_J>`, the bras of `bra` as they are, the kets of `ket` with their
+/// images under the ket basis's own symmetry `ket_sym` (its operations and coefficients c_P);
+/// `element` is `<phi_I| O |phi'_J>` (`registry::lookup_between`). Rows in parallel.
+pub fn between<const D: usize, F: Family<D>>(
+    ctx: &F::Context,
+    ket_sym: &Symmetry<D>,
+    bra: &F::Params<'_>,
+    ket: &F::Params<'_>,
+    element: impl Fn(&F::Function<f64>, &F::Function<f64>) -> f64 + Sync,
+) -> Result<Vec<f64>> {
+    let bras = F::functions(bra, ctx)?;
+    let kets = images::<D, F>(ctx, ket_sym, ket)?;
+    let rows: Vec<Vec<f64>> = bras
+        .par_iter()
+        .map(|b| {
+            (0..kets.len())
+                .map(|j| kets.images[j].iter().zip(&kets.coef).map(|(k, c)| c * element(b, k)).sum())
+                .collect()
+        })
+        .collect();
+    Ok(rows.concat())
 }
 
 /// `Σ_IJ c_I c_J Σ_P c_P <phi_I| O_k |P phi_J>` of an operator with `len` components `O_k`

@@ -1,6 +1,6 @@
 //! The one scalar interface of the generic elements' values (`ecg::Real`: `f64`, dual numbers)
 //! and the f64 kernels' values (`lanes::Lane`: `f64`, lanes), for maths written once for both:
-//! a formula generic over [`Scalar`] (e.g. `families::gvr::gvr_series::omega`) performs the same
+//! a formula generic over [`Scalar`] (e.g. `families::ecg_gvr::series::omega`) performs the same
 //! operations in the same order on each, so every instance has the bits of the others' values.
 use std::ops::{Add, Div, Mul, Sub};
 
@@ -101,8 +101,8 @@ macro_rules! dual_scalar {
 dual_scalar!([const W: usize] DualSVec64<W>, |x| RealField::clamp(x, Self::from(-1.0), Self::from(1.0)));
 
 // Hyper-dual numbers (one mixed second derivative), for ECG-GVR's `p_g⁴` and orbit–orbit elements
-// (`families::gvr::gvr_momentum`): `clamp_unit` clamps the value only, since the shared formulas
-// are analytic where they clamp (ρ = z/√(xy), `gvr_series::omega`) and the derivatives stand.
+// (`families::ecg_gvr::momentum`): `clamp_unit` clamps the value only, since the shared formulas
+// are analytic where they clamp (ρ = z/√(xy), `series::omega`) and the derivatives stand.
 dual_scalar!([] HyperDual64, |x| Self { re: x.re.clamp(-1.0, 1.0), ..x });
 // Dual numbers where those elements need one derivative only (the isotropic part of orbit–orbit),
 // clamped as the hyper-dual ones.

@@ -1,7 +1,7 @@
 //! Properties of the plain-ECG kernel that need no Python: normalisation, hermiticity,
 //! and the CM elimination equal to the internal mass matrix M - 1 1^T / (2 m_tot).
 use prebo_core::engine::{Engine, Kind, Representation};
-use prebo_core::families::Column;
+use prebo_core::params::Column;
 use prebo_core::matrices::Matrices;
 
 const N: usize = 3;

@@ -6,7 +6,7 @@ use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLikeDyn, Py
 use prebo_core::ecg::Element;
 use prebo_core::eigenpair::Indefinite;
 use prebo_core::engine::Kind;
-use prebo_core::families::Column;
+use prebo_core::params::Column;
 use prebo_core::matrices::Matrices;
 use prebo_core::CoreError;
 use pyo3::prelude::*;

@@ -8,7 +8,7 @@ use convert::{blocks, columns, dict, floats, floats_shaped, matrix, Result, Rows
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use prebo_core::engine::{self, Kind, Representation};
-use prebo_core::families::Directions;
+use prebo_core::params::Directions;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -272,7 +272,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_DIM", prebo_core::ecg::MAX_DIM)?;
     m.add("GIT_COMMIT", env!("PREBO_GIT_COMMIT"))?;
     let operators = PyDict::new(m.py());
-    for kind in [Kind::Pecg, Kind::EcgGvr, Kind::Fecg] {
+    for kind in [Kind::Pecg, Kind::EcgGvr, Kind::FecgFunction] {
         operators.set_item(kind.name(), kind.operators())?;
     }
     m.add("OPERATORS", operators)?;

@@ -72,11 +72,12 @@ mod tests {
     //! overlap) to 5/q — for ECG-GVR up to K = 20, where the profile's coefficients could not be
     //! recovered from its values — and `ρ̄(0)` is the contact density (delta.rs).
     use super::*;
-    use crate::families::floating::fecg::{Centres, Fecg};
-    use crate::families::floating::FloatingEcg;
-    use crate::families::gvr::gvr_element::{gauss_legendre, Gvr, GvrOps};
-    use crate::families::gvr::EcgGvr;
-    use crate::families::plain::PlainEcg;
+    use crate::families::fecg::kernel::{Centres, FecgFunction};
+    use crate::families::fecg::Fecg;
+    use crate::families::ecg_gvr::element::{GvrFunction, GvrOps};
+    use crate::quadrature::gauss_legendre;
+    use crate::families::ecg_gvr::EcgGvr;
+    use crate::families::pecg::Pecg;
     use crate::operators::delta;
     use crate::operators::fixtures::{close, exponent, operators, w, D};
 
@@ -100,16 +101,16 @@ mod tests {
     fn plain_and_global_vector_densities_transform_to_the_damped_overlap() {
         for (ki, kj, n_ang) in [(0, 0, 0), (1, 0, 0), (2, 1, 1), (1, 3, 2), (12, 15, 1), (20, 7, 2)] {
             let go = GvrOps::new(operators(vec![(w(), 1.0)]), n_ang, 20).unwrap();
-            let gi = Gvr::new(exponent(0.5), Vector::<D>::new(0.3, 1.0, -0.4), ki, 1.0, &go, 0).unwrap();
-            let gj = Gvr::new(exponent(1.1), Vector::<D>::new(-0.7, 0.2, 0.9), kj, 1.0, &go, 1).unwrap();
+            let gi = GvrFunction::new(exponent(0.5), Vector::<D>::new(0.3, 1.0, -0.4), ki, 1.0, &go, 0).unwrap();
+            let gj = GvrFunction::new(exponent(1.1), Vector::<D>::new(-0.7, 0.2, 0.9), kj, 1.0, &go, 1).unwrap();
             check::<EcgGvr>(&gi, &gj, &go, &format!("ECG-GVR K = ({ki}, {kj}), N = {n_ang}"));
             // global vectors nearly along w: the variance left at r_w = 0 a small difference
             let along = |x: f64| w() + Vector::<D>::new(0.0, 0.0, x);
-            let gi = Gvr::new(exponent(0.5), along(1e-4), ki, 1.0, &go, 0).unwrap();
-            let gj = Gvr::new(exponent(1.1), along(-2e-4), kj, 1.0, &go, 1).unwrap();
+            let gi = GvrFunction::new(exponent(0.5), along(1e-4), ki, 1.0, &go, 0).unwrap();
+            let gj = GvrFunction::new(exponent(1.1), along(-2e-4), kj, 1.0, &go, 1).unwrap();
             check::<EcgGvr>(&gi, &gj, &go, &format!("ECG-GVR along w, K = ({ki}, {kj}), N = {n_ang}"));
             if ki + kj + n_ang == 0 {
-                check::<PlainEcg>(&gi, &gj, &go, "plain");
+                check::<Pecg>(&gi, &gj, &go, "plain");
             }
         }
     }
@@ -119,9 +120,9 @@ mod tests {
         let ops = operators(vec![(w(), 1.0)]);
         let centres = |x: f64, spread: f64| Centres::<D>::from_fn(|i, c| spread * (x + i as f64 * 1.1 + c as f64 * 0.37).cos());
         for spread in [0.0, 0.05, 1.0, 4.0] {
-            let fi = Fecg::new(exponent(0.2), centres(0.3, spread), 1.0, 0).unwrap();
-            let fj = Fecg::new(exponent(1.7), centres(2.1, spread), 1.0, 1).unwrap();
-            check::<FloatingEcg>(&fi, &fj, &ops, &format!("floating, spread {spread}"));
+            let fi = FecgFunction::new(exponent(0.2), centres(0.3, spread), 1.0, 0).unwrap();
+            let fj = FecgFunction::new(exponent(1.7), centres(2.1, spread), 1.0, 1).unwrap();
+            check::<Fecg>(&fi, &fj, &ops, &format!("floating, spread {spread}"));
         }
     }
 }

@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 
 use super::profile::Profile;
 use crate::ecg::Vector;
-use crate::families::floating::fecg::coulomb_factor;
+use crate::families::fecg::kernel::coulomb_factor;
 use crate::families::Family;
 
 pub const NAME: &str = "r";

@@ -5,7 +5,7 @@
 //! floating-ECG Coulomb element).
 use super::profile::Profile;
 use crate::ecg::Vector;
-use crate::families::floating::fecg::coulomb_factor;
+use crate::families::fecg::kernel::coulomb_factor;
 use crate::families::Family;
 
 pub const NAME: &str = "inv_r";

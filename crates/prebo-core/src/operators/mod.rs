@@ -4,14 +4,14 @@
 //! module here with an element function generic over the family, built from the family's
 //! primitives (`Family::overlap`, `Family::damped`, `Family::element`; for the operators of one
 //! pair vector beyond r², the damped overlap's profile in `profile`, which needs of a family only
-//! its exponent and the `Shape` of that profile), and one line in `registry` with its arity,
-//! the number of D-vectors it takes (a pair operator one, `w`; `p_g² p_h²` two momentum vectors;
-//! the orbit–orbit operator the pair vector and two momentum vectors). `path::operator`
-//! symmetrises it and the binding exposes it by name (`Engine.operator(name, params, v)`, `arity`
-//! vectors per instance).
+//! its exponent and the `Shape` of that profile). A family with a cheaper or exact element of its
+//! own declares it in its folder (`families/<name>/operators.rs`, `Specialised`); the registry
+//! (`crate::registry`) takes that before the generic one, and gives each operator its arity, the
+//! number of D-vectors it takes (a pair operator one, `w`; `p_g² p_h²` two momentum vectors; the
+//! orbit–orbit operator the pair vector and two momentum vectors). `path::operator` symmetrises
+//! it and the binding exposes it by name (`Engine.operator(name, params, v)`, `arity` vectors
+//! per instance).
 use crate::ecg::Vector;
-use crate::error::{CoreError, Result};
-use crate::families::plain::PlainEcg;
 use crate::families::Family;
 
 pub mod angular;
@@ -23,6 +23,7 @@ pub mod inverse;
 pub mod inverse_square;
 pub mod momentum;
 pub mod orbit;
+pub mod overlap;
 pub mod profile;
 pub mod r2;
 
@@ -37,12 +38,12 @@ pub type ElementFn<const D: usize, F> = fn(
 ) -> f64;
 
 /// An operator's elements of all its instances at once (`instances`, each `arity` vectors), one
-/// value per instance, for an operator whose instances share work (`drachmann::coulomb_all`).
+/// value per instance, for an operator whose instances share work (`drachmann::coulomb::all`).
 pub type BatchFn<const D: usize, F> =
     fn(&<F as Family<D>>::Function<f64>, &<F as Family<D>>::Function<f64>, &<F as Family<D>>::Context, &[Vec<Vector<D>>]) -> Vec<f64>;
 
-/// How a registered operator evaluates its instances for one pair of functions: each alone by
-/// its `ElementFn`, or all at once by a `BatchFn`.
+/// How an operator evaluates its instances for one pair of functions: each alone by its
+/// `ElementFn`, or all at once by a `BatchFn`.
 pub enum Elements<const D: usize, F: Family<D>> {
     Each(ElementFn<D, F>),
     All(BatchFn<D, F>),
@@ -58,53 +59,11 @@ impl<const D: usize, F: Family<D>> Elements<D, F> {
     }
 }
 
-/// An operator's element of one vector, as `Elements::Each` of arity 1.
-macro_rules! one_vector {
-    ($element:path) => {{
-        let element: ElementFn<D, F> = |bra, ket, ctx, v| $element(bra, ket, ctx, &v[0]);
-        Some(Elements::Each(element))
-    }};
-}
-
-/// The registered operators: name, arity (vectors per instance) and elements (`None`: not
-/// derived for the family `F`).
-fn registry<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<Elements<D, F>>)> {
-    use Elements::{All, Each};
-    vec![
-        (r2::NAME, 1, one_vector!(r2::element::<D, F>)),
-        (distance::NAME, 1, one_vector!(distance::element::<D, F>)),
-        (inverse::NAME, 1, one_vector!(inverse::element::<D, F>)),
-        (inverse_square::NAME, 1, one_vector!(inverse_square::element::<D, F>)),
-        (delta::NAME, 1, one_vector!(delta::element::<D, F>)),
-        (momentum::P2, 1, one_vector!(momentum::p2::<D, F>)),
-        (momentum::P4, 1, one_vector!(momentum::p4::<D, F>)),
-        (momentum::P2P2, 2, Some(Each(momentum::p2p2::<D, F>))),
-        (drachmann::COULOMB, 1, Some(All(drachmann::coulomb_all::<D, F>))),
-        (drachmann::GRADIENT, 1, Some(Each(F::GRADIENT))),
-        (orbit::NAME, 3, Some(Each(F::ORBIT))),
-        (angular::NAME, 1, F::ANGULAR.and_then(|_| one_vector!(angular::element::<D, F>))),
-    ]
-}
-
-/// The names of the registered operators.
-pub fn names() -> Vec<&'static str> {
-    registry::<1, PlainEcg>().into_iter().map(|(name, ..)| name).collect()
-}
-
-/// The names of the registered operators the family `F` evaluates.
-pub fn derived<F: Family<1>>() -> Vec<&'static str> {
-    registry::<1, F>().into_iter().filter(|(.., element)| element.is_some()).map(|(name, ..)| name).collect()
-}
-
-/// The arity and elements of the operator `name` for the family `F`.
-pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<(usize, Elements<D, F>)> {
-    let (_, arity, element) = registry::<D, F>()
-        .into_iter()
-        .find(|(n, ..)| *n == name)
-        .ok_or_else(|| CoreError::Unsupported(format!("operator {name:?} (registered: {:?})", names())))?;
-    let element =
-        element.ok_or_else(|| CoreError::Unsupported(format!("operator {name:?} is not derived for {} functions", F::NAME)))?;
-    Ok((arity, element))
+/// The operator elements a family has of its own (in its folder, `families/<name>/operators.rs`):
+/// by operator name, cheaper or exact where the generic element is slower or approximate, or for
+/// an operator without a generic element (`angular`). The registry consults them first.
+pub trait Specialised<const D: usize>: Family<D> {
+    fn specialised() -> Vec<(&'static str, Elements<D, Self>)>;
 }
 
 /// What the operators' tests share: three coordinates, random exponents and centres, plain ECGs
@@ -112,8 +71,8 @@ pub fn lookup<const D: usize, F: Family<D>>(name: &str) -> Result<(usize, Elemen
 #[cfg(test)]
 pub(crate) mod fixtures {
     use crate::ecg::{Mat, Operators, Vector};
-    use crate::families::floating::fecg::Centres;
-    use crate::families::gvr::gvr_element::{Gvr, GvrOps};
+    use crate::families::fecg::kernel::Centres;
+    use crate::families::ecg_gvr::element::{GvrFunction, GvrOps};
 
     pub const D: usize = 3;
 
@@ -135,9 +94,9 @@ pub(crate) mod fixtures {
         Centres::<N>::from_fn(|i, c| spread * (x + i as f64 * 1.1 + c as f64 * 0.37).cos())
     }
 
-    /// A plain ECG of the `PlainEcg` family (an ECG-GVR function at K = N = 0, `u` irrelevant).
-    pub fn plain<const N: usize>(a: Mat<N>, c_a: f64, go: &GvrOps<N>, index: usize) -> Gvr<N> {
-        Gvr::new(a, Vector::<N>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 }), 0, c_a, go, index).unwrap()
+    /// A plain ECG of the `Pecg` family (an ECG-GVR function at K = N = 0, `u` irrelevant).
+    pub fn plain<const N: usize>(a: Mat<N>, c_a: f64, go: &GvrOps<N>, index: usize) -> GvrFunction<N> {
+        GvrFunction::new(a, Vector::<N>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 }), 0, c_a, go, index).unwrap()
     }
 
     /// Kinetic `Λ = ½` and the Coulomb `pairs`.

@@ -2,10 +2,10 @@
 //! D-vectors `g`, `h`, with `<φ_I| p_g² p_h² |φ_J> = <Δ_g φ_I|Δ_h φ_J>` (docs/properties-derivations.md,
 //! eq. 20). In the laboratory frame `g = e_i − μ_i 1` (`μ_i = m_i/m_tot`) gives particle i's
 //! momentum in the centre-of-mass frame, the `p_i` of the mass–velocity term (§5). `g` transforms
-//! like `∇`, not like `r`: in coordinates `x = U_x r` it is `U_x g`. The elements are the family's
-//! (`Family::MOMENTUM`): for a Gaussian about centres (plain and floating ECGs) `gaussian`
-//! (eq. 25'), for ECG-GVR the overlap's generating function (eq. 26b, `gvr_momentum`), its `p_g²`
-//! the kinetic element with `Λ = g g^T`.
+//! like `∇`, not like `r`: in coordinates `x = U_x r` it is `U_x g`. The generic elements are
+//! those of a Gaussian about centres (plain and floating ECGs; `gaussian`, eq. 25'); ECG-GVR has
+//! its own (`families/ecg_gvr/operators.rs`: the overlap's generating function, eq. 26b, its
+//! `p_g²` the kinetic element with `Λ = g g^T`), given to `p4_of` and `p2p2_of`.
 use crate::ecg::Vector;
 use crate::families::Family;
 
@@ -13,26 +13,47 @@ pub const P2: &str = "p2";
 pub const P4: &str = "p4";
 pub const P2P2: &str = "p2p2";
 
-/// `<φ_I| p_g² |φ_J>` for normalised functions ((ħ/bohr)²; `Family::momentum_square`).
+/// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` of normalised functions of family `F`, for
+/// `p_g = −i Σ_k g_k ∇_k` with D-vectors `g` and `h` (docs/properties-derivations.md §5): at
+/// `h = g` the elements of `p_g²` and `p_g⁴`.
+pub type Momentum<const D: usize, F> = fn(
+    &<F as Family<D>>::Function<f64>,
+    &<F as Family<D>>::Function<f64>,
+    &<F as Family<D>>::Context,
+    &Vector<D>,
+    &Vector<D>,
+) -> (f64, f64);
+
+/// `<φ_I| p_g² |φ_J>` for normalised functions ((ħ/bohr)²; `gaussian`).
 pub fn p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
-    F::momentum_square(bra, ket, ctx, g)
+    gaussian::<D, F>(bra, ket, ctx, g, g).0
 }
 
-/// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴; `Family::MOMENTUM`).
-pub fn p4<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
-    (F::MOMENTUM)(bra, ket, ctx, g, g).1
+/// `<φ_I| p_g⁴ |φ_J>` for normalised functions ((ħ/bohr)⁴) from the momentum elements `m`.
+pub fn p4_of<const D: usize, F: Family<D>>(m: Momentum<D, F>, bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
+    m(bra, ket, ctx, g, g).1
 }
 
 /// `<φ_I| (p_g² p_h² + p_h² p_g²)/2 |φ_J>` for normalised functions, `v = [g, h]` ((ħ/bohr)⁴;
-/// symmetric in I ↔ J as in g ↔ h): for two particles' momenta, a term of the regularised
-/// `<p_i⁴>` (docs/properties-derivations.md §6).
-pub fn p2p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
+/// symmetric in I ↔ J as in g ↔ h) from the momentum elements `m`: for two particles' momenta, a
+/// term of the regularised `<p_i⁴>` (docs/properties-derivations.md §6).
+pub fn p2p2_of<const D: usize, F: Family<D>>(m: Momentum<D, F>, bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
     let (g, h) = (&v[0], &v[1]);
-    0.5 * ((F::MOMENTUM)(bra, ket, ctx, g, h).1 + (F::MOMENTUM)(bra, ket, ctx, h, g).1)
+    0.5 * (m(bra, ket, ctx, g, h).1 + m(bra, ket, ctx, h, g).1)
 }
 
-/// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` of a Gaussian about centres (`Family::MOMENTUM`'s
-/// default): with `Δ_gφ_I = (4|a|² − 6α) φ_I`, `a = (A_I g)ᵀ(r − s_I)`, `α = gᵀA_Ig`, and likewise
+/// `p4_of` a Gaussian about centres (`gaussian`).
+pub fn p4<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, g: &Vector<D>) -> f64 {
+    p4_of::<D, F>(gaussian::<D, F>, bra, ket, ctx, g)
+}
+
+/// `p2p2_of` a Gaussian about centres (`gaussian`).
+pub fn p2p2<const D: usize, F: Family<D>>(bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<D>]) -> f64 {
+    p2p2_of::<D, F>(gaussian::<D, F>, bra, ket, ctx, v)
+}
+
+/// `(<φ_I| p_h² |φ_J>, <p_g² φ_I| p_h² φ_J>)` of a Gaussian about centres (plain and
+/// floating ECGs): with `Δ_gφ_I = (4|a|² − 6α) φ_I`, `a = (A_I g)ᵀ(r − s_I)`, `α = gᵀA_Ig`, and likewise
 /// `b`, `β` of `h` and `φ_J`, Gaussian moments under `φ_Iφ_J` (means ā, b̄ at r̄; per-component
 /// variances σ_a, σ_b and covariance σ_ab with `C = (A_I + A_J)⁻¹/2`) give
 ///
@@ -76,13 +97,21 @@ mod tests {
 
     use super::*;
     use crate::ecg::{Mat, Operators};
-    use crate::families::floating::fecg::{Centres, Fecg};
-    use crate::families::floating::FloatingEcg;
-    use crate::families::gvr::gvr_element::{Gvr, GvrOps};
-    use crate::families::gvr::{gvr_momentum, EcgGvr};
-    use crate::families::plain::PlainEcg;
+    use crate::families::fecg::kernel::{Centres, FecgFunction};
+    use crate::families::fecg::Fecg;
+    use crate::families::ecg_gvr::element::{GvrFunction, GvrOps};
+    use crate::families::ecg_gvr::{momentum, EcgGvr};
+    use crate::families::pecg::Pecg;
     use crate::operators::fixtures::{centres, close, exponent, gauss_hermite, plain, D};
-    use crate::operators::{lookup, names};
+    use crate::families::ecg_gvr;
+    use crate::operators::Specialised;
+    use crate::registry::{lookup, names};
+
+    /// The element of operator `name` the registry gives the family `F` (its own, else the
+    /// generic one) at the vectors `v`.
+    fn registered<const N: usize, F: Specialised<N>>(name: &str, bra: &F::Function<f64>, ket: &F::Function<f64>, ctx: &F::Context, v: &[Vector<N>]) -> f64 {
+        lookup::<N, F>(F::NAME, F::NAME, name).unwrap().1.of(bra, ket, ctx, &[v.to_vec()])[0]
+    }
 
     /// Kinetic `Λ = g g^T`, no Coulomb pairs.
     fn squared<const N: usize>(g: &Vector<N>) -> Operators<N> {
@@ -104,16 +133,16 @@ mod tests {
             let go = GvrOps::new(squared(&g), 0, 0).unwrap();
             for (si, sj) in SEEDS {
                 let (gi, gj) = (plain(exponent(si), 1.0, &go, 0), plain(exponent(sj), 1.0, &go, 1));
-                let got = p2::<D, PlainEcg>(&gi, &gj, &go, &g);
-                let want = <PlainEcg as Family<D>>::element(&gi, &gj, &go).t;
+                let got = p2::<D, Pecg>(&gi, &gj, &go, &g);
+                let want = <Pecg as Family<D>>::element(&gi, &gj, &go).t;
                 assert!(close(got, want, 1e-12), "plain: {got} vs {want}");
                 worst = worst.max((got / want - 1.0).abs());
                 for spread in [0.3, 1.5] {
-                    let fi = Fecg::new(exponent(si), centres(0.3, spread), 1.0, 0).unwrap();
-                    let fj = Fecg::new(exponent(sj), centres(2.1, spread), 1.0, 1).unwrap();
+                    let fi = FecgFunction::new(exponent(si), centres(0.3, spread), 1.0, 0).unwrap();
+                    let fj = FecgFunction::new(exponent(sj), centres(2.1, spread), 1.0, 1).unwrap();
                     let ops = squared(&g);
-                    let got = p2::<D, FloatingEcg>(&fi, &fj, &ops, &g);
-                    let want = <FloatingEcg as Family<D>>::element(&fi, &fj, &ops).t;
+                    let got = p2::<D, Fecg>(&fi, &fj, &ops, &g);
+                    let want = <Fecg as Family<D>>::element(&fi, &fj, &ops).t;
                     assert!(close(got, want, 1e-12), "floating, spread {spread}: {got} vs {want}");
                     worst = worst.max((got / want - 1.0).abs());
                 }
@@ -192,8 +221,8 @@ mod tests {
             let (ai, aj) = (sub(si), sub(sj));
             let zero = Centres::<2>::zeros();
             let (gi, gj) = (plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1));
-            let s = <PlainEcg as Family<2>>::overlap(&gi, &gj, &go);
-            let got = [p2::<2, PlainEcg>(&gi, &gj, &go, &g), p4::<2, PlainEcg>(&gi, &gj, &go, &g)];
+            let s = <Pecg as Family<2>>::overlap(&gi, &gj, &go);
+            let got = [p2::<2, Pecg>(&gi, &gj, &go, &g), p4::<2, Pecg>(&gi, &gj, &go, &g)];
             let q = quadrature::<4>(&ai, &zero, &aj, &zero, &|r| (real(&ai, &zero, r, &g), real(&aj, &zero, r, &g)));
             for k in 0..2 {
                 let want = q[k + 1] / q[0] * s;
@@ -203,9 +232,9 @@ mod tests {
             for spread in [0.3, 1.5] {
                 let (ci, cj) = (centres::<2>(0.3, spread), centres::<2>(2.1, spread));
                 let ops = squared(&g);
-                let (fi, fj) = (Fecg::new(ai, ci, 1.0, 0).unwrap(), Fecg::new(aj, cj, 1.0, 1).unwrap());
-                let s = <FloatingEcg as Family<2>>::overlap(&fi, &fj, &ops);
-                let got = [p2::<2, FloatingEcg>(&fi, &fj, &ops, &g), p4::<2, FloatingEcg>(&fi, &fj, &ops, &g)];
+                let (fi, fj) = (FecgFunction::new(ai, ci, 1.0, 0).unwrap(), FecgFunction::new(aj, cj, 1.0, 1).unwrap());
+                let s = <Fecg as Family<2>>::overlap(&fi, &fj, &ops);
+                let got = [p2::<2, Fecg>(&fi, &fj, &ops, &g), p4::<2, Fecg>(&fi, &fj, &ops, &g)];
                 let q = quadrature::<4>(&ai, &ci, &aj, &cj, &|r| (real(&ai, &ci, r, &g), real(&aj, &cj, r, &g)));
                 for k in 0..2 {
                     let want = q[k + 1] / q[0] * s;
@@ -224,8 +253,8 @@ mod tests {
             let go = GvrOps::new(squared(&g), 0, 0).unwrap();
             for seed in [0.1, 1.3, 2.2] {
                 let f = plain(exponent(seed), 1.0, &go, 0);
-                let s = <PlainEcg as Family<D>>::overlap(&f, &f, &go);
-                let ratio = p4::<D, PlainEcg>(&f, &f, &go, &g) * s / p2::<D, PlainEcg>(&f, &f, &go, &g).powi(2);
+                let s = <Pecg as Family<D>>::overlap(&f, &f, &go);
+                let ratio = p4::<D, Pecg>(&f, &f, &go, &g) * s / p2::<D, Pecg>(&f, &f, &go, &g).powi(2);
                 assert!(close(ratio, 5.0 / 3.0, 1e-14), "{ratio}");
                 worst = worst.max((ratio * 0.6 - 1.0).abs());
             }
@@ -240,10 +269,10 @@ mod tests {
             let (ops, go) = (squared(&g), GvrOps::new(squared(&g), 0, 0).unwrap());
             for (si, sj) in SEEDS {
                 let (gi, gj) = (plain(exponent(si), 1.0, &go, 0), plain(exponent(sj), 1.0, &go, 1));
-                let fi = Fecg::new(exponent(si), Centres::<D>::zeros(), 1.0, 0).unwrap();
-                let fj = Fecg::new(exponent(sj), Centres::<D>::zeros(), 1.0, 1).unwrap();
-                let want = [p2::<D, PlainEcg>(&gi, &gj, &go, &g), p4::<D, PlainEcg>(&gi, &gj, &go, &g)];
-                let got = [p2::<D, FloatingEcg>(&fi, &fj, &ops, &g), p4::<D, FloatingEcg>(&fi, &fj, &ops, &g)];
+                let fi = FecgFunction::new(exponent(si), Centres::<D>::zeros(), 1.0, 0).unwrap();
+                let fj = FecgFunction::new(exponent(sj), Centres::<D>::zeros(), 1.0, 1).unwrap();
+                let want = [p2::<D, Pecg>(&gi, &gj, &go, &g), p4::<D, Pecg>(&gi, &gj, &go, &g)];
+                let got = [p2::<D, Fecg>(&fi, &fj, &ops, &g), p4::<D, Fecg>(&fi, &fj, &ops, &g)];
                 assert!(close(got[0], want[0], 1e-13) && close(got[1], want[1], 1e-13), "{got:?} vs {want:?}");
                 worst = worst.max((got[0] / want[0] - 1.0).abs()).max((got[1] / want[1] - 1.0).abs());
             }
@@ -267,21 +296,21 @@ mod tests {
         for ((si, sj), (ci, cj)) in SEEDS.into_iter().zip([(0.7, 1.3), (0.7, 0.7), (2.0, 0.4)]) {
             let (ai, aj) = (separable(si, ci), separable(sj, cj));
             let (gi, gj) = (plain(ai, ci, &go, 0), plain(aj, cj, &go, 1));
-            let got = (0..D).map(|i| p2::<D, PlainEcg>(&gi, &gj, &go, &g(i)) / (2.0 * m[i])).sum::<f64>();
-            let want = <PlainEcg as Family<D>>::element(&gi, &gj, &go).t_ti;
+            let got = (0..D).map(|i| p2::<D, Pecg>(&gi, &gj, &go, &g(i)) / (2.0 * m[i])).sum::<f64>();
+            let want = <Pecg as Family<D>>::element(&gi, &gj, &go).t_ti;
             assert!(close(got, want, 1e-12), "plain: {got} vs {want}");
             worst = worst.max((got / want - 1.0).abs());
-            let fi = Fecg::new(ai, centres(0.3, 1.0), ci, 0).unwrap();
-            let fj = Fecg::new(aj, centres(2.1, 1.0), cj, 1).unwrap();
-            let got = (0..D).map(|i| p2::<D, FloatingEcg>(&fi, &fj, &ops, &g(i)) / (2.0 * m[i])).sum::<f64>();
-            let want = <FloatingEcg as Family<D>>::element(&fi, &fj, &ops).t_ti;
+            let fi = FecgFunction::new(ai, centres(0.3, 1.0), ci, 0).unwrap();
+            let fj = FecgFunction::new(aj, centres(2.1, 1.0), cj, 1).unwrap();
+            let got = (0..D).map(|i| p2::<D, Fecg>(&fi, &fj, &ops, &g(i)) / (2.0 * m[i])).sum::<f64>();
+            let want = <Fecg as Family<D>>::element(&fi, &fj, &ops).t_ti;
             assert!(close(got, want, 1e-12), "floating: {got} vs {want}");
             worst = worst.max((got / want - 1.0).abs());
             // ECG-GVR (its kinetic element with Λ = g gᵀ), K = 2 and 3, N = 1, 1ᵀu = 0
             let gvr_ops = GvrOps::new(ops.clone(), 1, 3).unwrap();
             let (ui, uj) = (Vector::<D>::new(0.4, -1.0, 0.6), Vector::<D>::new(-0.9, 0.2, 0.7));
-            let (gi, gj) = (Gvr::new(ai, ui, 2, ci, &gvr_ops, 0).unwrap(), Gvr::new(aj, uj, 3, cj, &gvr_ops, 1).unwrap());
-            let got = (0..D).map(|i| p2::<D, EcgGvr>(&gi, &gj, &gvr_ops, &g(i)) / (2.0 * m[i])).sum::<f64>();
+            let (gi, gj) = (GvrFunction::new(ai, ui, 2, ci, &gvr_ops, 0).unwrap(), GvrFunction::new(aj, uj, 3, cj, &gvr_ops, 1).unwrap());
+            let got = (0..D).map(|i| registered::<D, EcgGvr>(P2, &gi, &gj, &gvr_ops, &[g(i)]) / (2.0 * m[i])).sum::<f64>();
             let want = <EcgGvr as Family<D>>::element(&gi, &gj, &gvr_ops).t_ti;
             assert!(close(got, want, 1e-12), "ECG-GVR: {got} vs {want}");
             worst = worst.max((got / want - 1.0).abs());
@@ -296,8 +325,8 @@ mod tests {
             let go = GvrOps::new(squared(&g), 0, 0).unwrap();
             for (si, sj) in SEEDS {
                 let (gi, gj) = (plain(exponent(si), 1.0, &go, 0), plain(exponent(sj), 1.0, &go, 1));
-                let want = [p2::<D, PlainEcg>(&gi, &gj, &go, &g), p4::<D, PlainEcg>(&gi, &gj, &go, &g)];
-                let (p2_h, p4_h) = gvr_momentum::momentum(&gi, &gj, &go, &g, &g);
+                let want = [p2::<D, Pecg>(&gi, &gj, &go, &g), p4::<D, Pecg>(&gi, &gj, &go, &g)];
+                let (p2_h, p4_h) = momentum::momentum(&gi, &gj, &go, &g, &g);
                 assert!(close(p2_h, want[0], 1e-13) && close(p4_h, want[1], 1e-13), "{:?} vs {want:?}", (p2_h, p4_h));
                 worst = worst.max((p2_h / want[0] - 1.0).abs()).max((p4_h / want[1] - 1.0).abs());
             }
@@ -313,10 +342,10 @@ mod tests {
                 let go = GvrOps::new(squared(&g), n, 3).unwrap();
                 for ((si, sj), (ki, kj)) in SEEDS.into_iter().zip([(0, 3), (2, 1), (3, 3)]) {
                     let (ui, uj) = (Vector::<D>::new(0.4, -1.0, 0.6), Vector::<D>::new(-0.9, 0.2, 0.7 + si));
-                    let fi = Gvr::new(exponent(si), ui, ki, 1.0, &go, 0).unwrap();
-                    let fj = Gvr::new(exponent(sj), uj, kj, 1.0, &go, 1).unwrap();
-                    let want = p2::<D, EcgGvr>(&fi, &fj, &go, &g);
-                    let got = gvr_momentum::momentum(&fi, &fj, &go, &g, &g).0;
+                    let fi = GvrFunction::new(exponent(si), ui, ki, 1.0, &go, 0).unwrap();
+                    let fj = GvrFunction::new(exponent(sj), uj, kj, 1.0, &go, 1).unwrap();
+                    let want = registered::<D, EcgGvr>(P2, &fi, &fj, &go, &[g]);
+                    let got = momentum::momentum(&fi, &fj, &go, &g, &g).0;
                     assert!(close(got, want, 1e-12), "N = {n}, K = ({ki}, {kj}): {got} vs {want}");
                     worst = worst.max((got / want - 1.0).abs());
                 }
@@ -360,9 +389,9 @@ mod tests {
         for ((si, sj), (ki, kj, n)) in SEEDS.into_iter().zip([(1, 0, 1), (2, 1, 0), (0, 1, 2)]) {
             let (ai, aj) = (exponent::<2>(si), exponent::<2>(sj));
             let ctx = go(n);
-            let (fi, fj) = (Gvr::new(ai, ui, ki, 1.0, &ctx, 0).unwrap(), Gvr::new(aj, uj, kj, 1.0, &ctx, 1).unwrap());
+            let (fi, fj) = (GvrFunction::new(ai, ui, ki, 1.0, &ctx, 0).unwrap(), GvrFunction::new(aj, uj, kj, 1.0, &ctx, 1).unwrap());
             let s = <EcgGvr as Family<2>>::overlap(&fi, &fj, &ctx);
-            let got = gvr_momentum::momentum(&fi, &fj, &ctx, &g, &g);
+            let got = momentum::momentum(&fi, &fj, &ctx, &g, &g);
             let zero = Centres::<2>::zeros();
             let q = quadrature::<6>(&ai, &zero, &aj, &zero, &|r| (gvr_laplacian(&ai, &ui, ki, n, r, &g), gvr_laplacian(&aj, &uj, kj, n, r, &g)));
             for (k, got) in [got.0, got.1].into_iter().enumerate() {
@@ -393,20 +422,20 @@ mod tests {
             let (ai, aj) = (exponent::<2>(si), exponent::<2>(sj));
             let (gi, gj) = (plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1));
             let q = quadrature::<4>(&ai, &zero, &aj, &zero, &|r| (real(&ai, &zero, r, &g), real(&aj, &zero, r, &h)));
-            let s = <PlainEcg as Family<2>>::overlap(&gi, &gj, &go);
-            check("plain", <PlainEcg as Family<2>>::MOMENTUM(&gi, &gj, &go, &g, &h), s, q);
+            let s = <Pecg as Family<2>>::overlap(&gi, &gj, &go);
+            check("plain", gaussian::<2, Pecg>(&gi, &gj, &go, &g, &h), s, q);
             let (ci, cj) = (centres::<2>(0.3, 1.5), centres::<2>(2.1, 1.5));
-            let (fi, fj) = (Fecg::new(ai, ci, 1.0, 0).unwrap(), Fecg::new(aj, cj, 1.0, 1).unwrap());
+            let (fi, fj) = (FecgFunction::new(ai, ci, 1.0, 0).unwrap(), FecgFunction::new(aj, cj, 1.0, 1).unwrap());
             let q = quadrature::<4>(&ai, &ci, &aj, &cj, &|r| (real(&ai, &ci, r, &g), real(&aj, &cj, r, &h)));
-            let s = <FloatingEcg as Family<2>>::overlap(&fi, &fj, &ops);
-            check("floating", <FloatingEcg as Family<2>>::MOMENTUM(&fi, &fj, &ops, &g, &h), s, q);
+            let s = <Fecg as Family<2>>::overlap(&fi, &fj, &ops);
+            check("floating", gaussian::<2, Fecg>(&fi, &fj, &ops, &g, &h), s, q);
             let (ui, uj) = (Vector::<2>::new(0.7, -0.4), Vector::<2>::new(0.3, 0.9));
-            let (vi, vj) = (Gvr::new(ai, ui, 1, 1.0, &go, 0).unwrap(), Gvr::new(aj, uj, 1, 1.0, &go, 1).unwrap());
+            let (vi, vj) = (GvrFunction::new(ai, ui, 1, 1.0, &go, 0).unwrap(), GvrFunction::new(aj, uj, 1, 1.0, &go, 1).unwrap());
             let q = quadrature::<6>(&ai, &zero, &aj, &zero, &|r| (gvr_laplacian(&ai, &ui, 1, 1, r, &g), gvr_laplacian(&aj, &uj, 1, 1, r, &h)));
             let s = <EcgGvr as Family<2>>::overlap(&vi, &vj, &go);
-            check("ECG-GVR", <EcgGvr as Family<2>>::MOMENTUM(&vi, &vj, &go, &g, &h), s, q);
+            check("ECG-GVR", ecg_gvr::momentum::momentum::<2>(&vi, &vj, &go, &g, &h), s, q);
             for (bra, ket) in [(&gi, &gj), (&vi, &vj)] {
-                let x = [(bra, ket, [g, h]), (ket, bra, [g, h]), (bra, ket, [h, g])].map(|(b, k, v)| p2p2::<2, EcgGvr>(b, k, &go, &v));
+                let x = [(bra, ket, [g, h]), (ket, bra, [g, h]), (bra, ket, [h, g])].map(|(b, k, v)| registered::<2, EcgGvr>(P2P2, b, k, &go, &v));
                 assert!(close(x[1], x[0], 1e-13) && close(x[2], x[0], 1e-13), "{x:?}");
             }
         }
@@ -417,9 +446,9 @@ mod tests {
     fn every_family_evaluates_p2_p4_and_p2p2() {
         assert!(names().contains(&P2) && names().contains(&P4) && names().contains(&P2P2));
         for name in [P2, P4, P2P2] {
-            assert!(lookup::<D, PlainEcg>(name).is_ok() && lookup::<D, FloatingEcg>(name).is_ok());
-            assert!(lookup::<D, EcgGvr>(name).is_ok());
+            assert!(lookup::<D, Pecg>("pecg", "pecg", name).is_ok() && lookup::<D, Fecg>("fecg", "fecg", name).is_ok());
+            assert!(lookup::<D, EcgGvr>("ecg-gvr", "ecg-gvr", name).is_ok());
         }
-        assert!(lookup::<D, PlainEcg>(P2P2).is_ok_and(|(arity, _)| arity == 2));
+        assert!(lookup::<D, Pecg>("pecg", "pecg", P2P2).is_ok_and(|(arity, _)| arity == 2));
     }
 }

@@ -11,12 +11,12 @@
 //! of five Boys functions (eq. 36); plain ECGs `16 τ S/√(πq)` (eq. 37).
 //!
 //! This is the element of the families whose gradients are a Gaussian times a linear polynomial,
-//! plain and floating ECGs (one formula; a plain ECG has no centres), and `Family::ORBIT`'s
+//! plain and floating ECGs (one formula; a plain ECG has no centres), and ECG-GVR's own
 //! default. ECG-GVR gradients carry the derivatives of `|v|^{2K}(v_x + i v_y)^N`: their element
-//! is the overlap's generating function's (`gvr_momentum::orbit`, eq. 26c).
+//! is the overlap's generating function's (`momentum::orbit`, eq. 26c).
 use std::f64::consts::PI;
 
-use super::drachmann::boys;
+use super::drachmann::gradient::boys;
 use crate::ecg::Vector;
 use crate::families::Family;
 
@@ -73,11 +73,12 @@ mod tests {
 
     use super::*;
     use crate::ecg::{Mat, Operators};
-    use crate::families::gvr::gvr_element::{even_rule, Gvr, GvrOps};
-    use crate::families::floating::fecg::{Centres, Fecg};
-    use crate::families::floating::FloatingEcg;
-    use crate::families::gvr::EcgGvr;
-    use crate::families::plain::PlainEcg;
+    use crate::families::ecg_gvr::element::{GvrFunction, GvrOps};
+    use crate::quadrature::even_rule;
+    use crate::families::fecg::kernel::{Centres, FecgFunction};
+    use crate::families::fecg::Fecg;
+    use crate::families::ecg_gvr::{self, EcgGvr};
+    use crate::families::pecg::Pecg;
     use crate::operators::fixtures::{centres, close, exponent, gauss_hermite, plain, separable};
 
     /// A function's value and `∇_g φ` (a 3-vector) at r, each as (real, imaginary) parts.
@@ -198,16 +199,16 @@ mod tests {
             let sets = pairs.iter().map(|&(i, j)| vectors(&mu, i, j)).chain([[vectors(&mu, 0, 1)[0], free(0.3), free(2.0)]]);
             for (set, v) in sets.enumerate() {
                 let zero = Centres::<N>::zeros();
-                let got = element::<N, PlainEcg>(&plain(ai, 0.7, &go, 0), &plain(aj, 1.3, &go, 1), &go, &v);
-                let s = <PlainEcg as Family<N>>::overlap(&plain(ai, 0.7, &go, 0), &plain(aj, 1.3, &go, 1), &go);
+                let got = element::<N, Pecg>(&plain(ai, 0.7, &go, 0), &plain(aj, 1.3, &go, 1), &go, &v);
+                let s = <Pecg as Family<N>>::overlap(&plain(ai, 0.7, &go, 0), &plain(aj, 1.3, &go, 1), &go);
                 let want = quadrature::<N, 3>((&ai, &zero, None), (&aj, &zero, None), &v, 5, 1.0) * s;
                 assert!(close(got, want, 1e-12), "N = {N}, plain, vectors {set}: {got} vs {want}");
                 worst = worst.max((got / want - 1.0).abs());
                 for &spread in spreads {
                     let (ci, cj) = (centres::<N>(0.3, spread), centres::<N>(2.1, spread));
-                    let (fi, fj) = (Fecg::new(ai, ci, 0.7, 0).unwrap(), Fecg::new(aj, cj, 1.3, 1).unwrap());
-                    let got = element::<N, FloatingEcg>(&fi, &fj, &ops, &v);
-                    let want = quadrature::<N, 3>((&ai, &ci, None), (&aj, &cj, None), &v, 12, 1.0) * <FloatingEcg as Family<N>>::overlap(&fi, &fj, &ops);
+                    let (fi, fj) = (FecgFunction::new(ai, ci, 0.7, 0).unwrap(), FecgFunction::new(aj, cj, 1.3, 1).unwrap());
+                    let got = element::<N, Fecg>(&fi, &fj, &ops, &v);
+                    let want = quadrature::<N, 3>((&ai, &ci, None), (&aj, &cj, None), &v, 12, 1.0) * <Fecg as Family<N>>::overlap(&fi, &fj, &ops);
                     assert!(close(got, want, 1e-11), "N = {N}, floating, spread {spread}, vectors {set}: {got} vs {want}");
                     worst = worst.max((got / want - 1.0).abs());
                 }
@@ -232,12 +233,12 @@ mod tests {
 
     /// Three particles' functions of both families (exponents without structure, centres spread 1)
     /// and the vectors of the pair (0, 2).
-    fn three() -> (GvrOps<3>, [Gvr<3>; 2], Operators<3>, [Fecg<3>; 2], [Vector<3>; 3]) {
+    fn three() -> (GvrOps<3>, [GvrFunction<3>; 2], Operators<3>, [FecgFunction<3>; 2], [Vector<3>; 3]) {
         let ops = Operators { lambda: Mat::<3>::identity() * 0.5, pairs: vec![], cm_mass: None };
         let go = GvrOps::new(ops.clone(), 0, 0).unwrap();
         let (ai, aj) = (exponent(0.4), exponent(1.9));
         let g = [plain(ai, 1.0, &go, 0), plain(aj, 1.0, &go, 1)];
-        let f = [Fecg::new(ai, centres(0.3, 1.0), 1.0, 0).unwrap(), Fecg::new(aj, centres(2.1, 1.0), 1.0, 1).unwrap()];
+        let f = [FecgFunction::new(ai, centres(0.3, 1.0), 1.0, 0).unwrap(), FecgFunction::new(aj, centres(2.1, 1.0), 1.0, 1).unwrap()];
         let mu = Vector::<3>::new(1836.15267343, 1.0, 1.0) / 1838.15267343;
         (go, g, ops, f, vectors(&mu, 0, 2))
     }
@@ -248,8 +249,8 @@ mod tests {
         let mut worst: f64 = 0.0;
         for v in [[w, g, h], [w, g * 0.3 - h, h * 1.7 + g]] {
             let swapped = [v[0], v[2], v[1]];
-            let plain = [element::<3, PlainEcg>(&gi, &gj, &go, &v), element::<3, PlainEcg>(&gj, &gi, &go, &v), element::<3, PlainEcg>(&gi, &gj, &go, &swapped)];
-            let floating = [element::<3, FloatingEcg>(&fi, &fj, &ops, &v), element::<3, FloatingEcg>(&fj, &fi, &ops, &v), element::<3, FloatingEcg>(&fi, &fj, &ops, &swapped)];
+            let plain = [element::<3, Pecg>(&gi, &gj, &go, &v), element::<3, Pecg>(&gj, &gi, &go, &v), element::<3, Pecg>(&gi, &gj, &go, &swapped)];
+            let floating = [element::<3, Fecg>(&fi, &fj, &ops, &v), element::<3, Fecg>(&fj, &fi, &ops, &v), element::<3, Fecg>(&fi, &fj, &ops, &swapped)];
             for x in [plain, floating] {
                 assert!(close(x[1], x[0], 1e-13) && close(x[2], x[0], 1e-13), "{x:?}");
                 worst = worst.max((x[1] / x[0] - 1.0).abs()).max((x[2] / x[0] - 1.0).abs());
@@ -262,24 +263,24 @@ mod tests {
     fn floating_ecgs_at_zero_centres_are_plain_ecgs_and_those_the_closed_form() {
         let (go, [gi, gj], ops, _, v) = three();
         let [w, g, h] = v;
-        let zero = |f: &Gvr<3>| Fecg::new(f.a, Centres::<3>::zeros(), 1.0, 0).unwrap();
-        let got = element::<3, FloatingEcg>(&zero(&gi), &zero(&gj), &ops, &v);
-        let want = element::<3, PlainEcg>(&gi, &gj, &go, &v);
+        let zero = |f: &GvrFunction<3>| FecgFunction::new(f.a, Centres::<3>::zeros(), 1.0, 0).unwrap();
+        let got = element::<3, Fecg>(&zero(&gi), &zero(&gj), &ops, &v);
+        let want = element::<3, Pecg>(&gi, &gj, &go, &v);
         assert!(close(got, want, 1e-14), "{got} vs {want}");
         // eq. (37): 16 τ S/√(πq)
         let binv = (gi.a + gj.a).try_inverse().unwrap();
         let (tau, q) = ((gi.a * g).dot(&(binv * gj.a * h)), w.dot(&(binv * w)));
-        let closed = 16.0 * tau * <PlainEcg as Family<3>>::overlap(&gi, &gj, &go) / (std::f64::consts::PI * q).sqrt();
+        let closed = 16.0 * tau * <Pecg as Family<3>>::overlap(&gi, &gj, &go) / (std::f64::consts::PI * q).sqrt();
         assert!(close(want, closed, 1e-14), "{want} vs eq. (37) {closed}");
         eprintln!("orbit-orbit, floating at s = 0 against plain: {:.1e}; plain against eq. (37): {:.1e}", (got / want - 1.0).abs(), (want / closed - 1.0).abs());
     }
 
-    /// ECG-GVR functions (`gvr_momentum::orbit`, eq. 26c) of (K_I, K_J, N) and global vectors
+    /// ECG-GVR functions (`momentum::orbit`, eq. 26c) of (K_I, K_J, N) and global vectors
     /// varied by `x`, in N_C coordinates.
-    fn gvr_pair<const NC: usize>(a: [Mat<NC>; 2], (ki, kj, n): (u32, u32, u32), x: f64) -> (GvrOps<NC>, [Gvr<NC>; 2]) {
+    fn gvr_pair<const NC: usize>(a: [Mat<NC>; 2], (ki, kj, n): (u32, u32, u32), x: f64) -> (GvrOps<NC>, [GvrFunction<NC>; 2]) {
         let go = GvrOps::new(Operators { lambda: Mat::<NC>::identity() * 0.5, pairs: vec![], cm_mass: None }, n, 3).unwrap();
         let u = |y: f64| Vector::<NC>::from_fn(|k, _| (1.3 * k as f64 + y).sin());
-        (go.clone(), [Gvr::new(a[0], u(x), ki, 1.0, &go, 0).unwrap(), Gvr::new(a[1], u(x + 2.0), kj, 1.0, &go, 1).unwrap()])
+        (go.clone(), [GvrFunction::new(a[0], u(x), ki, 1.0, &go, 0).unwrap(), GvrFunction::new(a[1], u(x + 2.0), kj, 1.0, &go, 1).unwrap()])
     }
 
     #[test]
@@ -292,7 +293,7 @@ mod tests {
         for (case, powers) in [(1, 0, 1), (1, 1, 0), (0, 0, 2), (0, 0, 0)].into_iter().enumerate() {
             let a = [exponent::<2>(0.3 + case as f64), exponent::<2>(1.7 + case as f64)];
             let (go, [fi, fj]) = gvr_pair(a, powers, 0.4 * case as f64);
-            let got = <EcgGvr as Family<2>>::ORBIT(&fi, &fj, &go, &v);
+            let got = ecg_gvr::momentum::orbit::<2>(&fi, &fj, &go, &v);
             let zero = Centres::<2>::zeros();
             let (si, sj) = ((&fi.u, fi.k, go.n_ang), (&fj.u, fj.k, go.n_ang));
             let want = quadrature::<2, 5>((&fi.a, &zero, Some(si)), (&fj.a, &zero, Some(sj)), &v, 4, 1.0)
@@ -308,13 +309,13 @@ mod tests {
         let (go, [gi, gj], _, _, v) = three();
         let [w, g, h] = v;
         let (gvr_go, [fi, fj]) = gvr_pair([gi.a, gj.a], (0, 0, 0), 0.0);
-        let (got, want) = (<EcgGvr as Family<3>>::ORBIT(&fi, &fj, &gvr_go, &v), element::<3, PlainEcg>(&gi, &gj, &go, &v));
+        let (got, want) = (ecg_gvr::momentum::orbit::<3>(&fi, &fj, &gvr_go, &v), element::<3, Pecg>(&gi, &gj, &go, &v));
         assert!(close(got, want, 1e-13), "K = N = 0: {got} vs {want}");
         let mut worst = (got / want - 1.0).abs();
         let (gvr_go, [fi, fj]) = gvr_pair([gi.a, gj.a], (2, 1, 1), 0.7);
         for v in [[w, g, h], [w, g * 0.3 - h, h * 1.7 + g]] {
             let x = [(&fi, &fj, v), (&fj, &fi, v), (&fi, &fj, [v[0], v[2], v[1]])]
-                .map(|(bra, ket, v)| <EcgGvr as Family<3>>::ORBIT(bra, ket, &gvr_go, &v));
+                .map(|(bra, ket, v)| ecg_gvr::momentum::orbit::<3>(bra, ket, &gvr_go, &v));
             assert!(close(x[1], x[0], 1e-12) && close(x[2], x[0], 1e-12), "{x:?}");
             worst = worst.max((x[1] / x[0] - 1.0).abs()).max((x[2] / x[0] - 1.0).abs());
         }
@@ -330,14 +331,14 @@ mod tests {
         let w = Vector::<2>::new(1.0, -1.0);
         let go = GvrOps::new(Operators { lambda: Mat::<2>::identity() * 0.5, pairs: vec![], cm_mass: None }, 0, 0).unwrap();
         let f = plain(w * w.transpose() * a + mu * mu.transpose() * c_a, c_a, &go, 0);
-        let got = element::<2, PlainEcg>(&f, &f, &go, &vectors(&mu, 0, 1));
+        let got = element::<2, Pecg>(&f, &f, &go, &vectors(&mu, 0, 1));
         let want = -8.0 * a * (2.0 * a / std::f64::consts::PI).sqrt();
         assert!(close(got, want, 1e-14), "{got} vs {want}");
         eprintln!("orbit-orbit of exp(−a r² − c_A R²) against −8a√(2a/π): {:.1e}", (got / want - 1.0).abs());
     }
 
-    /// Drachmann's `<∇φ_I| Λ/r_w |∇φ_J>` (`drachmann::gradient_inv_r`) of floating ECGs, whose
-    /// damped functions move their centres (`Fecg::damped`), against the `δ_ab/r` part of this
+    /// Drachmann's `<∇φ_I| Λ/r_w |∇φ_J>` (`drachmann::gradient::gradient_inv_r`) of floating ECGs, whose
+    /// damped functions move their centres (`FecgFunction::damped`), against the `δ_ab/r` part of this
     /// quadrature with `Λ = g gᵀ`: centres 0.3 to 2.5 apart, three particles, CM-separable exponents.
     #[test]
     fn floating_gradient_inv_r_matches_quadrature() {
@@ -348,11 +349,11 @@ mod tests {
             let ai = separable(&exponent(seed), &mu, 0.7);
             let aj = separable(&exponent(seed + 0.8), &mu, 1.3);
             let (ci, cj) = (centres::<N>(0.3, spread), centres::<N>(2.1, spread));
-            let (fi, fj) = (Fecg::new(ai, ci, 0.7, 0).unwrap(), Fecg::new(aj, cj, 1.3, 1).unwrap());
+            let (fi, fj) = (FecgFunction::new(ai, ci, 0.7, 0).unwrap(), FecgFunction::new(aj, cj, 1.3, 1).unwrap());
             let [w, g, _] = vectors(&mu, 0, 1);
             let ops = Operators { lambda: g * g.transpose(), pairs: vec![], cm_mass: None };
-            let got = super::super::drachmann::gradient_inv_r::<N, FloatingEcg>(&fi, &fj, &ops, &[w]);
-            let want = quadrature::<N, 3>((&ai, &ci, None), (&aj, &cj, None), &[w, g, g], 12, 0.0) * <FloatingEcg as Family<N>>::overlap(&fi, &fj, &ops);
+            let got = super::super::drachmann::gradient::gradient_inv_r::<N, Fecg>(&fi, &fj, &ops, &[w]);
+            let want = quadrature::<N, 3>((&ai, &ci, None), (&aj, &cj, None), &[w, g, g], 12, 0.0) * <Fecg as Family<N>>::overlap(&fi, &fj, &ops);
             assert!(close(got, want, 1e-11), "spread {spread}: {got} vs {want}");
             worst = worst.max((got / want - 1.0).abs());
         }

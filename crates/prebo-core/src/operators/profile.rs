@@ -13,7 +13,7 @@
 use std::sync::OnceLock;
 
 use crate::ecg::{Mat, Vector};
-use crate::families::gvr::gvr_element::gauss_legendre;
+use crate::quadrature::gauss_legendre;
 use crate::families::{Family, Shape};
 
 /// `G(u)` of one pair of functions and one vector `w`.
@@ -128,11 +128,11 @@ mod tests {
     //! overlap extrapolated to `α → ∞` (Richardson).
     use super::*;
     use std::f64::consts::PI;
-    use crate::families::floating::fecg::{erf, Centres, Fecg};
-    use crate::families::floating::FloatingEcg;
-    use crate::families::gvr::gvr_element::{Gvr, GvrOps};
-    use crate::families::gvr::EcgGvr;
-    use crate::families::plain::PlainEcg;
+    use crate::families::fecg::kernel::{erf, Centres, FecgFunction};
+    use crate::families::fecg::Fecg;
+    use crate::families::ecg_gvr::element::{GvrFunction, GvrOps};
+    use crate::families::ecg_gvr::EcgGvr;
+    use crate::families::pecg::Pecg;
     use crate::gradient::{seed, Dual};
     use crate::operators::fixtures::{close, exponent, operators, w, D};
     use crate::operators::{delta, distance, inverse, inverse_square};
@@ -167,16 +167,16 @@ mod tests {
         let u = Vector::<D>::new(1.0, 0.0, 0.0);
         for (si, sj) in [(0.1, 0.9), (1.3, 2.2), (0.4, 0.4)] {
             let (ai, aj) = (exponent(si), exponent(sj));
-            let (gi, gj) = (Gvr::new(ai, u, 0, 1.0, &go, 0).unwrap(), Gvr::new(aj, u, 0, 1.0, &go, 1).unwrap());
-            let s = <PlainEcg as Family<D>>::overlap(&gi, &gj, &go);
+            let (gi, gj) = (GvrFunction::new(ai, u, 0, 1.0, &go, 0).unwrap(), GvrFunction::new(aj, u, 0, 1.0, &go, 1).unwrap());
+            let s = <Pecg as Family<D>>::overlap(&gi, &gj, &go);
             let q = (w().transpose() * (ai + aj).try_inverse().unwrap() * w())[(0, 0)];
             let want = [s * (PI * q).powf(-1.5), 2.0 * s / (PI * q).sqrt(), 2.0 * s * (q / PI).sqrt(), 2.0 * s / q];
-            let (plain, gvr) = (four::<PlainEcg>(&gi, &gj, &go), four::<EcgGvr>(&gi, &gj, &go));
+            let (plain, gvr) = (four::<Pecg>(&gi, &gj, &go), four::<EcgGvr>(&gi, &gj, &go));
             for k in 0..4 {
                 assert!(close(plain[k], want[k], 1e-13), "operator {k}: {} vs {}", plain[k], want[k]);
                 assert!(close(gvr[k], want[k], 1e-13), "operator {k}, ECG-GVR: {} vs {}", gvr[k], want[k]);
             }
-            let coulomb = <PlainEcg as Family<D>>::element(&gi, &gj, &go).v;
+            let coulomb = <Pecg as Family<D>>::element(&gi, &gj, &go).v;
             assert!(close(plain[1], coulomb, 1e-13), "1/r {} vs the Coulomb element {coulomb}", plain[1]);
         }
     }
@@ -186,18 +186,18 @@ mod tests {
         let ops = operators(vec![(w(), 1.0)]);
         let centres = |x: f64, spread: f64| Centres::<D>::from_fn(|i, c| spread * (x + i as f64 * 1.1 + c as f64 * 0.37).cos());
         for spread in [0.0, 0.05, 1.0, 4.0] {
-            let (fi, fj) = (Fecg::new(exponent(0.2), centres(0.3, spread), 1.0, 0).unwrap(), Fecg::new(exponent(1.7), centres(2.1, spread), 1.0, 1).unwrap());
+            let (fi, fj) = (FecgFunction::new(exponent(0.2), centres(0.3, spread), 1.0, 0).unwrap(), FecgFunction::new(exponent(1.7), centres(2.1, spread), 1.0, 1).unwrap());
             let b = fi.a + fj.a;
             let binv = b.try_inverse().unwrap();
             let m = w().transpose() * binv * (fi.a * fi.s + fj.a * fj.s);
             let (q, m2) = ((w().transpose() * binv * w())[(0, 0)], m.norm_squared());
-            let (s, lambda) = (<FloatingEcg as Family<D>>::overlap(&fi, &fj, &ops), m2 / q);
-            let got = four::<FloatingEcg>(&fi, &fj, &ops);
+            let (s, lambda) = (<Fecg as Family<D>>::overlap(&fi, &fj, &ops), m2 / q);
+            let got = four::<Fecg>(&fi, &fj, &ops);
             let delta = s * (PI * q).powf(-1.5) * (-lambda).exp();
             let inv_r = if m2 > 0.0 { s * erf(m2.sqrt() / q.sqrt()) / m2.sqrt() } else { 2.0 * s / (PI * q).sqrt() };
             let r = s * ((q / PI).sqrt() * (-lambda).exp() + (m2 + 0.5 * q) * inv_r / s);
             let inv_r2 = 2.0 * s / q * integral(4000, |x| (-lambda * (1.0 - x * x)).exp());
-            let coulomb = <FloatingEcg as Family<D>>::element(&fi, &fj, &ops).v;
+            let coulomb = <Fecg as Family<D>>::element(&fi, &fj, &ops).v;
             for (k, want) in [delta, inv_r, r, inv_r2].into_iter().enumerate() {
                 assert!(close(got[k], want, 2e-13), "spread {spread}, operator {k}: {} vs {want}", got[k]);
             }
@@ -209,8 +209,8 @@ mod tests {
     fn global_vector_functions_match_rules_on_the_damped_overlap() {
         for (ki, kj, n_ang) in [(1, 0, 0), (2, 1, 1), (1, 3, 2), (12, 15, 1)] {
             let go = GvrOps::new(operators(vec![(w(), 1.0)]), n_ang, 15).unwrap();
-            let gi = Gvr::new(exponent(0.5), Vector::<D>::new(0.3, 1.0, -0.4), ki, 1.0, &go, 0).unwrap();
-            let gj = Gvr::new(exponent(1.1), Vector::<D>::new(-0.7, 0.2, 0.9), kj, 1.0, &go, 1).unwrap();
+            let gi = GvrFunction::new(exponent(0.5), Vector::<D>::new(0.3, 1.0, -0.4), ki, 1.0, &go, 0).unwrap();
+            let gj = GvrFunction::new(exponent(1.1), Vector::<D>::new(-0.7, 0.2, 0.9), kj, 1.0, &go, 1).unwrap();
             let p = Profile::<D, EcgGvr>::of(&gi, &gj, &go, &w());
             let q = p.q;
             let damped = |alpha: f64| {

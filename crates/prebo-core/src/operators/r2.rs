@@ -37,11 +37,11 @@ mod tests {
     //! plain ECGs, and for K, N > 0 against central differences of the damped overlap in α.
     use super::*;
     use crate::ecg::Gaussian;
-    use crate::families::floating::fecg::{self, Centres, Fecg};
-    use crate::families::floating::FloatingEcg;
-    use crate::families::gvr::gvr_element::{Gvr, GvrOps};
-    use crate::families::gvr::EcgGvr;
-    use crate::families::plain::{pecg, PlainEcg};
+    use crate::families::fecg::kernel::{Centres, FecgFunction};
+    use crate::families::fecg::{self, Fecg};
+    use crate::families::ecg_gvr::element::{GvrFunction, GvrOps};
+    use crate::families::ecg_gvr::EcgGvr;
+    use crate::families::pecg::{self, Pecg};
     use crate::operators::fixtures::{close, exponent, w, D};
 
     fn operators() -> crate::ecg::Operators<D> {
@@ -54,11 +54,11 @@ mod tests {
         let u = Vector::<D>::new(1.0, 0.0, 0.0);
         for (si, sj) in [(0.1, 0.9), (1.3, 2.2), (0.4, 0.4)] {
             let (ai, aj) = (exponent(si), exponent(sj));
-            let (gi, gj) = (Gvr::new(ai, u, 0, 1.0, &go, 0).unwrap(), Gvr::new(aj, u, 0, 1.0, &go, 1).unwrap());
-            let s = pecg::element(&Gaussian::new(ai, 1.0, 0).unwrap(), &Gaussian::new(aj, 1.0, 1).unwrap(), &go.ops).s;
+            let (gi, gj) = (GvrFunction::new(ai, u, 0, 1.0, &go, 0).unwrap(), GvrFunction::new(aj, u, 0, 1.0, &go, 1).unwrap());
+            let s = pecg::kernel::element(&Gaussian::new(ai, 1.0, 0).unwrap(), &Gaussian::new(aj, 1.0, 1).unwrap(), &go.ops).s;
             let b = (ai + aj).try_inverse().unwrap();
             let want = 1.5 * (w().transpose() * b * w())[(0, 0)] * s;
-            let got = element::<D, PlainEcg>(&gi, &gj, &go, &w());
+            let got = element::<D, Pecg>(&gi, &gj, &go, &w());
             assert!(close(got, want, 1e-13), "{got} vs {want}");
             // the ECG-GVR family at K = N = 0 is the same function
             assert!(close(element::<D, EcgGvr>(&gi, &gj, &go, &w()), want, 1e-13));
@@ -70,15 +70,15 @@ mod tests {
         let ops = operators();
         let centres = |x: f64| Centres::<D>::from_fn(|i, c| (x + i as f64 * 1.1 + c as f64 * 0.37).cos());
         let (fi, fj) = (
-            Fecg::new(exponent(0.2), centres(0.3), 1.0, 0).unwrap(),
-            Fecg::new(exponent(1.7), centres(2.1), 1.0, 1).unwrap(),
+            FecgFunction::new(exponent(0.2), centres(0.3), 1.0, 0).unwrap(),
+            FecgFunction::new(exponent(1.7), centres(2.1), 1.0, 1).unwrap(),
         );
         let b = (fi.a + fj.a).try_inverse().unwrap();
         let rbar = b * (fi.a * fi.s + fj.a * fj.s);
         let m = w().transpose() * rbar;
-        let s = fecg::element(&fi, &fj, &ops).s;
+        let s = fecg::kernel::element(&fi, &fj, &ops).s;
         let want = (1.5 * (w().transpose() * b * w())[(0, 0)] + m.norm_squared()) * s;
-        let got = element::<D, FloatingEcg>(&fi, &fj, &ops, &w());
+        let got = element::<D, Fecg>(&fi, &fj, &ops, &w());
         assert!(close(got, want, 1e-12), "{got} vs {want}");
     }
 
@@ -86,8 +86,8 @@ mod tests {
     fn global_vector_functions_match_a_central_difference() {
         for n_ang in [0, 1, 2] {
             let go = GvrOps::new(operators(), n_ang, 3).unwrap();
-            let gi = Gvr::new(exponent(0.5), Vector::<D>::new(0.3, 1.0, -0.4), 2, 1.0, &go, 0).unwrap();
-            let gj = Gvr::new(exponent(1.1), Vector::<D>::new(-0.7, 0.2, 0.9), 3, 1.0, &go, 1).unwrap();
+            let gi = GvrFunction::new(exponent(0.5), Vector::<D>::new(0.3, 1.0, -0.4), 2, 1.0, &go, 0).unwrap();
+            let gj = GvrFunction::new(exponent(1.1), Vector::<D>::new(-0.7, 0.2, 0.9), 3, 1.0, &go, 1).unwrap();
             let ww = w() * w().transpose();
             let damped = |a: f64| <EcgGvr as Family<D>>::overlap(&gi, &<EcgGvr as Family<D>>::damped(&gj, &(ww * a)), &go);
             // central differences at h and h/2, Richardson-extrapolated (error O(h⁴))
