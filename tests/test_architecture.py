@@ -74,7 +74,8 @@ def test_every_path_it_names_exists(name):
 def test_every_code_name_it_names_is_defined(name):
     defined, holds = definitions()
     bare = re.sub(r"(!|\(.*\))$", "", name)
-    if (ROOT / "python" / bare.replace(".", "/")).with_suffix(".py").exists() or bare in RUST:
+    module = ROOT / "python" / bare.replace(".", "/")
+    if module.with_suffix(".py").exists() or (module / "__init__.py").exists() or bare in RUST:
         return
     parts = re.split(r"::|\.", bare)
     assert parts[-1] in defined, f"docs/architecture.md names {name!r}: {parts[-1]!r} is defined nowhere"

@@ -1,7 +1,7 @@
 """Drachmann's regularised ⟨δ³(r_ij)⟩ (prebo.level.drachmann; docs/properties-derivations.md §6, eq. 27)
 on wave functions: hydrogen against the closed form, helium and H2⁺ (floating ECGs, ECG-GVR) against
 the direct ⟨δ⟩. The elements are checked against quadratures in
-crates/prebo-core/src/operators/drachmann.rs."""
+crates/prebo-core/src/operators/drachmann/."""
 import json
 
 import numpy as np

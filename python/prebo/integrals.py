@@ -3,7 +3,7 @@
 - `laboratory(system)`: LFCC, kinetic matrix M; the core returns T (with CM motion) and T_ti,
   the CM kinetic energy eliminated through c_A (Muolo, Mátyus & Reiher, J. Chem. Phys. 148,
   084112 (2018), Sec. IV.B-D, the translationally invariant kinetic energy of a CM-separable
-  function; crates/prebo-core/src/families/plain/pecg.rs).
+  function; crates/prebo-core/src/families/pecg/kernel.rs).
 - `laboratory(system, kinetic="internal")`: LFCC with M - 1 1^T/(2 m_tot), the CM
   kinetic operator removed exactly (an independent check of the elimination).
 - `translationally_invariant(system, coords)`: TICC of a coordinate set x, kinetic

@@ -20,12 +20,12 @@ use crate::path;
 pub enum Kind {
     Pecg,
     EcgGvr,
-    FecgFunction,
+    Fecg,
 }
 
 impl Kind {
     pub fn from_name(name: &str) -> Result<Self> {
-        [Kind::Pecg, Kind::EcgGvr, Kind::FecgFunction]
+        [Kind::Pecg, Kind::EcgGvr, Kind::Fecg]
             .into_iter()
             .find(|k| k.name() == name)
             .ok_or_else(|| CoreError::Unsupported(format!("basis family {name:?} (pecg, ecg-gvr or fecg)")))
@@ -35,7 +35,7 @@ impl Kind {
         match self {
             Kind::Pecg => <Pecg as Family<1>>::NAME,
             Kind::EcgGvr => <EcgGvr as Family<1>>::NAME,
-            Kind::FecgFunction => <Fecg as Family<1>>::NAME,
+            Kind::Fecg => <Fecg as Family<1>>::NAME,
         }
     }
 
@@ -44,7 +44,7 @@ impl Kind {
         match self {
             Kind::Pecg => registry::derived::<Pecg>(),
             Kind::EcgGvr => registry::derived::<EcgGvr>(),
-            Kind::FecgFunction => registry::derived::<Fecg>(),
+            Kind::Fecg => registry::derived::<Fecg>(),
         }
     }
 
@@ -53,7 +53,7 @@ impl Kind {
         match self {
             Kind::Pecg => <Pecg as Family<1>>::FIELDS,
             Kind::EcgGvr => <EcgGvr as Family<1>>::FIELDS,
-            Kind::FecgFunction => <Fecg as Family<1>>::FIELDS,
+            Kind::Fecg => <Fecg as Family<1>>::FIELDS,
         }
     }
 
@@ -62,7 +62,7 @@ impl Kind {
         match self {
             Kind::Pecg => <Pecg as Family<1>>::ORIENTED,
             Kind::EcgGvr => <EcgGvr as Family<1>>::ORIENTED,
-            Kind::FecgFunction => <Fecg as Family<1>>::ORIENTED,
+            Kind::Fecg => <Fecg as Family<1>>::ORIENTED,
         }
     }
 }
@@ -139,7 +139,7 @@ macro_rules! dispatch {
         match $e.kind {
             Kind::Pecg => dispatch!(@dim $e, $f, Pecg, ($($arg),*)),
             Kind::EcgGvr => dispatch!(@dim $e, $f, EcgGvr, ($($arg),*)),
-            Kind::FecgFunction => dispatch!(@dim $e, $f, Fecg, ($($arg),*)),
+            Kind::Fecg => dispatch!(@dim $e, $f, Fecg, ($($arg),*)),
         }
     };
     (@dim $e:expr, $f:ident, $fam:ty, ($($arg:expr),*)) => {

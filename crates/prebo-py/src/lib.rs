@@ -272,7 +272,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_DIM", prebo_core::ecg::MAX_DIM)?;
     m.add("GIT_COMMIT", env!("PREBO_GIT_COMMIT"))?;
     let operators = PyDict::new(m.py());
-    for kind in [Kind::Pecg, Kind::EcgGvr, Kind::FecgFunction] {
+    for kind in [Kind::Pecg, Kind::EcgGvr, Kind::Fecg] {
         operators.set_item(kind.name(), kind.operators())?;
     }
     m.add("OPERATORS", operators)?;

@@ -1,7 +1,8 @@
 """Plain ECGs ("pecg"): φ(r) = exp(-r^T (A ⊗ I_3) r), no parameters beyond A and c_A.
 
 Spherical (N = 0), even-parity functions (Muolo, Mátyus & Reiher, J. Chem. Phys. 148, 084112
-(2018), Sec. III.A); matrix elements by the core's SIMD kernel (crates/prebo-core/src/families/plain/pecg.rs).
+(2018), Sec. III.A); matrix elements by the core's SIMD kernel
+(crates/prebo-core/src/families/pecg/kernel.rs).
 """
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ eigenstate Ψ of T_TI + V with energy E,
 with Λ the kinetic matrix of T_TI = −∇ᵀΛ∇. The right side holds global operators, so in Gaussians,
 which lack the cusp, it converges faster with the basis than the direct ⟨δ³(r_ij)⟩ ("delta"), the
 density at one point. Its elements are the core's "inv_r", "coulomb_inv_r" and "gradient_inv_r"
-(crates/prebo-core/src/operators/drachmann.rs), for every family. ⟨V/r_ij⟩ is in closed form for
+(crates/prebo-core/src/operators/drachmann/), for every family. ⟨V/r_ij⟩ is in closed form for
 plain ECGs (eq. 19) and a quadrature over the family's damped ⟨1/r⟩ elements for floating ECGs and
 ECG-GVR (eq. 38), tens of damped elements per product (H2-500's properties take 55 s with it,
 26 s without): `CLOSED_FORM` says where it is cheap.

@@ -16,7 +16,7 @@ from .particles import ALIASES, Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
 
 #: N: bound few-body states have far smaller ones (H₂'s last rotational level has N = 31); the
-#: ECG-GVR quadrature holds 2 K + N ≤ 1021 (crates/prebo-core/src/families/gvr/)
+#: ECG-GVR quadrature holds 2 K + N ≤ 1021 (crates/prebo-core/src/families/ecg_gvr/)
 N_RANGE = Integer(0, 1000)
 #: a targeted root index: below the largest basis (validation.MAX_SIZE)
 ROOT_RANGE = Integer(0, MAX_SIZE - 1)
