@@ -314,7 +314,9 @@ def test_no_printed_number_is_cut_short(run_dir, columns):
 
 
 @pytest.mark.parametrize("argv,line", [
-    (["energy", "he.json", "--bogus"], "prebo: error: unrecognized arguments: --bogus (see prebo --help)"),
+    (["energy", "he.json", "--bogus"], "prebo: error: energy: unrecognized arguments: --bogus "
+                                       "(see prebo energy --help)"),
+    (["run", "in.toml", "extra"], "prebo: error: run: unrecognized arguments: extra (see prebo run --help)"),
     (["nosuch"], "prebo: error: argument command: invalid choice: 'nosuch' (choose from 'run', 'properties', "
                  "'energy', 'import', 'export', 'plot') (see prebo --help)"),
     (["run", "--budget", "0"], "prebo: error: run: argument --budget: '0' is not a number of seconds above 0 "
@@ -329,6 +331,7 @@ def test_no_printed_number_is_cut_short(run_dir, columns):
 ])
 def test_command_line_errors_name_the_program_once(argv, line):
     """Issue 55, item 7: an unknown option printed `prebo: error: prebo: unrecognized arguments` (and a
-    subcommand's errors `prebo: error: prebo energy: ...`)."""
+    subcommand's errors `prebo: error: prebo energy: ...`); a subcommand's unknown argument is
+    refused by that subcommand, which names its own --help."""
     r = prebo_process(*argv)
     assert r.returncode == 2 and r.stdout == "" and r.stderr == line + "\n", r.stderr

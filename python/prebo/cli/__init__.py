@@ -31,6 +31,7 @@ def parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
     for module in COMMANDS:
         module.add(sub)
+    p.commands = sub.choices  # each subcommand's parser by name
     return p
 
 
@@ -50,7 +51,10 @@ def main(argv=None) -> int:
 
 def command(argv) -> int:
     """The exit status of the command `argv` (main); SystemExit from argparse."""
-    args = parser().parse_args(argv)
+    p = parser()
+    args, extra = p.parse_known_args(argv)
+    if extra:  # refused by the subcommand given them, which names its own --help
+        p.commands[args.command].error(f"unrecognized arguments: {' '.join(extra)}")
     try:
         world()  # under MPI: the ranks' threads set before the core first runs (parallel.py)
         return args.func(args)
