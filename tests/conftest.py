@@ -1,5 +1,6 @@
 import itertools
 import json
+import os
 import subprocess
 import sys
 import time
@@ -9,6 +10,9 @@ import numpy as np
 import pytest
 
 pytest.register_assert_rewrite("gvr_reference", "fecg_reference")  # helper modules' asserts explained
+
+#: a test that makes FIFOs, device nodes or sockets: POSIX only
+POSIX_FILES = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs, device nodes and sockets are POSIX files")
 
 import prebo  # noqa: E402
 from prebo.cli import main  # noqa: E402

@@ -19,7 +19,7 @@ from prebo.integrals import laboratory
 from prebo.io import ecgpack
 from prebo.system.young import young_operator, young_product, young_string
 
-from conftest import ROOT
+from conftest import POSIX_FILES, ROOT
 
 DATA = Path(__file__).parent / "data" / "ecgpack"
 HE = DATA / "ecgpack-He4-490.inout.txt"
@@ -140,7 +140,7 @@ def test_a_file_that_is_neither_a_basis_json_nor_an_ecgpack_file_is_refused_in_o
                                        "(a header line, BASIS_TYPE, first)\n")
 
 
-@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="a FIFO is a POSIX file")
+@POSIX_FILES
 def test_a_basis_in_a_fifo_is_read_once_and_one_that_never_ends_is_refused_by_its_start(inout, tmp_path):
     """A FIFO is read once: a basis written into one is evaluated; one whose writer sent zeros and
     keeps it open (as /dev/zero) is refused by its first bytes, not read until it ends."""

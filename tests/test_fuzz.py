@@ -28,7 +28,7 @@ from prebo.cli import main
 from prebo.errors import PreboError
 from prebo.optimise import SETTINGS
 
-from conftest import h_input, prebo_process, toml_text
+from conftest import POSIX_FILES, h_input, prebo_process, toml_text
 
 ROOT = Path(__file__).resolve().parents[1]
 BASES = ROOT / "examples" / "bases"
@@ -51,7 +51,6 @@ TOML = EDGES | EDGES | st.recursive(SCALARS.filter(lambda v: v is not None),
                                     lambda inner: st.lists(inner, max_size=3)
                                     | st.dictionaries(st.text("abcNe", min_size=1, max_size=3), inner, max_size=2),
                                     max_leaves=4)
-POSIX_FILES = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs, device nodes and sockets are POSIX files")
 
 
 #: positions a corruption most often matters at (the state, the particles, the functions, the symmetry)

@@ -25,12 +25,13 @@ from prebo.cli import main
 from prebo.errors import InputError, OutputError
 from prebo.optimise.cursor import PHASES
 
+from conftest import POSIX_FILES
+
 ROOT = Path(__file__).resolve().parents[1]
 LI = ROOT / "tests" / "data" / "ecgpack" / "ecgpack-Li7-100.inout.txt"
 H_RUN = ROOT / "examples" / "bases" / "auto-h"  # a run of 20 functions: its checkpoint and result
 PREBO = [sys.executable, "-m", "prebo"]
 H_TOML = '[system]\nparticles = ["p", "e"]\n[basis]\nsize = 3\n[optimiser]\ntrials = 4\nseed = 3\n'
-POSIX_FILES = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs, device nodes and sockets are POSIX files")
 
 
 def cli(capsys, *args):
