@@ -9,7 +9,7 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.optimise`: `Optimiser` settings and `optimise`, the stochastic variational driver;
 - `prebo.level`: the results of a basis's levels: `evaluate`, their energies; `properties`, a
   level's energy, expectation values and their corrections; `densities`, the distance
-  distributions of levels;
+  distributions of levels; `transitions`, the electric-dipole lines between two bases' levels;
 - `prebo.system.thresholds`: the lowest dissociation threshold, below which a state is bound;
 - `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
 - `prebo.cli`, `prebo.plot`: the command line and convergence plots;
@@ -24,6 +24,7 @@ from .errors import PreboError
 from .optimise import Optimiser, optimise
 from .level.evaluate import evaluate
 from .level.properties import densities, properties
+from .level.transitions import transitions
 from .system import Particle, State, System, particle
 
 __all__ = [
@@ -32,6 +33,6 @@ __all__ = [
     # coordinates
     "CoordinateSet", "jacobi", "heavy_particle_centred", "cm_centred", "all_sets",
     # basis, solving, results
-    "Basis", "Optimiser", "optimise", "evaluate", "properties", "densities", "PreboError",
+    "Basis", "Optimiser", "optimise", "evaluate", "properties", "densities", "transitions", "PreboError",
 ]
 from .provenance import VERSION as __version__  # noqa: E402 (the package metadata's)

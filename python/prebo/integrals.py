@@ -122,6 +122,16 @@ class Representation:
         engine, params = self.engine(f), self.arrays(f)
         return self.shared().instances(lambda part: engine.operator(name, params, part), np.ascontiguousarray(v))
 
+    def between(self, name: str, bra, ket, v: np.ndarray, momentum: bool = False) -> np.ndarray:
+        """(p, nb_bra, nb_ket) matrices of the core's two-basis operator `name` ("dipole", "velocity",
+        "overlap"; crates/prebo-core/src/registry.rs) between the normalised functions of the basis
+        `bra` and those of the basis `ket`, symmetrised by this representation's operations (the
+        kets' images), one per laboratory-frame vector v (p, n), position-like or, with `momentum`,
+        momentum-like (`vectors`). The dipole's forms join a bra of N = 0 to a ket of N = 1 and are
+        reduced elements <1‖O‖0> (level/transitions.py)."""
+        v = self.vectors(v, momentum) if len(v) else np.zeros((0, 0))
+        return self.engine(bra).between(name, self.arrays(bra), self.engine(ket), self.arrays(ket), v)
+
     def density(self, f, w: np.ndarray, C: np.ndarray, r: np.ndarray) -> np.ndarray:
         """The spherically averaged densities (p, states, len(r)) of r_w (bohr⁻³) at the radii `r`
         (bohr) in the states Σ_k C_ks Yφ_k of the basis `f`, one per laboratory-frame vector w (p, n)."""
