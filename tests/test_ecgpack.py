@@ -439,7 +439,8 @@ def test_rg_1p_round_trips_through_import_and_export(tmp_path):
     ecgpack.write_inout(b1, tmp_path / "x.inout.txt", source=f1)
     f2 = ecgpack.parse_inout(tmp_path / "x.inout.txt")
     assert f2.basis_type == "RG_1P" and np.array_equal(f2.z, f1.z) and np.array_equal(f2.L, f1.L)
-    assert np.array_equal(f2.masses, f1.masses) and " MASSES   1.0000000000000000E+30 " in (tmp_path / "x.inout.txt").read_text()
+    assert np.array_equal(f2.masses, f1.masses)
+    assert " MASSES   1.0000000000000000E+30 " in (tmp_path / "x.inout.txt").read_text()
     assert f2.energy == e1 and prebo.evaluate(f2.to_basis())["energy"] == e1
 
 
@@ -452,7 +453,8 @@ def test_rg_1p_round_trips_through_the_command_line(tmp_path, capsys):
     assert main(["import", str(HE_2P), "--out", str(tmp_path / "p.json")]) == 0
     stored = json.loads((tmp_path / "p.json").read_text())
     assert stored["basis_type"] == "ecg-gvr" and stored["system"]["particles"][0]["mass"] == "inf"
-    assert main(["export", str(tmp_path / "p.json"), "--format", "ecgpack", "--out", str(tmp_path / "p.inout.txt")]) == 0
+    out = tmp_path / "p.inout.txt"
+    assert main(["export", str(tmp_path / "p.json"), "--format", "ecgpack", "--out", str(out)]) == 0
     capsys.readouterr()
     f1, f2 = ecgpack.parse_inout(HE_2P), ecgpack.parse_inout(tmp_path / "p.inout.txt")
     A1, A2 = f1.exponents(), f2.exponents()
@@ -534,3 +536,45 @@ def test_ecg_gvr_functions_rg_1p_does_not_hold_are_not_exported(tmp_path, capsys
     basis.u[4] = [-1.0, 0.5, 0.5]  # the electrons' centre relative to the nucleus
     with pytest.raises(prebo.errors.UnsupportedError, match=r"function 4: .* u = \[0.5, 0.5, 0.0\]"):
         ecgpack.write_inout(basis, tmp_path / "y.inout.txt", energy=0.0)
+
+
+def test_the_he_samples_give_the_transition_moments_ecgpack_prints():
+    """What the import means, checked beyond the energy: prebo's eigenvectors of the two imported
+    bases (normalised functions; an RG_1P function's M = 1 partner has its M = 0 function's
+    matrices), put on ecgpack's own functions z_i exp(−rᵀ𝒜r) in its coordinates r_i = R_{i+1} − R_1,
+    give the values ecgpack's RG_0S-1P sample README prints, cut to nine decimals (iDynbek/ecgpack, commit ad8e8f3,
+    RG_0S-1P/sample_input/transition_dipole_moment_He/dipole_moment/README.md): ΔE = 0.779 287 387,
+    ⟨S|z|P⟩ = 0.395 665 167 (its z is d_z = Σ_i (q_{i+1} − Q m_{i+1}/m_tot) z_i, −(z_1 + z_2) here) and
+    ⟨S|P_z|P⟩ = i 0.314 193 144, P_z = −Σ_a (q_a/m_a) p_a,z (matelem.f90, main.f90); the sign of
+    either eigenvector is free. Elements by the closed forms S = (πⁿ/|A|)^{3/2},
+    ⟨e^{-A_I}|w·r_z|(v·r)_z e^{-A_J}⟩ = S wᵀ(A_I + A_J)⁻¹v/2 and
+    ⟨e^{-A_I}|∂/∂z_i|(v·r)_z e^{-A_J}⟩ = S (A_I (A_I + A_J)⁻¹v)_i."""
+    f0, f1 = ecgpack.parse_inout(HE_1S), ecgpack.parse_inout(HE_2P)
+    r0, r1 = prebo.evaluate(f0.to_basis()), prebo.evaluate(f1.to_basis())
+    A0, A1 = f0.exponents(), f1.exponents()
+    v = np.eye(2)[f1.z - 1]
+    swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # P23 in r: (1 + P23), ecgpack's Y and prebo's operator
+
+    def overlap(A, B):
+        return (np.pi**2 / np.linalg.det(A + B)) ** 1.5
+
+    def p_norm(A, w):
+        return np.sqrt(overlap(A, A) * (w @ np.linalg.solve(2 * A, w)) / 2)
+
+    d, velocity, s1 = np.zeros((3, 10, 10))
+    for I in range(10):
+        for J in range(10):
+            for T in (np.eye(2), swap):  # the image of function J: e^{-rᵀ Tᵀ A T r} (Tᵀv · r)_z
+                B, w = T.T @ A1[J] @ T, T.T @ v[J]
+                S, Bi = overlap(A0[I], B), np.linalg.inv(A0[I] + B)
+                norms = np.sqrt(overlap(A0[I], A0[I])) * p_norm(A1[J], v[J])
+                d[I, J] += S * (-np.ones(2) @ Bi @ w) / 2 / norms
+                velocity[I, J] += S * (np.ones(2) @ A0[I] @ Bi @ w) / norms
+                norms = p_norm(A1[I], v[I]) * p_norm(A1[J], v[J])
+                s1[I, J] += overlap(A1[I], B) * (v[I] @ np.linalg.solve(A1[I] + B, w)) / 2 / norms
+    c0, c1 = np.asarray(r0["coefficients"]), np.asarray(r1["coefficients"])
+    assert c1 @ s1 @ c1 == pytest.approx(1.0, rel=1e-13)  # the M = 0 functions have the same matrices
+    z, p = c0 @ d @ c1, c0 @ velocity @ c1
+    for value, printed in ((r1["energy"] - r0["energy"], 0.779287387), (abs(z), 0.395665167), (abs(p), 0.314193144)):
+        assert 0 <= value - printed < 1e-9, (value, printed)  # the README's nine decimals, cut off
+    assert np.sign(p) == -np.sign(z)  # i⟨P_z⟩... = (E_S − E_P)⟨z⟩ in the exact limit: opposite signs here

@@ -277,9 +277,9 @@ class System:
 
     @classmethod
     def from_dict(cls, d: dict, symmetry: dict | None = None) -> "System":
-        """The system of `to_dict` (a mass INFINITE read as ∞), and the operator of a `Symmetriser.as_dict` block `symmetry`
-        checked against its state: the state's own (up to a factor and rounding), or one of the
-        state kept explicitly (`Symmetriser.check_projector`, an ecgpack import's); InputError,
+        """The system of `to_dict` (a mass INFINITE read as ∞), and the operator of a
+        `Symmetriser.as_dict` block `symmetry` checked against its state: the state's own (up to a
+        factor and rounding), or one of the state kept explicitly (`Symmetriser.check_projector`, an ecgpack import's); InputError,
         SpinError naming what is malformed, or that the stored operator is not that of the state."""
         if not isinstance(d, dict) or "particles" not in d:
             raise InputError("system: missing 'particles'")
