@@ -27,6 +27,7 @@ the exact one.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -200,11 +201,12 @@ class Representation:
 def laboratory(system: System, kinetic: str = "M") -> Representation:
     """The laboratory-frame representation of `system`: kinetic matrix M = diag(1/(2 m_i)) with the
     CM kinetic energy eliminated through c_A (kinetic="M"), or M - 1 1^T/(2 m_tot), the CM
-    kinetic operator removed exactly (kinetic="internal", no T_ti elimination)."""
+    kinetic operator removed exactly (kinetic="internal", no T_ti elimination). With an infinite
+    mass the CM is that particle, which has no kinetic term: T_ti = T (cm_mass None)."""
     w, q = system.coulomb_pairs()
     sym = system.symmetriser
-    if kinetic == "M":
-        lam, cm = system.M, system.m_total
+    if kinetic == "M":  # an infinite mass: the CM does not move, no kinetic energy to eliminate (T_ti = T)
+        lam, cm = system.M, system.m_total if math.isfinite(system.m_total) else None
     elif kinetic == "internal":
         lam, cm = system.M_internal, None
     else:
