@@ -109,3 +109,17 @@ def test_the_dynamic_polarisability_grows_towards_the_first_pole_and_stops_there
     with pytest.raises(InputError, match="first pole"):
         polarisability(hydrogen(0), hydrogen(1), omega=r["pole"])
 
+
+
+def test_ecgpack_he_samples_give_the_elements_its_readme_prints():
+    # ecgpack's RG_0S-1P He sample (tests/data/ecgpack/README.md): its README prints, digits cut off,
+    # dE = 0.779 287 387, <S|z|P> = 0.395 665 167 for the M = 0 component (<1‖d‖0> = √3 <1 0|d_z|0 0>)
+    # and <S|P_z|P> = i 0.314 193 144 with P_z the electrons' momentum (|velocity form| × ΔE / √3)
+    from prebo.cli.files import load_basis
+
+    data = __import__("pathlib").Path(__file__).parent / "data" / "ecgpack"
+    lower, upper = (load_basis(data / f"ecgpack-He-inf-{s}-10.inout.txt")[0] for s in ("1S", "2P"))
+    (line,) = transitions(lower, upper)["lines"]
+    assert 0.779287387 <= line["Eh"] < 0.779287388
+    assert 0.395665167 <= abs(line["length"]) / 3 ** 0.5 < 0.395665168
+    assert 0.314193144 <= abs(line["velocity"]) * line["Eh"] / 3 ** 0.5 < 0.314193145
