@@ -554,7 +554,7 @@ def _coordinate_indices(basis: Basis, hpc) -> np.ndarray | None:
     fam = basis.family
     if fam.parameters == ("A", "c_A"):
         return None
-    if fam.name != "ecg-gvr" or basis.N != 1:
+    if fam.parameters != ("A", "u", "K", "c_A") or basis.N != 1:
         raise UnsupportedError(f"ecgpack's {S_TYPE} and {P_TYPE} formats hold plain ECGs and ECG-GVR functions of "
                                f"N = 1, not {fam.name} functions of N = {basis.N}")
     ux = hpc.transform_vectors_to_x(basis.u)

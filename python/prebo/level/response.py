@@ -20,7 +20,7 @@ import scipy.linalg
 
 from .. import eigen
 from ..basis import Basis
-from ..errors import InputError, UnsupportedError
+from ..errors import InputError, LinearDependenceError, UnsupportedError
 from ..integrals import laboratory
 from .evaluate import evaluate
 from .transitions import dipole_vectors, forbidden
@@ -73,7 +73,11 @@ def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,
     de = states.energies - E0
 
     def solved(shift: float) -> float:
-        return float(r @ scipy.linalg.solve(H - (E0 + shift) * S, r, assume_a="pos"))
+        try:
+            return float(r @ scipy.linalg.solve(H - (E0 + shift) * S, r, assume_a="pos"))
+        except np.linalg.LinAlgError:
+            raise LinearDependenceError(f"polarisability: H − (E₀ {shift:+.6g}) S of the response basis is not "
+                                        "positive definite in double precision (a nearly dependent basis)") from None
 
     alpha = [(solved(x) + solved(-x)) / 3 for x in omegas]
     sos = [float(np.sum(strengths * (1 / (de - x) + 1 / (de + x)))) / 3 for x in omegas]
