@@ -14,10 +14,10 @@ from prebo.level.transitions import ALPHA, AU_TIME, dipole_vectors, transitions
 EXPONENTS = 0.002 * 1.7 ** np.arange(40)
 
 
-def hydrogen(N: int, exponents=EXPONENTS, kind=None, c_A=0.7) -> prebo.Basis:
+def hydrogen(N: int, exponents=EXPONENTS, kind=None, c_A=0.7, nucleus="p") -> prebo.Basis:
     """p e of N = 0 (plain ECGs) or N = 1 (ECG-GVR, K = 0, u = r_e − r_p), the Gaussians exp(−a r²)
     of the relative coordinate with one CM exponent c_A."""
-    system = prebo.System(["p", "e"], N=N, parity=(-1) ** N)
+    system = prebo.System([nucleus, "e"], N=N, parity=(-1) ** N)
     coords = jacobi(system.masses)
     A = np.array([coords.to_lab(np.array([[a]]), c_A) for a in exponents])
     kind = kind or ("pecg" if N == 0 else "ecg-gvr")
@@ -82,10 +82,8 @@ def test_a_plain_bra_equals_the_ecg_gvr_bra_at_k_0():
 def test_bad_pairs_are_refused_in_one_line():
     with pytest.raises(InputError, match="one symmetry"):
         transitions(hydrogen(0), hydrogen(0))
-    d = prebo.Basis(prebo.System(["d", "e"], N=1, parity=-1), hydrogen(1).A, hydrogen(1).c_A, kind="ecg-gvr",
-                    u=hydrogen(1).u, K=hydrogen(1).K)
     with pytest.raises(InputError, match="different particles"):
-        transitions(hydrogen(0), d)
+        transitions(hydrogen(0), hydrogen(1, nucleus="d"))
 
 
 def test_the_static_polarisability_of_hydrogen_is_nine_halves_over_mu_cubed():
@@ -123,3 +121,100 @@ def test_ecgpack_he_samples_give_the_elements_its_readme_prints():
     assert 0.779287387 <= line["Eh"] < 0.779287388
     assert 0.395665167 <= abs(line["length"]) / 3 ** 0.5 < 0.395665168
     assert 0.314193144 <= abs(line["velocity"]) * line["Eh"] / 3 ** 0.5 < 0.314193145
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """basis.json files of hydrogen 1s and 2p (8 functions), H 2p with a deuteron, and a floating ECG basis."""
+    d = tmp_path_factory.mktemp("lines")
+    few = EXPONENTS[::5]
+    hydrogen(0, few).save(d / "s.json")
+    hydrogen(1, few).save(d / "p.json")
+    hydrogen(1, few, nucleus="d").save(d / "dp.json")
+    s = hydrogen(0, few)
+    prebo.Basis(s.system, s.A, s.c_A, kind="fecg", s=np.zeros((len(s), 2, 3))).save(d / "f.json")
+    (d / "run").mkdir()
+    hydrogen(1, few).save(d / "run" / "basis.json")
+    (d / "broken.json").write_text('{"format": "prebo-basis", "version": 1, "system": ')
+    return d
+
+
+def test_the_command_prints_every_line_and_its_json(files, capsys):
+    from prebo.cli import main
+
+    assert main(["transitions", str(files / "s.json"), str(files / "run"), "--json"]) == 0
+    r = __import__("json").loads(capsys.readouterr().out)
+    assert r == transitions(prebo.Basis.load(files / "s.json"), prebo.Basis.load(files / "p.json"))
+    assert main(["transitions", str(files / "s.json"), str(files / "p.json"), "--roots", "2", "3"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("(N=0+) →") + out.count("(N=1−) →") == 6 and "radiative lifetimes" in out
+
+
+@pytest.mark.parametrize("args, words", [
+    (("s.json", "s.json"), "one symmetry"),
+    (("s.json", "dp.json"), "different particles"),
+    (("f.json", "p.json"), "no definite N"),
+    (("s.json", "broken.json"), "broken.json"),
+    (("s.json", "missing.json"), "missing.json"),
+    (("s.json", "p.json", "--roots", "1", "2", "3"), "--roots"),
+    (("s.json", "p.json", "--roots", "99"), "roots"),
+])
+def test_bad_input_is_one_line(files, capsys, args, words):
+    from conftest import cli_error
+
+    err = cli_error(capsys, "transitions", *(str(files / a) if a.endswith("json") else a for a in args))
+    assert words in err, err
+
+
+def test_a_forbidden_pair_is_reported_as_such_never_as_a_number():
+    # para H2+ (N = 0) and ortho H2+ (N = 1): the protons' spin states differ
+    from prebo.cli.files import load_basis
+
+    bases = __import__("pathlib").Path(__file__).parent.parent / "examples" / "bases"
+    para, ortho = (load_basis(bases / name / "basis.json")[0] for name in ("h2plus-gvr", "h2plus-n1"))
+    (line,) = transitions(para, ortho)["lines"]
+    assert line["forbidden"].startswith("spin-forbidden") and "length" not in line and "einstein_A" not in line
+
+
+def test_the_polarisability_command_prints_alpha_and_draws_it(files, capsys, tmp_path):
+    from prebo.cli import main
+
+    args = ["polarisability", str(files / "s.json"), str(files / "p.json")]
+    assert main(args + ["--omega", "0", "0.2", "--json"]) == 0
+    r = __import__("json").loads(capsys.readouterr().out)
+    want = prebo.polarisability(prebo.Basis.load(files / "s.json"), prebo.Basis.load(files / "p.json"), [0.0, 0.2])
+    assert r == want and r["alpha"][0] < r["alpha"][1]
+    assert main(args + ["--plot", str(tmp_path / "alpha.png")]) == 0
+    assert (tmp_path / "alpha.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--omega", "5"], "first pole"),
+    (["--points", "10"], "only with --plot"),
+    (["--root", "99"], "root"),
+])
+def test_bad_polarisability_input_is_one_line(files, capsys, extra, words):
+    from conftest import cli_error
+
+    err = cli_error(capsys, "polarisability", files / "s.json", files / "p.json", *extra)
+    assert words in err, err
+
+
+def test_the_polarisability_needs_a_response_basis_of_n_1():
+    with pytest.raises(InputError, match="N = 0"):
+        prebo.polarisability(hydrogen(0), hydrogen(0))
+
+
+def test_a_run_with_a_partner_basis_writes_its_lines_into_result_json(files, tmp_path, capsys):
+    from conftest import cli_error
+    from prebo.cli import main
+
+    (tmp_path / "h.toml").write_text('[system]\nparticles = ["p", "e"]\n[basis]\nsize = 4\n')
+    assert main(["run", str(tmp_path / "h.toml"), "--out", str(tmp_path / "run"), "--quiet",
+                 "--partner", str(files / "p.json")]) == 0
+    r = __import__("json").loads((tmp_path / "run" / "result.json").read_text())
+    want = transitions(prebo.Basis.load(tmp_path / "run" / "basis.json"), prebo.Basis.load(files / "p.json"))
+    assert r["lines"] == {"partner": str(files / "p.json")} | want
+    capsys.readouterr()
+    err = cli_error(capsys, "run", tmp_path / "h.toml", "--out", tmp_path / "other", "--partner", files / "dp.json")
+    assert "--partner" in err and "different particles" in err and not (tmp_path / "other").exists()

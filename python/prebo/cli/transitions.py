@@ -36,7 +36,7 @@ def command(args) -> int:
 
     if len(args.roots) > 2:
         raise PreboError(f"--roots {' '.join(map(str, args.roots))}: one K for both bases, or K_lower K_upper")
-    (lower, t_lower), (upper, t_upper) = (load_basis(_basis_file(p)) for p in (args.lower, args.upper))
+    (lower, t_lower), (upper, t_upper) = (load_basis(basis_file(p)) for p in (args.lower, args.upper))
     threshold = args.threshold or max(t_lower, t_upper)
     try:
         r = transitions(lower, upper, tuple(args.roots * (3 - len(args.roots)))[:2], threshold, args.coordinates)
@@ -49,7 +49,7 @@ def command(args) -> int:
     return 0
 
 
-def _basis_file(path: str) -> str:
+def basis_file(path: str) -> str:
     """`path`, or the basis.json of the run folder `path`."""
     p = Path(path)
     return str(p / "basis.json") if p.is_dir() else path

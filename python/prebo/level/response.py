@@ -23,7 +23,7 @@ from ..basis import Basis
 from ..errors import InputError, LinearDependenceError, UnsupportedError
 from ..integrals import laboratory
 from .evaluate import evaluate
-from .transitions import dipole_vectors, forbidden
+from .transitions import dipole_vectors, forbidden, same_particles
 
 
 def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,
@@ -48,8 +48,7 @@ def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,
     why = forbidden(ground, response)
     if why is not None:
         raise InputError(f"polarisability: the response basis cannot hold the dipole's first-order function ({why})")
-    if [p.to_dict() for p in ground.system.particles] != [p.to_dict() for p in response.system.particles]:
-        raise InputError("polarisability: the two bases are of different particles or masses")
+    same_particles(ground.system, response.system)
     omegas = np.atleast_1d(np.asarray(omega, dtype=float))
     if omegas.ndim != 1 or not np.all(np.isfinite(omegas)):
         raise InputError(f"polarisability: omega = {omega!r}: must be finite frequencies (E_h)")

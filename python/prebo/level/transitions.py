@@ -55,9 +55,11 @@ def forbidden(a: Basis, b: Basis) -> str | None:
     return None
 
 
-def _same_particles(a: Basis, b: Basis) -> None:
-    pa = [p.to_dict() for p in a.system.particles]
-    pb = [p.to_dict() for p in b.system.particles]
+def same_particles(a, b) -> None:
+    """InputError unless the systems `a` and `b` are of the same particles (names, masses, charges,
+    spins, in one order)."""
+    pa = [p.to_dict() for p in a.particles]
+    pb = [p.to_dict() for p in b.particles]
     if pa != pb:
         raise InputError(f"the two bases are of different particles or masses: {pa} and {pb}")
 
@@ -87,7 +89,7 @@ def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: f
         if not b.family.conserves_L:
             raise InputError(f"transitions: a basis of {b.family.name} functions, which have no definite N; "
                              "lines need bases of definite N (pecg, ecg-gvr)")
-    _same_particles(lower, upper)
+    same_particles(lower.system, upper.system)
     states = [b.system.state for b in bases]
     if (states[0].N, states[0].parity) == (states[1].N, states[1].parity) and \
             lower.system.symmetriser.equivalent(upper.system.symmetriser):
