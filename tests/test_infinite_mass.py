@@ -193,3 +193,8 @@ def test_a_stored_infinite_mass_is_only_the_string_inf(he_run, tmp_path, capsys)
     (tmp_path / "b.json").write_text(json.dumps(d))
     err = cli_error(capsys, "energy", tmp_path / "b.json")
     assert "b.json" in err and "mass = 'Infinity': must be" in err, err
+
+
+def test_a_clamped_particle_is_made_again_from_its_dict():
+    p = prebo.particle({"name": "He", "mass": float("inf"), "charge": 2, "spin": 0})
+    assert prebo.particle(p.to_dict()) == p

@@ -8,19 +8,21 @@ below as the basis grows. With r_J = ⟨φ_J‖d‖ψ₀⟩, the reduced element
 
     α(ω) = (1/3) [rᵀ(H − (E₀ + ω)S)⁻¹r + rᵀ(H − (E₀ − ω)S)⁻¹r],   α = α(0) = (2/3) rᵀ(H − E₀S)⁻¹r,
 
-the static value at the minimum, J = −α/2 (a₀³ in atomic units, e² a₀² / E_h). Below the first
-pole ω₁ = E₁ − E₀ (the basis's lowest level of N = 1) H − (E₀ ± ω)S is positive definite. The
-sum over the basis's pseudostates n, (1/3) Σ_n S_n [1/(ΔE_n − ω) + 1/(ΔE_n + ω)], S_n their line
+the static value at the minimum, J = −α/2 (a₀³ in atomic units, e² a₀² / E_h), for an exact ψ₀.
+The minimiser is taken over the directions of the basis its overlap resolves (`eigen.solve`'s
+threshold), through the basis's pseudostates n (S-orthonormal C, energies E_n):
+z = −Σ_n c_n (c_nᵀr)/(E_n − E₀ ∓ ω), and the functional is evaluated at it with the basis's own
+H and S. Below the first pole ω₁ = E₁ − E₀ (the basis's lowest level of N = 1) it is a minimum.
+The sum over states, (1/3) Σ_n S_n [1/(ΔE_n − ω) + 1/(ΔE_n + ω)], S_n = (c_nᵀr)² the line
 strengths, is the same number in exact arithmetic and is reported as a check.
 """
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
 from .. import eigen
 from ..basis import Basis
-from ..errors import InputError, LinearDependenceError, UnsupportedError
+from ..errors import InputError, UnsupportedError
 from ..integrals import laboratory
 from .evaluate import evaluate
 from .transitions import dipole_vectors, forbidden, same_particles
@@ -68,17 +70,16 @@ def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,
     if np.any(above):
         raise InputError(f"polarisability: omega = {omegas[above][0]:.6g} Eh is at or above the first pole "
                          f"{pole:.6g} Eh (the response basis's lowest level of N = 1)")
-    strengths = (states.vectors.T @ r) ** 2
-    de = states.energies - E0
+    C, de = states.vectors, states.energies - E0
+    strengths = (C.T @ r) ** 2
 
-    def solved(shift: float) -> float:
-        try:
-            return float(r @ scipy.linalg.solve(H - (E0 + shift) * S, r, assume_a="pos"))
-        except np.linalg.LinAlgError:
-            raise LinearDependenceError(f"polarisability: H − (E₀ {shift:+.6g}) S of the response basis is not "
-                                        "positive definite in double precision (a nearly dependent basis)") from None
+    def hylleraas(shift: float) -> float:
+        """J[ψ₁] at its minimiser over the basis's resolved directions (the pseudostates C)."""
+        z = -C @ ((C.T @ r) / (de - shift))
+        return float(z @ (H - (E0 + shift) * S) @ z + 2 * z @ r)
 
-    alpha = [(solved(x) + solved(-x)) / 3 for x in omegas]
+    alpha = [-(hylleraas(x) + hylleraas(-x)) / 3 for x in omegas]
     sos = [float(np.sum(strengths * (1 / (de - x) + 1 / (de + x)))) / 3 for x in omegas]
+    J = hylleraas(0.0) / 3
     return {"alpha": alpha, "sum_over_states": sos, "omega": omegas.tolist(), "pole": pole, "energy": E0,
-            "hylleraas": -alpha[0] / 2 if omegas[0] == 0 else -solved(0.0) / 3}
+            "hylleraas": J}

@@ -36,7 +36,8 @@ INFINITE = "inf"
 
 @dataclass(frozen=True)
 class Mass:
-    """A finite mass of the range `finite`, or +∞ (a clamped particle; module docstring)."""
+    """A finite mass of the range `finite`, or +∞ (a clamped particle; module docstring), also as
+    its stored form `INFINITE` (what `Particle.to_dict` gives, so a particle's dict makes it again)."""
 
     finite: Real
 
@@ -46,7 +47,7 @@ class Mass:
         return f"{self.finite.allowed}, or inf (a clamped particle of infinite mass)"
 
     def __call__(self, v) -> float:
-        if isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)) and v == math.inf:
+        if v == INFINITE or isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)) and v == math.inf:
             return math.inf
         return self.finite(v)
 
