@@ -88,7 +88,7 @@ LEVELS = {
     "he-2-1s": [(0, "He", 1e-8)],  # 4He: 1 1S 6.1e-9 above with 2 1S in the same 250 functions
     "he-inf-2-1s": [(1, "He 2 1S", "rel:1e-7")],
     "he-inf-2-3s": [(0, "He 2 3S", "rel:1e-7")],
-    "he-inf-1s": [(0, "He inf", 2e-9)],  # mass = inf: 1.50e-9 above after 308 s with 400 functions
+    "he-inf-1s": [(0, "He inf", 5e-10)],  # mass = inf: 1.48e-10 above after 660 s with 700 functions
     "he-inf-2p": [(0, "He 2 1P", 5e-9)],  # mass = inf, ECG-GVR: 3.72e-9 above after 903 s with 300 functions
     "h2plus-ladder": [(0, "H2+", 1e-8), (1, "H2+ v=1", 1e-8), (2, "H2+ v=2", 1e-7), (3, "H2+ v=3", 1e-7)],
     "h2plus-n1": [(0, "H2+ N=1", 1e-8), (1, "H2+ N=1 v=1", 1e-8)],
