@@ -88,6 +88,8 @@ LEVELS = {
     "he-2-1s": [(0, "He", 1e-8)],  # 4He: 1 1S 6.1e-9 above with 2 1S in the same 250 functions
     "he-inf-2-1s": [(1, "He 2 1S", "rel:1e-7")],
     "he-inf-2-3s": [(0, "He 2 3S", "rel:1e-7")],
+    "he-inf-1s": [(0, "He inf", 5e-10)],  # mass = inf: 1.48e-10 above after 660 s with 700 functions
+    "he-inf-2p": [(0, "He 2 1P", 5e-9)],  # mass = inf, ECG-GVR: 3.72e-9 above after 903 s with 300 functions
     "h2plus-ladder": [(0, "H2+", 1e-8), (1, "H2+ v=1", 1e-8), (2, "H2+ v=2", 1e-7), (3, "H2+ v=3", 1e-7)],
     "h2plus-n1": [(0, "H2+ N=1", 1e-8), (1, "H2+ N=1 v=1", 1e-8)],
 }
@@ -102,7 +104,7 @@ def test_excited_levels_of_example_bases(name, references):
     targets = r.get("targets", [0])
     assert targets == stored.get("targets", [0]) and r["state"] == stored["state"]
     levels = r.get("levels", [r | {"root": 0}])
-    masses = {p["name"]: p["mass"] for p in r["particles"]}
+    masses = {p["name"]: float(p["mass"]) for p in r["particles"]}  # an infinite mass is stored as "inf"
     for root, key, tol in LEVELS[name]:
         level, ref = levels[root], references[key]
         for particle, m in ref["masses"].items():
