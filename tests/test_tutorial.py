@@ -35,7 +35,7 @@ def test_the_tutorial_runs_as_written(tmp_path, monkeypatch, references):
     energies = [level["energy"] for level in result["levels"]]
     # the input's proton mass, 1836.15267, moves the levels by ~1e-12 Eh from the references'
     assert len(energies) == 4 and all(e > ref - 1e-9 for e, ref in zip(energies, literature)), (energies, literature)
-    for output in ("runs/ladder/convergence.png", "ladder-densities.png", "ladder-densities.csv"):
+    for output in ("runs/ladder/convergence.png", "ladder-densities.png", "ladder-densities.csv", "he-alpha.png"):
         assert (tmp_path / output).stat().st_size > 0, output
     (python,) = blocks("python")
     out = io.StringIO()
