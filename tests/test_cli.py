@@ -318,7 +318,7 @@ def test_no_printed_number_is_cut_short(run_dir, columns):
                                        "(see prebo energy --help)"),
     (["run", "in.toml", "extra"], "prebo: error: run: unrecognized arguments: extra (see prebo run --help)"),
     (["nosuch"], "prebo: error: argument command: invalid choice: 'nosuch' (choose from 'run', 'properties', "
-                 "'energy', 'import', 'export', 'plot') (see prebo --help)"),
+                 "'energy', 'transitions', 'polarisability', 'import', 'export', 'plot') (see prebo --help)"),
     (["run", "--budget", "0"], "prebo: error: run: argument --budget: '0' is not a number of seconds above 0 "
                                "(see prebo run --help)"),
     (["properties", "he.json", "--root", "x"], "prebo: error: properties: argument --root: 'x' is not an integer ≥ 0 "

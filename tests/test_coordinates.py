@@ -95,8 +95,10 @@ def test_bad_sets_are_refused():
 
 
 @pytest.mark.parametrize("call, message", [
-    (lambda: jacobi(None), "jacobi: masses = None: must be the masses of two or more particles, finite positive "
-                           "numbers in m_e (System.masses)"),
+    (lambda: jacobi(None), "jacobi: masses = None: must be the masses of two or more particles, positive "
+                           "numbers in m_e, finite but for at most one (System.masses)"),
+    (lambda: jacobi([float("inf"), 1.0, float("inf")]), "jacobi: masses = [inf, 1.0, inf]: must be"),
+    (lambda: jacobi([-float("inf"), 1.0]), "jacobi: masses = [-inf, 1.0]: must be"),
     (lambda: jacobi(prebo.System(["p", "e"])), "jacobi: masses = System("),
     (lambda: jacobi([1.0]), "jacobi: masses = [1.0]: must be the masses of two or more particles"),
     (lambda: jacobi([float("nan"), 1.0]), "jacobi: masses = [nan, 1.0]: must be"),

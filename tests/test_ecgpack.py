@@ -284,7 +284,7 @@ def _edit(tmp_path, old, new, src=HE):
 
 @pytest.mark.parametrize("old,new,line,words", [
     (" BASIS_TYPE RG_0S", " BASIS_TYPE CG_0S", 1, ["complex"]),
-    (" BASIS_TYPE RG_0S", " BASIS_TYPE RG_1P", 1, ["L > 0"]),
+    (" BASIS_TYPE RG_0S", " BASIS_TYPE RG_2P", 1, ["BASIS_TYPE RG_2P", "prebo reads RG_0S"]),
     (" CHARGES  0.2000000000000000E+01 -0.1000000000000000E+01 -0.1000000000000000E+01",
      " CHARGES  0.2000000000000000E+01 -0.1000000000000000E+01", 4, ["CHARGES", "2 values"]),
     (" SYMMETRY (1+P23)", " SYMMETRY (1+P12)", 5, ["SYMMETRY", "differ"]),
@@ -403,3 +403,178 @@ def test_two_groups_round_trip(tmp_path):
     assert [p.name for p in back.system.particles] == ["p", "p", "e", "e"]
     assert back.system.state.spin == {"p": 1.0, "e": 0.0}
     assert np.allclose(back.A, basis.A, rtol=0, atol=1e-12 * np.abs(basis.A).max())
+
+
+# --- issue 57: RG_1P (P states) and ecgpack's infinite masses -------------------------------
+HE_1S = DATA / "ecgpack-He-inf-1S-10.inout.txt"
+HE_2P = DATA / "ecgpack-He-inf-2P-10.inout.txt"
+
+
+@pytest.mark.parametrize("path", [HE_1S, HE_2P], ids=["1S", "2P"])
+def test_the_he_samples_give_the_energies_ecgpack_reports(path):
+    """ecgpack's RG_0S-1P He samples (infinite nuclear mass, 10 functions each): prebo's energy is
+    the file's CURRENT_ENERGY (−2.9012919829575297 and −2.122004595065177) to 3e-15 relative,
+    in the laboratory frame and in Jacobi coordinates."""
+    f = ecgpack.parse_inout(path)
+    basis = f.to_basis()
+    assert basis.system.masses.tolist() == [np.inf, 1.0, 1.0]
+    for coordinates in ("lab", "ti"):
+        assert rel(prebo.evaluate(basis, coordinates)["energy"], f.energy) < 5e-15
+
+
+def test_an_rg_1p_function_is_an_ecg_gvr_function_of_n_1():
+    """z_1 exp(−rᵀ𝒜r), r_1 = R_2 − R_1: ECG-GVR, N = 1, K = 0, u = e_2 − e_1 (0-based [−1, 1, 0])."""
+    f = ecgpack.parse_inout(HE_2P)
+    assert f.basis_type == "RG_1P" and f.z.tolist() == [1] * 10
+    basis = f.to_basis()
+    assert basis.kind == "ecg-gvr" and (basis.system.state.N, basis.system.state.parity) == (1, -1)
+    assert np.array_equal(basis.u, np.tile([-1.0, 1.0, 0.0], (10, 1))) and not basis.K.any()
+    assert basis.channels == ["hpc:0"] * 10
+
+
+def test_rg_1p_round_trips_through_import_and_export(tmp_path):
+    f1 = ecgpack.parse_inout(HE_2P)
+    b1 = f1.to_basis()
+    e1 = prebo.evaluate(b1)["energy"]
+    ecgpack.write_inout(b1, tmp_path / "x.inout.txt", source=f1)
+    f2 = ecgpack.parse_inout(tmp_path / "x.inout.txt")
+    assert f2.basis_type == "RG_1P" and np.array_equal(f2.z, f1.z) and np.array_equal(f2.L, f1.L)
+    assert np.array_equal(f2.masses, f1.masses)
+    assert " MASSES   1.0000000000000000E+30 " in (tmp_path / "x.inout.txt").read_text()
+    assert f2.energy == e1 and prebo.evaluate(f2.to_basis())["energy"] == e1
+
+
+def test_rg_1p_round_trips_through_the_command_line(tmp_path, capsys):
+    """`prebo import`, then `prebo export` of the basis.json: the same coordinate indices, L Lᵀ to
+    rounding (L is now the Cholesky factor of A's internal block, ecgpack's has columns of either
+    sign), the same energy."""
+    from prebo.cli import main
+
+    assert main(["import", str(HE_2P), "--out", str(tmp_path / "p.json")]) == 0
+    stored = json.loads((tmp_path / "p.json").read_text())
+    assert stored["basis_type"] == "ecg-gvr" and stored["system"]["particles"][0]["mass"] == "inf"
+    out = tmp_path / "p.inout.txt"
+    assert main(["export", str(tmp_path / "p.json"), "--format", "ecgpack", "--out", str(out)]) == 0
+    capsys.readouterr()
+    f1, f2 = ecgpack.parse_inout(HE_2P), ecgpack.parse_inout(tmp_path / "p.inout.txt")
+    A1, A2 = f1.exponents(), f2.exponents()
+    assert np.array_equal(f2.z, f1.z) and np.max(np.abs(A2 - A1)) < 1e-14 * np.max(np.abs(A1))
+    assert rel(f2.energy, f1.energy) < 5e-15
+
+
+def test_a_mass_of_1e30_is_infinite(tmp_path):
+    """ecgpack's 1e30 is read as ∞: the same bits as the system with `mass = inf` (through basis.json),
+    and within 1e-11 relative of a nucleus of 1e12 m_e."""
+    basis = ecgpack.read_inout(HE_1S)
+    basis.save(tmp_path / "inf.json")
+    d = json.loads((tmp_path / "inf.json").read_text())
+    assert d["system"]["particles"][0] == {"name": "x1", "mass": "inf", "charge": 2.0, "spin": 0.0}
+    e = prebo.evaluate(basis)["energy"]
+    assert prebo.evaluate(Basis.load(tmp_path / "inf.json"))["energy"] == e
+    toml_like = prebo.System([{"name": "He", "mass": float("inf"), "charge": 2, "spin": 0}, "e", "e"])
+    assert prebo.evaluate(Basis(toml_like, basis.A, basis.c_A, basis.channels))["energy"] == e
+    big = ecgpack.read_inout(_edit_file(tmp_path, HE_1S, "0.1000000000000000E+31", "0.1000000000000000E+13"))
+    e12 = prebo.evaluate(big)["energy"]
+    assert e12 != e and rel(e12, e) < 1e-11
+
+
+def _edit_file(tmp_path, src, old, new, name="edited.inout.txt"):
+    text = src.read_text()
+    assert old in text
+    p = tmp_path / name
+    p.write_text(text.replace(old, new, 1))
+    return p
+
+
+def test_a_file_without_basis_type_is_told_by_its_lines(tmp_path):
+    p = _edit_file(tmp_path, HE_2P, " BASIS_TYPE RG_1P\n", "")
+    assert ecgpack.parse_inout(p).basis_type == "RG_1P"
+    q = _edit_file(tmp_path, HE_1S, " BASIS_TYPE RG_0S\n", "", "s.inout.txt")
+    assert ecgpack.parse_inout(q).basis_type == "RG_0S"
+
+
+P_LINE = "      3      1 -0.3256830670396673E+00"
+
+
+@pytest.mark.parametrize("old,new,line,words", [
+    (P_LINE, "      3      0 -0.3256830670396673E+00", 33, ["basis function 3: '0' after the index", "1..2"]),
+    (P_LINE, "      3      3 -0.3256830670396673E+00", 33, ["'3' after the index", "z_i, an integer in 1..2"]),
+    (P_LINE, "      3    1.0 -0.3256830670396673E+00", 33, ["'1.0' after the index"]),
+    (P_LINE + " -0.7132632415593938E-02", "      3      1 -0.3256830670396673E+00", 33,
+     ["basis function 3: 2 reals after the coordinate index, expected n(n+1)/2 = 3"]),
+    (" BASIS_TYPE RG_1P", " BASIS_TYPE RG_2D", 1, ["BASIS_TYPE RG_2D", "RG_0S", "RG_1P"]),
+    ("0.1000000000000000E+01  0.1000000000000000E+01\n CHARGES", "0.1000000000000000E+31  0.1000000000000000E+31\n "
+     "CHARGES", None, ["infinite masses: at most one"]),
+])
+def test_a_corrupt_rg_1p_file_names_the_line(tmp_path, capsys, old, new, line, words):
+    p = _edit_file(tmp_path, HE_2P, old, new)
+    from conftest import cli_error
+
+    err = cli_error(capsys, "energy", p)
+    assert f"{p}:{line}:" in err if line else f"{p}:" in err, err
+    for w in words:
+        assert w in err, err
+
+
+def test_rg_0s_lines_declared_rg_1p_are_refused(tmp_path):
+    p = _edit_file(tmp_path, HE_1S, " BASIS_TYPE RG_0S", " BASIS_TYPE RG_1P")
+    with pytest.raises(BasisFileError, match=r":31: basis function 1: '0.4825734967754652E\+00' after the index"):
+        ecgpack.read_inout(p)
+
+
+def test_ecg_gvr_functions_rg_1p_does_not_hold_are_not_exported(tmp_path, capsys):
+    from conftest import cli_error
+
+    err = cli_error(capsys, "export", ROOT / "examples" / "bases" / "h2plus-gvr" / "basis.json", "--format",
+                    "ecgpack", "--out", tmp_path / "x.inout.txt")
+    assert "ECG-GVR functions of N = 1, not ecg-gvr functions of N = 0" in err, err
+    basis = ecgpack.read_inout(HE_2P)
+    basis.K[3] = 2
+    with pytest.raises(prebo.errors.UnsupportedError, match="function 3: RG_1P holds .* K = 2"):
+        ecgpack.write_inout(basis, tmp_path / "y.inout.txt", energy=0.0)
+    basis = ecgpack.read_inout(HE_2P)
+    basis.u[4] = [-1.0, 0.5, 0.5]  # the electrons' centre relative to the nucleus
+    with pytest.raises(prebo.errors.UnsupportedError, match=r"function 4: .* u = \[0.5, 0.5, 0.0\]"):
+        ecgpack.write_inout(basis, tmp_path / "y.inout.txt", energy=0.0)
+
+
+def test_the_he_samples_give_the_transition_moments_ecgpack_prints():
+    """What the import means, checked beyond the energy: prebo's eigenvectors of the two imported
+    bases (normalised functions; an RG_1P function's M = 1 partner has its M = 0 function's
+    matrices), put on ecgpack's own functions z_i exp(−rᵀ𝒜r) in its coordinates r_i = R_{i+1} − R_1,
+    give the values ecgpack's RG_0S-1P sample README prints, cut to nine decimals (iDynbek/ecgpack, commit ad8e8f3,
+    RG_0S-1P/sample_input/transition_dipole_moment_He/dipole_moment/README.md): ΔE = 0.779 287 387,
+    ⟨S|z|P⟩ = 0.395 665 167 (its z is d_z = Σ_i (q_{i+1} − Q m_{i+1}/m_tot) z_i, −(z_1 + z_2) here) and
+    ⟨S|P_z|P⟩ = i 0.314 193 144, P_z = −Σ_a (q_a/m_a) p_a,z (matelem.f90, main.f90); the sign of
+    either eigenvector is free. Elements by the closed forms S = (πⁿ/|A|)^{3/2},
+    ⟨e^{-A_I}|w·r_z|(v·r)_z e^{-A_J}⟩ = S wᵀ(A_I + A_J)⁻¹v/2 and
+    ⟨e^{-A_I}|∂/∂z_i|(v·r)_z e^{-A_J}⟩ = S (A_I (A_I + A_J)⁻¹v)_i."""
+    f0, f1 = ecgpack.parse_inout(HE_1S), ecgpack.parse_inout(HE_2P)
+    r0, r1 = prebo.evaluate(f0.to_basis()), prebo.evaluate(f1.to_basis())
+    A0, A1 = f0.exponents(), f1.exponents()
+    v = np.eye(2)[f1.z - 1]
+    swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # P23 in r: (1 + P23), ecgpack's Y and prebo's operator
+
+    def overlap(A, B):
+        return (np.pi**2 / np.linalg.det(A + B)) ** 1.5
+
+    def p_norm(A, w):
+        return np.sqrt(overlap(A, A) * (w @ np.linalg.solve(2 * A, w)) / 2)
+
+    d, velocity, s1 = np.zeros((3, 10, 10))
+    for I in range(10):
+        for J in range(10):
+            for T in (np.eye(2), swap):  # the image of function J: e^{-rᵀ Tᵀ A T r} (Tᵀv · r)_z
+                B, w = T.T @ A1[J] @ T, T.T @ v[J]
+                S, Bi = overlap(A0[I], B), np.linalg.inv(A0[I] + B)
+                norms = np.sqrt(overlap(A0[I], A0[I])) * p_norm(A1[J], v[J])
+                d[I, J] += S * (-np.ones(2) @ Bi @ w) / 2 / norms
+                velocity[I, J] += S * (np.ones(2) @ A0[I] @ Bi @ w) / norms
+                norms = p_norm(A1[I], v[I]) * p_norm(A1[J], v[J])
+                s1[I, J] += overlap(A1[I], B) * (v[I] @ np.linalg.solve(A1[I] + B, w)) / 2 / norms
+    c0, c1 = np.asarray(r0["coefficients"]), np.asarray(r1["coefficients"])
+    assert c1 @ s1 @ c1 == pytest.approx(1.0, rel=1e-13)  # the M = 0 functions have the same matrices
+    z, p = c0 @ d @ c1, c0 @ velocity @ c1
+    for value, printed in ((r1["energy"] - r0["energy"], 0.779287387), (abs(z), 0.395665167), (abs(p), 0.314193144)):
+        assert 0 <= value - printed < 1e-9, (value, printed)  # the README's nine decimals, cut off
+    assert np.sign(p) == -np.sign(z)  # i⟨P_z⟩... = (E_S − E_P)⟨z⟩ in the exact limit: opposite signs here

@@ -9,7 +9,8 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.optimise`: `Optimiser` settings and `optimise`, the stochastic variational driver;
 - `prebo.level`: the results of a basis's levels: `evaluate`, their energies; `properties`, a
   level's energy, expectation values and their corrections; `densities`, the distance
-  distributions of levels;
+  distributions of levels; `transitions`, the electric-dipole lines between two bases' levels; `polarisability`, a level's
+  dipole polarisability α(ω) from a basis of its first-order function;
 - `prebo.system.thresholds`: the lowest dissociation threshold, below which a state is bound;
 - `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
 - `prebo.cli`, `prebo.plot`: the command line and convergence plots;
@@ -24,6 +25,8 @@ from .errors import PreboError
 from .optimise import Optimiser, optimise
 from .level.evaluate import evaluate
 from .level.properties import densities, properties
+from .level.response import polarisability
+from .level.transitions import transitions
 from .system import Particle, State, System, particle
 
 __all__ = [
@@ -32,6 +35,7 @@ __all__ = [
     # coordinates
     "CoordinateSet", "jacobi", "heavy_particle_centred", "cm_centred", "all_sets",
     # basis, solving, results
-    "Basis", "Optimiser", "optimise", "evaluate", "properties", "densities", "PreboError",
+    "Basis", "Optimiser", "optimise", "evaluate", "properties", "densities", "transitions", "polarisability",
+    "PreboError",
 ]
 from .provenance import VERSION as __version__  # noqa: E402 (the package metadata's)

@@ -88,6 +88,16 @@ class Engine:
         r_ij²). Symmetrised like S, which is exact for
         operators that commute with the symmetry operations."""
 
+    def between(self, name: str, bra: Params, ket: Engine, ket_params: Params, v: ArrayLike) -> NDArray[np.float64]:
+        """(p, nb_bra, nb_ket) matrices of the registered two-basis operator `name` between the
+        normalised functions of the basis `bra` (this engine's family and N) and those of
+        `ket_params` (`ket`'s family and N, symmetrised by `ket`'s operations), one per instance
+        of its vectors v (p, arity, n), given in this representation: "overlap" (no vectors;
+        two bases of one N), and the electric dipole's reduced elements <1‖O‖0> between a bra of
+        N = 0 (plain or ECG-GVR) and an ECG-GVR ket of N = 1: "dipole", O = Σ_k w_k r_k (w like
+        the Coulomb vectors), "velocity", O = Σ_k w'_k ∇_k (w' momentum-like);
+        crates/prebo-core/src/families/ecg_gvr/transition.rs."""
+
     def density(self, params: Params, w: ArrayLike, C: ArrayLike, r: ArrayLike) -> NDArray[np.float64]:
         """Spherically averaged densities <Ψ|ρ̄_w(r)|Ψ> (bohr⁻³) of the states Ψ = Σ_I c_I Yφ_I
         (C: (nb, ns), the columns) at the radii r (bohr), one per vector w (p, n) given in this

@@ -6,6 +6,10 @@ Every U_x is N_p x N_p and dimensionless: rows 1..N_p-1 are translationally inva
 as A^(x) = U^-T A^(r) U^-1 = blockdiag(𝒜, c_A) and global vectors as u^(x) = U^-T u^(r)
 = (u', c_U) (eqs. (24), (25)). The kinetic matrix in x is U M U^T = blockdiag(μ, 1/(2 m_tot))
 (eq. (9)). Exponents are in bohr⁻², masses in m_e, μ in 1/m_e.
+
+One mass may be infinite (a clamped particle, prebo.system.particles): every m_j / m_tot takes
+its limit (`mass_fractions`), 1 on that particle and 0 elsewhere, so the last row of U_x is its
+position, the centre of mass, and U_x stays finite.
 """
 from __future__ import annotations
 
@@ -46,7 +50,7 @@ class CoordinateSet:
             raise InputError(f"{self.name}: U has shape {self.U.shape}, expected {(n, n)}")
         if np.max(np.abs(self.U[:-1].sum(axis=1))) > tol:
             raise InputError(f"{self.name}: a translationally invariant row does not sum to zero")
-        if np.max(np.abs(self.U[-1] - masses / masses.sum())) > tol:
+        if np.max(np.abs(self.U[-1] - mass_fractions(masses))) > tol:
             raise InputError(f"{self.name}: last row is not m_j / m_tot")
         if abs(np.linalg.det(self.U)) < 1e-12:
             raise InputError(f"{self.name}: U is singular")
@@ -102,11 +106,9 @@ def jacobi(masses: np.ndarray, order=None) -> CoordinateSet:
     U = np.zeros((n, n))
     for i in range(n - 1):
         cluster = order[: i + 1]
-        mc = masses[cluster].sum()
-        for j in cluster:
-            U[i, j] = masses[j] / mc
+        U[i, cluster] = mass_fractions(masses[cluster])
         U[i, order[i + 1]] -= 1.0
-    U[-1] = masses / masses.sum()
+    U[-1] = mass_fractions(masses)
     return CoordinateSet("jacobi:" + "-".join(map(str, order)), U)
 
 
@@ -118,7 +120,7 @@ def heavy_particle_centred(masses: np.ndarray, centre: int) -> CoordinateSet:
     U = np.zeros((n, n))
     for row, i in enumerate(k for k in range(n) if k != centre):
         U[row, i], U[row, centre] = 1.0, -1.0
-    U[-1] = masses / masses.sum()
+    U[-1] = mass_fractions(masses)
     return CoordinateSet(f"hpc:{centre}", U)
 
 
@@ -126,17 +128,24 @@ def cm_centred(masses: np.ndarray, dropped: int | None = None) -> CoordinateSet:
     """CM-centred set: x_i = r_i - X_CM for every particle but `dropped` (default: the last).
 
     Named ``cmc:DROPPED``. (Eq. (7) divides by m_{i..N}, which violates eq. (3); this is
-    the set the paper's figure 1 describes.)
+    the set the paper's figure 1 describes.) With an infinite mass the centre of mass is that
+    particle, whose coordinate r_k - X_CM vanishes: it is the one dropped (default; InputError for
+    another), and the set is ``hpc:k``'s.
     """
     masses = _masses(masses, "cm_centred")
     n = len(masses)
-    dropped = n - 1 if dropped is None else dropped
+    clamped = np.flatnonzero(np.isinf(masses))
+    default = int(clamped[0]) if len(clamped) else n - 1
+    dropped = default if dropped is None else dropped
     _particle_index(dropped, n, "cmc", "dropped")
+    if len(clamped) and dropped != default:
+        raise InputError(f"coordinate set cmc:{dropped}: particle {default} has an infinite mass and is the centre "
+                         f"of mass; the CM-centred set drops it (cmc:{default})")
     U = np.zeros((n, n))
     for row, i in enumerate(k for k in range(n) if k != dropped):
-        U[row] = -masses / masses.sum()
+        U[row] = -mass_fractions(masses)
         U[row, i] += 1.0
-    U[-1] = masses / masses.sum()
+    U[-1] = mass_fractions(masses)
     return CoordinateSet(f"cmc:{dropped}", U)
 
 
@@ -161,18 +170,26 @@ def _reals(value) -> np.ndarray | None:
 
 
 def _masses(masses, where: str) -> np.ndarray:
-    """`masses` as a float array of two or more finite positive numbers (m_e); InputError naming
-    `where` otherwise."""
+    """`masses` as a float array of two or more positive numbers (m_e), finite but for at most one
+    infinite mass; InputError naming `where` otherwise."""
     m = _reals(masses)
-    if m is None or m.ndim != 1 or len(m) < 2 or not np.all((m > 0) & np.isfinite(m)):
+    if m is None or m.ndim != 1 or len(m) < 2 or not np.all((m > 0) & ~np.isnan(m)) or np.isinf(m).sum() > 1:
         got = reprlib.repr(masses if m is None else m.tolist())
-        raise InputError(f"{where}: masses = {got}: must be the masses of two or more particles, finite "
-                         "positive numbers in m_e (System.masses)")
+        raise InputError(f"{where}: masses = {got}: must be the masses of two or more particles, positive "
+                         "numbers in m_e, finite but for at most one (System.masses)")
     return m
 
 
+def mass_fractions(masses: np.ndarray) -> np.ndarray:
+    """m_j / m_tot (eq. (4)) of the masses `masses` (m_e), and the limit of an infinite mass: 1 on
+    that particle, 0 elsewhere (the centre of mass on it)."""
+    infinite = np.isinf(masses)
+    return infinite.astype(float) if infinite.any() else masses / masses.sum()
+
+
 def all_sets(masses: np.ndarray, labels=None) -> list[CoordinateSet]:
-    """Every Jacobi set, every heavy-particle-centred set and the CM-centred set.
+    """Every Jacobi set, every heavy-particle-centred set and the CM-centred set (but with an
+    infinite mass, where it is a heavy-particle-centred one).
 
     Sets that differ only by a relabelling of identical particles (equal `labels`, e.g. the
     particle names) are counted once, as are Jacobi orders that differ only by swapping the
@@ -199,7 +216,8 @@ def all_sets(masses: np.ndarray, labels=None) -> list[CoordinateSet]:
         add(("jacobi", first, tuple(map(str, names[2:]))), lambda o=order: jacobi(masses, o))
     for c in range(n):
         add(("hpc", str(labels[c])), lambda c=c: heavy_particle_centred(masses, c))
-    sets.append(cm_centred(masses))
+    if np.isfinite(masses).all():  # with an infinite mass k it is hpc:k (`cm_centred`)
+        sets.append(cm_centred(masses))
     return sets
 
 

@@ -27,6 +27,7 @@ the exact one.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -122,6 +123,16 @@ class Representation:
         engine, params = self.engine(f), self.arrays(f)
         return self.shared().instances(lambda part: engine.operator(name, params, part), np.ascontiguousarray(v))
 
+    def between(self, name: str, bra, ket, v: np.ndarray, momentum: bool = False) -> np.ndarray:
+        """(p, nb_bra, nb_ket) matrices of the core's two-basis operator `name` ("dipole", "velocity",
+        "overlap"; crates/prebo-core/src/registry.rs) between the normalised functions of the basis
+        `bra` and those of the basis `ket`, symmetrised by this representation's operations (the
+        kets' images), one per laboratory-frame vector v (p, n), position-like or, with `momentum`,
+        momentum-like (`vectors`). The dipole's forms join a bra of N = 0 to a ket of N = 1 and are
+        reduced elements <1‖O‖0> (level/transitions.py)."""
+        v = self.vectors(v, momentum) if len(v) else np.zeros((0, 0))
+        return self.engine(bra).between(name, self.arrays(bra), self.engine(ket), self.arrays(ket), v)
+
     def density(self, f, w: np.ndarray, C: np.ndarray, r: np.ndarray) -> np.ndarray:
         """The spherically averaged densities (p, states, len(r)) of r_w (bohr⁻³) at the radii `r`
         (bohr) in the states Σ_k C_ks Yφ_k of the basis `f`, one per laboratory-frame vector w (p, n)."""
@@ -190,11 +201,12 @@ class Representation:
 def laboratory(system: System, kinetic: str = "M") -> Representation:
     """The laboratory-frame representation of `system`: kinetic matrix M = diag(1/(2 m_i)) with the
     CM kinetic energy eliminated through c_A (kinetic="M"), or M - 1 1^T/(2 m_tot), the CM
-    kinetic operator removed exactly (kinetic="internal", no T_ti elimination)."""
+    kinetic operator removed exactly (kinetic="internal", no T_ti elimination). With an infinite
+    mass the CM is that particle, which has no kinetic term: T_ti = T (cm_mass None)."""
     w, q = system.coulomb_pairs()
     sym = system.symmetriser
-    if kinetic == "M":
-        lam, cm = system.M, system.m_total
+    if kinetic == "M":  # an infinite mass: the CM does not move, no kinetic energy to eliminate (T_ti = T)
+        lam, cm = system.M, system.m_total if math.isfinite(system.m_total) else None
     elif kinetic == "internal":
         lam, cm = system.M_internal, None
     else:

@@ -126,6 +126,20 @@ def densities(table: dict, png: Path) -> Path:
     return save(fig, png)
 
 
+def polarisability(omega, alpha, pole: float, png: Path) -> Path:
+    """Draw α(ω) (a₀³) at the frequencies `omega` (Eh) below the first `pole` into `png`."""
+    plt = pyplot(png)
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    ax.plot(omega, alpha, lw=1.4)
+    ax.axvline(pole, color="grey", ls="--", lw=1.0, label=f"first pole, {pole:.8f} Eh")
+    ax.set_yscale("log")
+    ax.set_xlabel("ω / Eh")
+    ax.set_ylabel("α(ω) / a₀³")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    return save(fig, png)
+
+
 def pyplot(png: Path):
     """matplotlib.pyplot without a display; InputError for a suffix not in FORMATS."""
     if Path(png).suffix.lower() not in FORMATS:

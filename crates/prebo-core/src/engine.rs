@@ -203,6 +203,43 @@ fn operator_d<const D: usize, F: Specialised<D>>(e: &Engine, name: &str, basis: 
     path::operator::<D, F>(&F::context(ops, e.n_ang, &[&basis])?, &sym, &basis, |bra, ket, ctx, v| elements.of(bra, ket, ctx, v), arity, w)
 }
 
+/// `between` for the family `F` of both bases (a contained family's columns as `F`'s,
+/// `as_family`), the context at the bra's N.
+fn between_d<const D: usize, F: Specialised<D>>(
+    e: &Engine,
+    name: &str,
+    bra: &[Column],
+    ket: &Engine,
+    ket_params: &[Column],
+    v: &[f64],
+) -> Result<Vec<f64>> {
+    let (arity, elements) = registry::lookup_between::<D, F>(e.kind.name(), ket.kind.name(), name)?;
+    let (bra_columns, ket_columns) = (as_family::<D, F>(e.kind, bra)?, as_family::<D, F>(ket.kind, ket_params)?);
+    let (bra, ket_p) = (F::params(&bra_columns)?, F::params(&ket_columns)?);
+    let instances: Vec<Vec<Vector<D>>> = if arity == 0 {
+        check(v.len(), 0, "operator vectors")?;
+        vec![vec![]]
+    } else {
+        check(v.len(), v.len() / (arity * D) * (arity * D), "operator vectors")?;
+        v.chunks_exact(arity * D).map(|vk| vk.chunks_exact(D).map(Vector::<D>::from_row_slice).collect()).collect()
+    };
+    let (ops, _) = e.rep.operators::<D>();
+    let (_, ket_sym) = ket.rep.operators::<D>();
+    let ctx = F::kinetic_only(&F::context(ops, e.n_ang, &[&bra, &ket_p])?);
+    path::between::<D, F>(&ctx, &ket_sym, &bra, &ket_p, instances.len(), |x, y| elements.of(x, y, &ctx, &instances))
+}
+
+/// The columns of a basis of family `kind` as those of `F`: as they are, or a plain ECG's `(A, c_A)`
+/// as the ECG-GVR `(A, u = e_1, K = 0, c_A)` (`Family::CONTAINS`).
+fn as_family<const D: usize, F: Family<D>>(kind: Kind, columns: &[Column]) -> Result<Vec<Column>> {
+    if kind != Kind::Pecg || kind.name() == F::NAME {
+        return Ok(columns.to_vec());
+    }
+    let count = <Pecg as Family<D>>::params(columns)?.len();
+    let u = (0..count).flat_map(|_| (0..D).map(|i| f64::from(i == 0))).collect();
+    Ok(vec![columns[0].clone(), Column::Floats(u), Column::Naturals(vec![0; count]), columns[1].clone()])
+}
+
 fn density_d<const D: usize, F: Family<D>>(e: &Engine, basis: &[Column], w: &[f64], c: &[f64], radii: &[f64]) -> Result<Vec<f64>> {
     check(w.len(), w.len() / D * D, "density vectors")?;
     let basis = F::params(basis)?;
@@ -266,6 +303,31 @@ impl Engine {
     /// `arity` vectors `w` (`p x arity x n`).
     pub fn operator(&self, name: &str, basis: &[Column], w: &[f64]) -> Result<Vec<f64>> {
         dispatch!(self, operator_d(self, name, basis, w))
+    }
+
+    /// The `p x nb_bra x nb_ket` matrices (row-major) of the registered two-basis operator `name`
+    /// (`registry::lookup_between`) between the basis `bra` of this engine and the basis
+    /// `ket_params` of `ket` (its family, N and symmetry: the kets are symmetrised by `ket`'s
+    /// operations), one per instance of its `arity` vectors `v` (`p x arity x n`). An operator of
+    /// rank k > 0 (`registry::rank`) joins a bra of N = 0 to a ket of N = k; the overlap two
+    /// bases of one N. The bra's operators (its representation) serve both.
+    pub fn between(&self, name: &str, bra: &[Column], ket: &Engine, ket_params: &[Column], v: &[f64]) -> Result<Vec<f64>> {
+        if ket.rep.n != self.rep.n {
+            return Err(CoreError::ShapeMismatch(format!("a bra of {} coordinates and a ket of {}", self.rep.n, ket.rep.n)));
+        }
+        let rank = registry::rank(name);
+        let wanted = if rank == 0 { (ket.n_ang, ket.n_ang) } else { (0, rank) };
+        if (self.n_ang, ket.n_ang) != wanted {
+            return Err(CoreError::Unsupported(format!(
+                "operator {name:?} between a bra of N = {} and a ket of N = {} (its elements join N = {} to N = {})",
+                self.n_ang, ket.n_ang, wanted.0, wanted.1
+            )));
+        }
+        match (self.kind, ket.kind) {
+            (Kind::Pecg, Kind::Pecg) => dispatch!(@dim self, between_d, Pecg, (self, name, bra, ket, ket_params, v)),
+            (Kind::Fecg, _) | (_, Kind::Fecg) => dispatch!(@dim self, between_d, Fecg, (self, name, bra, ket, ket_params, v)),
+            _ => dispatch!(@dim self, between_d, EcgGvr, (self, name, bra, ket, ket_params, v)),
+        }
     }
 
     /// The spherically averaged densities `<Ψ| ρ̄_w(r) |Ψ>` (operators/density.rs) of the states

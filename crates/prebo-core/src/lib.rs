@@ -22,7 +22,7 @@
 //! 4. the generic builds: `path`;
 //! 5. the families: `families::pecg`, `families::ecg_gvr`, `families::fecg`;
 //! 6. the operators, generic and each family's own: `operators`, `families::pecg::operators`,
-//!    `families::ecg_gvr::{operators, drachmann}`, `families::fecg::operators`;
+//!    `families::ecg_gvr::{operators, drachmann, transition}`, `families::fecg::operators`;
 //! 7. the registry and the engine: `registry`, `engine`.
 pub mod assemble;
 pub mod cache;

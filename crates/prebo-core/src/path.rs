@@ -164,28 +164,43 @@ pub fn operator<const D: usize, F: Family<D>>(
     Ok(out)
 }
 
-/// The `nb_bra x nb_ket` matrix (row-major) of an operator between two bases of family `F`:
-/// `Σ_P c_P <phi_I| O |P phi'_J>`, the bras of `bra` as they are, the kets of `ket` with their
-/// images under the ket basis's own symmetry `ket_sym` (its operations and coefficients c_P);
-/// `element` is `<phi_I| O |phi'_J>` (`registry::lookup_between`). Rows in parallel.
+/// The `p` matrices (`p x nb_bra x nb_ket`, row-major) of an operator with `p` instances between
+/// two bases of family `F`: `Σ_P c_P <phi_I| O |P phi'_J>`, the bras of `bra` as they are, the
+/// kets of `ket` with their images under the ket basis's own symmetry `ket_sym` (its operations
+/// and coefficients c_P); `element` is `<phi_I| O |phi'_J>` of every instance
+/// (`registry::lookup_between`). Rows in parallel.
 pub fn between<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     ket_sym: &Symmetry<D>,
     bra: &F::Params<'_>,
     ket: &F::Params<'_>,
-    element: impl Fn(&F::Function<f64>, &F::Function<f64>) -> f64 + Sync,
+    p: usize,
+    element: impl Fn(&F::Function<f64>, &F::Function<f64>) -> Vec<f64> + Sync,
 ) -> Result<Vec<f64>> {
     let bras = F::functions(bra, ctx)?;
     let kets = images::<D, F>(ctx, ket_sym, ket)?;
+    let nk = kets.len();
     let rows: Vec<Vec<f64>> = bras
         .par_iter()
         .map(|b| {
-            (0..kets.len())
-                .map(|j| kets.images[j].iter().zip(&kets.coef).map(|(k, c)| c * element(b, k)).sum())
-                .collect()
+            let mut row = vec![0.0; p * nk];
+            for j in 0..nk {
+                for (k, c) in kets.images[j].iter().zip(&kets.coef) {
+                    for (q, x) in element(b, k).into_iter().enumerate() {
+                        row[q * nk + j] += c * x;
+                    }
+                }
+            }
+            row
         })
         .collect();
-    Ok(rows.concat())
+    let mut out = vec![0.0; p * bras.len() * nk];
+    for (i, row) in rows.iter().enumerate() {
+        for (q, values) in row.chunks_exact(nk.max(1)).enumerate().take(p) {
+            out[(q * bras.len() + i) * nk..][..nk].copy_from_slice(&values[..nk]);
+        }
+    }
+    Ok(out)
 }
 
 /// `Σ_IJ c_I c_J Σ_P c_P <phi_I| O_k |P phi_J>` of an operator with `len` components `O_k`

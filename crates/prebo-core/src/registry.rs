@@ -1,12 +1,14 @@
 //! The operator registry: every extra operator by name with its arity (D-vectors per instance),
 //! and its elements for a key (bra family, ket family, operator) — the bra family's own
 //! (`operators::Specialised`, in the family's folder) before the generic element in `operators`.
-//! Only pairs of one family have elements today; any other pair is refused in one line naming
-//! the three. Operators of one basis (`generic`, symmetrised by `path::operator`) and between two
+//! Pairs of one family have elements, and between two bases a family's pair with a family it
+//! contains (`Family::CONTAINS`: a plain bra, an ECG-GVR ket); any other pair is refused in one
+//! line naming the three. Operators of one basis (`generic`, symmetrised by `path::operator`) and between two
 //! bases of a family, each with its own parameters and symmetriser (`two_bases`, `path::between`):
 //! a new one is its module in `operators`, its line here and, where a family has its own element,
 //! that family's `operators.rs`.
 use crate::error::{CoreError, Result};
+use crate::families::ecg_gvr::transition::{DIPOLE, VELOCITY};
 use crate::families::pecg::Pecg;
 use crate::families::Family;
 use crate::operators::drachmann::{self, coulomb, gradient};
@@ -40,9 +42,21 @@ fn generic<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<E
     ]
 }
 
-/// The registered operators between two bases (`path::between`): name, arity, generic element.
+/// The registered operators between two bases (`path::between`): name, arity, generic element
+/// (`None`: a family's own, `Specialised`).
 fn two_bases<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<Elements<D, F>>)> {
-    vec![(overlap::NAME, 0, Some(Elements::Each(overlap::element::<D, F>)))]
+    vec![(overlap::NAME, 0, Some(Elements::Each(overlap::element::<D, F>))), (DIPOLE, 1, None), (VELOCITY, 1, None)]
+}
+
+/// The rank of the two-basis operator `name`: its elements join a bra basis of N = 0 to a ket
+/// basis of N = rank (the dipole's, 1), or, at rank 0, two bases of one N.
+pub fn rank(name: &str) -> u32 {
+    u32::from(matches!(name, DIPOLE | VELOCITY))
+}
+
+/// The names of the registered operators between two bases.
+pub fn names_between() -> Vec<&'static str> {
+    two_bases::<1, Pecg>().into_iter().map(|(name, ..)| name).collect()
 }
 
 /// The registered operators of the family `F` (bra and ket of that family): name, arity, and the
@@ -79,8 +93,12 @@ pub fn lookup<const D: usize, F: Specialised<D>>(bra: &str, ket: &str, name: &st
 /// The arity and elements of operator `name` between a bra basis of family `bra` and a ket basis
 /// of family `ket` (`path::between`).
 pub fn lookup_between<const D: usize, F: Specialised<D>>(bra: &str, ket: &str, name: &str) -> Result<(usize, Elements<D, F>)> {
-    let names = two_bases::<1, Pecg>().into_iter().map(|(name, ..)| name).collect();
-    find(registry::<D, F>(two_bases::<D, F>()), bra, ket, name, names)
+    let ours = |family: &str| family == F::NAME || F::CONTAINS.contains(&family);
+    if ours(bra) && ours(ket) {
+        find(registry::<D, F>(two_bases::<D, F>()), F::NAME, F::NAME, name, names_between())
+    } else {
+        find(registry::<D, F>(two_bases::<D, F>()), bra, ket, name, names_between())
+    }
 }
 
 /// The entry `name` of `operators` for the key (bra family, ket family, operator).
@@ -128,7 +146,7 @@ mod tests {
             F::specialised().into_iter().map(|(name, _)| name).collect()
         }
         for name in [own::<Pecg>(), own::<EcgGvr>(), own::<Fecg>()].concat() {
-            assert!(names().contains(&name), "{name}");
+            assert!(names().contains(&name) || names_between().contains(&name), "{name}");
         }
     }
 }

@@ -130,6 +130,23 @@ impl Engine {
         Ok(blocks(py, nb, m))
     }
 
+    fn between<'py>(
+        &self,
+        py: Python<'py>,
+        name: &str,
+        bra: &Bound<'py, PyAny>,
+        ket: &Engine,
+        ket_params: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> Result<Bound<'py, PyArray3<f64>>> {
+        let (b, k) = (columns(self.core.kind, bra)?, columns(ket.core.kind, ket_params)?);
+        let v = floats(v, "v")?;
+        let (nb, nk) = (self.core.count(&b)?, ket.core.count(&k)?);
+        let m = py.allow_threads(|| self.core.between(name, &b, &ket.core, &k, &v))?;
+        let p = if nb * nk == 0 { 0 } else { m.len() / (nb * nk) };
+        Ok(Array3::from_shape_vec((p, nb, nk), m).expect("p x nb x nk values").into_pyarray(py))
+    }
+
     #[allow(non_snake_case)]
     fn density<'py>(
         &self,

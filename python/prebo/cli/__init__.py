@@ -1,4 +1,4 @@
-"""Command line: `prebo run`, `energy`, `properties`, `import`, `export`, `plot`, a module each (its
+"""Command line: `prebo run`, `energy`, `properties`, `transitions`, `polarisability`, `import`, `export`, `plot`, a module each (its
 arguments, `add`, and its body, `command`). Errors print one line and exit 2, never a traceback.
 
 Outputs never replace inputs nor anything but a regular file (`io.files.replaceable`), and
@@ -13,12 +13,12 @@ import sys
 
 from ..errors import PreboError
 from ..parallel import stop_all, world
-from . import energy, export, import_, plot, properties, run
+from . import energy, export, import_, plot, polarisability, properties, run, transitions
 from .arguments import Parser
 from .streams import standard_streams, written
 
 #: the subcommands, in the order `prebo --help` lists them
-COMMANDS = (run, properties, energy, import_, export, plot)
+COMMANDS = (run, properties, energy, transitions, polarisability, import_, export, plot)
 
 
 def parser() -> argparse.ArgumentParser:

@@ -1,4 +1,4 @@
-"""`prebo export`: a plain-ECG basis in another code's format."""
+"""`prebo export`: a plain-ECG basis, or an ECG-GVR one of a P state, in another code's format."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -8,7 +8,7 @@ from .files import given, load_basis, output_file
 
 def add(sub) -> None:
     """The `prebo export` subcommand, added to the subparsers `sub`."""
-    p = sub.add_parser("export", help="write a plain-ECG basis in another code's format")
+    p = sub.add_parser("export", help="write a plain-ECG basis (or ECG-GVR, N = 1, K = 0) in another code's format")
     p.add_argument("basis", help="basis.json")
     p.add_argument("--format", choices=["ecgpack"], required=True)
     p.add_argument("--out", help="file to write (default BASIS.inout.txt)")
@@ -17,7 +17,8 @@ def add(sub) -> None:
 
 
 def command(args) -> int:
-    """`prebo export BASIS.json --format ecgpack [--out FILE] [--force]`: a plain-ECG basis as an ecgpack file."""
+    """`prebo export BASIS.json --format ecgpack [--out FILE] [--force]`: a plain-ECG basis as an ecgpack
+    RG_0S file, an ECG-GVR one of N = 1 and K = 0 as RG_1P (prebo.io.ecgpack)."""
     from ..io import stored
     from ..io.ecgpack import write_inout
 

@@ -10,7 +10,7 @@ from .files import given, output_file
 def add(sub) -> None:
     """The `prebo import` subcommand, added to the subparsers `sub`."""
     p = sub.add_parser("import", help="convert an ecgpack / ATOM-MOL-nonBO FILE.inout.txt to basis.json")
-    p.add_argument("file", help="ecgpack FILE.inout.txt (RG_0S: real plain ECGs)")
+    p.add_argument("file", help="ecgpack FILE.inout.txt (RG_0S: real plain ECGs; RG_1P: P states)")
     p.add_argument("--out", help="basis.json to write (default FILE.json)")
     p.add_argument("--force", action="store_true", help="replace an existing --out file")
     p.add_argument("--c-A", dest="c_A", type=float, default=1.0, help="CM exponent c_A of the LFCC functions")

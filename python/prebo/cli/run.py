@@ -7,12 +7,13 @@ from contextlib import nullcontext
 from dataclasses import replace
 from pathlib import Path
 
-from ..errors import NonFiniteError
+from ..errors import NonFiniteError, PreboError
 from ..parallel import world
 from ..validation import path_name
 from .arguments import seconds
-from .files import RESULT, claim, given
+from .files import RESULT, claim, given, load_basis
 from .result import print_result, result, warn_if_unbound
+from .transitions import basis_file
 
 
 def add(sub) -> None:
@@ -28,6 +29,10 @@ def add(sub) -> None:
     p.add_argument("--budget", type=seconds, metavar="SECONDS",
                    help="wall-time budget of the whole run, resumed parts included; replaces [optimiser] "
                         "budget, or the checkpoint's with --resume (a run stopped by its budget goes on)")
+    p.add_argument("--partner", metavar="BASIS",
+                   help="a basis of another symmetry of the same particles (basis.json, a run folder or an ecgpack "
+                        "file): result.json gains the electric-dipole lines between the run's levels and its "
+                        "(`lines`, as `prebo transitions`)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     p.set_defaults(func=command)
 
@@ -54,6 +59,7 @@ def command(args) -> int:
     from ..provenance import provenance
 
     t0 = time.perf_counter()
+    partner = None if args.partner is None else load_basis(basis_file(args.partner))[0]  # refused before the run
     if args.resume is not None and (args.input is not None or args.out is not None or args.force):
         raise InputError(f"--resume {args.resume}: give no input file or --out with it, nor --force (a resumed run "
                          "keeps its checkpoint's system, settings and folder; --budget changes its budget)")
@@ -64,6 +70,13 @@ def command(args) -> int:
         if args.input is None:
             raise InputError("give an input file, or --resume DIR")
         job = toml.load(args.input)
+        if partner is not None:
+            from ..level.transitions import same_particles
+
+            try:
+                same_particles(job.system, partner.system)
+            except InputError as exc:
+                raise InputError(f"--partner {args.partner}: {exc}") from exc
         out = given(args.out, Path("runs") / Path(args.input).stem, "a folder")
         title, source = job.title, str(args.input)
     root = world().root  # under MPI, rank 0 alone owns and writes the folder (parallel.py)
@@ -91,6 +104,12 @@ def command(args) -> int:
             print(f"prebo: warning: result.json without expectation values: {exc}", file=sys.stderr)
         for level in r.get("levels", [r]):  # each level's Breit–Pauli correction and regularised δ, p⁴
             level |= corrections(basis, level)
+        if partner is not None:  # the run's result stands without them: a warning
+            try:
+                r["lines"] = lines(basis, partner, args.partner, len(r.get("levels", [r])), opts.threshold)
+            except PreboError as exc:
+                print(f"prebo: warning: result.json without the lines to --partner {args.partner}: {exc}",
+                      file=sys.stderr)
         r |= {"title": title, "wall_seconds": time.perf_counter() - t0, "input": source,
               "convergence": basis.convergence, "provenance": provenance()}
         if root:
@@ -112,3 +131,11 @@ def command(args) -> int:
               f"{len(basis.convergence['followed'])} time(s), last from roots {before} to {after} after {seconds:.0f} s; "
               f"they end at roots {basis.convergence['levels']} (convergence.followed in {RESULT})", file=sys.stderr)
     return 0
+
+
+def lines(basis, partner, where: str, roots: int, threshold: float) -> dict:
+    """result.json's `lines`: the electric-dipole lines between the run's `roots` lowest levels and
+    the levels the `partner` basis (the file `where`) targets (level/transitions.py)."""
+    from ..level.transitions import transitions
+
+    return {"partner": where} | transitions(basis, partner, (roots, max(partner.system.state.levels[0]) + 1), threshold)

@@ -1,6 +1,6 @@
 """Read and write the real-ECG basis files of ecgpack / ATOM-MOL-nonBO (``*.inout.txt``).
 
-The format (RG_0S: real plain ECGs, L = 0, S states)
+The format (RG_0S: real plain ECGs, L = 0, S states; RG_1P below)
 ----------------------------------------------------
 Sections are separated by lines of ``=====``::
 
@@ -32,6 +32,21 @@ Only the header keywords, the basis section and its size are read; the status li
 commands and energy history are skipped. Fortran ``D`` exponents are accepted.
 WHICH_EIGENVALUE k (1-based) is the root the basis was optimised for: the imported state
 targets root k − 1 (`[state] root`), and an export writes the lowest targeted root back.
+
+RG_1P (real ECGs of a P state, L = 1, odd parity; ecgpack's README): a basis line holds the
+index, then the integer i (1..n) of the function φ = z_i exp(−rᵀ(𝒜 ⊗ I₃)r), then vech(L): a
+Gaussian times the z coordinate of particle i + 1 relative to particle 1. In prebo that is an
+ECG-GVR function (prebo.basis.ecg_gvr) of N = 1 (parity −1) with K = 0 and the global vector
+of that coordinate, u^(x) = e_i in ``hpc:0``, u = U_xᵀ e_i = e_{i+1} − e_1 in the laboratory
+frame: v = uᵀr = R_{i+1} − R_1 and φ ∝ v_x + i v_y, the M = 1 partner of ecgpack's v_z, of the
+same energy (every function rotated alike). A file without BASIS_TYPE is RG_1P when its basis
+lines carry that integer (n(n+1)/2 + 1 fields), else RG_0S (ecgpack's own codes do not need
+the line either). An export writes ECG-GVR functions of N = 1 and K = 0 whose global vector is
+one such coordinate (a multiple of e_i in ``hpc:0``) as RG_1P.
+
+Masses: ecgpack writes an infinite mass (a clamped nucleus, its atomic samples) as 1e30
+(INFINITE_MASS); a mass of 1e30 or more is read as infinite (prebo.system.particles), and an
+infinite mass is written back as 1e30.
 
 Symmetry
 --------
@@ -94,7 +109,10 @@ from .files import write_atomic
 
 __all__ = ["read_inout", "write_inout", "parse_inout", "InoutFile"]
 
-SUPPORTED_TYPE = "RG_0S"
+#: the basis types read and written: real plain ECGs of S states, and of P states (module docstring)
+S_TYPE, P_TYPE = "RG_0S", "RG_1P"
+#: ecgpack's infinite mass (m_e): a mass at or above it is read as infinite, and written as it
+INFINITE_MASS = 1e30
 _SEP = re.compile(r"^\s*={5,}\s*$")
 #: nuclei prebo has no name for: name -> (mass / m_e, charge, spin); used to name particles only
 #: (the file's masses are kept). Nuclear masses from the atomic masses (AME 2020) less Z m_e.
@@ -119,9 +137,11 @@ def _particle_spec(mass: float, charge: float) -> dict | str | None:
 # --- the file --------------------------------------------------------------------------
 @dataclass
 class InoutFile:
-    """A parsed ``*.inout.txt``: BASIS_TYPE, MASSES (m_e), CHARGES (e), the SYMMETRY string,
-    CURRENT_ENERGY (Eh; None if absent), each function's vech(L), every header line, and the root
-    the basis was optimised for (WHICH_EIGENVALUE − 1; 0 if absent), which its state targets."""
+    """A parsed ``*.inout.txt``: BASIS_TYPE (S_TYPE or P_TYPE), MASSES (m_e; ∞ for ecgpack's
+    INFINITE_MASS), CHARGES (e), the SYMMETRY string, CURRENT_ENERGY (Eh; None if absent), each
+    function's vech(L), every header line, the root the basis was optimised for (WHICH_EIGENVALUE
+    − 1; 0 if absent), which its state targets, and, for RG_1P, each function's coordinate index i
+    (1..n: its factor z_i)."""
 
     path: Path
     basis_type: str
@@ -132,6 +152,7 @@ class InoutFile:
     L: np.ndarray  # (K, n(n+1)/2) vech(L), column by column
     header: dict = field(default_factory=dict)  # keyword -> (line number, rest of the line)
     root: int = 0
+    z: np.ndarray | None = None  # (K,) RG_1P's coordinate indices i, 1-based; None for RG_0S
 
     @property
     def n_particles(self) -> int:
@@ -211,19 +232,16 @@ def parse_inout(path, text: str | None = None) -> InoutFile:
         if key not in header:
             _fail(path, None, f"header has no {key} line (lines 1-{seps[0]})")
 
-    btype = "RG_0S"
+    btype = None  # absent: told by the basis lines below
     if "BASIS_TYPE" in header:
         ln, vals, _ = header["BASIS_TYPE"]
-        btype = " ".join(vals)
-        if btype.upper() != SUPPORTED_TYPE:
-            kind = btype.upper()
-            if kind.startswith("C"):
-                why = "complex ECGs are not supported (prebo reads real plain ECGs, RG_0S)"
-            elif not kind.endswith("0S"):
-                why = "L > 0 basis functions are not supported (prebo reads S states, RG_0S)"
+        btype = " ".join(vals).upper()
+        if btype not in (S_TYPE, P_TYPE):
+            if btype.startswith("C"):
+                why = f"complex ECGs are not supported (prebo reads real ECGs, {S_TYPE} and {P_TYPE})"
             else:
-                why = f"only {SUPPORTED_TYPE} (real plain ECGs, L = 0) is supported"
-            _fail(path, ln, f"BASIS_TYPE {btype}: {why}")
+                why = f"prebo reads {S_TYPE} (real ECGs, S states) and {P_TYPE} (P states) only"
+            _fail(path, ln, f"BASIS_TYPE {' '.join(vals)}: {why}")
 
     ln, vals, _ = header["PARTICLES"]
     n = _count(vals)
@@ -239,6 +257,7 @@ def parse_inout(path, text: str | None = None) -> InoutFile:
     ln = header["MASSES"][0]
     if not np.all(arrays["MASSES"] > 0):
         _fail(path, ln, "MASSES must be positive")
+    arrays["MASSES"][arrays["MASSES"] >= INFINITE_MASS] = math.inf
     ln, vals, _ = header["BASIS_SIZE"]
     size = _count(vals)
     if size is None or size > MAX_SIZE:
@@ -269,11 +288,12 @@ def parse_inout(path, text: str | None = None) -> InoutFile:
     # the basis: the last section
     m = n * (n - 1) // 2
     start = seps[-1] + 1
-    L = []
-    for i in range(start, len(lines)):
-        parts = lines[i].split()
-        if not parts:
-            continue
+    basis_lines = [(i, lines[i].split()) for i in range(start, len(lines)) if lines[i].split()]
+    if btype is None:  # RG_1P lines carry the coordinate index before vech(L)
+        first = basis_lines[0][1] if basis_lines else []
+        btype = P_TYPE if len(first) == m + 2 and _count(first[1:2]) is not None else S_TYPE
+    L, z = [], []
+    for i, parts in basis_lines:
         if len(L) == size:
             _fail(path, i + 1, f"more basis lines than BASIS_SIZE {size} (line {header['BASIS_SIZE'][0]})")
         idx = parts[0]
@@ -282,9 +302,19 @@ def parse_inout(path, text: str | None = None) -> InoutFile:
         if _count([idx]) != len(L) + 1:
             _fail(path, i + 1, f"basis function index {_clip(idx)}, expected {len(L) + 1}")
         vals = parts[1:]
+        if btype == P_TYPE:
+            k = _count(vals[:1])
+            if k is None or not 1 <= k <= n - 1:
+                got = repr(_clip(vals[0])) if vals else "nothing"
+                _fail(path, i + 1, f"basis function {idx}: {got} after the index: {P_TYPE} gives there the "
+                                   f"coordinate i of the factor z_i, an integer in 1..{n - 1}")
+            z.append(k)
+            vals = vals[1:]
         if len(vals) != m:
-            extra = " (twice as many: a complex ECG? only real RG_0S is supported)" if len(vals) == 2 * m else ""
-            _fail(path, i + 1, f"basis function {idx}: {len(vals)} reals, expected n(n+1)/2 = {m} "
+            extra = (f" (twice as many: a complex ECG? only real {S_TYPE} and {P_TYPE} are supported)"
+                     if len(vals) == 2 * m else "")
+            what = " after the coordinate index" if btype == P_TYPE else ""
+            _fail(path, i + 1, f"basis function {idx}: {len(vals)} reals{what}, expected n(n+1)/2 = {m} "
                                f"for n = {n - 1} coordinates{extra}")
         L.append(_reals(path, i + 1, vals, f"basis function {idx}"))
     if len(L) != size:
@@ -292,7 +322,7 @@ def parse_inout(path, text: str | None = None) -> InoutFile:
                                 f"BASIS_SIZE says {size} (line {header['BASIS_SIZE'][0]})")
     return InoutFile(path, btype, arrays["MASSES"], arrays["CHARGES"], symmetry, energy,
                      np.array(L, dtype=float).reshape(size, m), {k: (v[0], " ".join(v[1])) for k, v in header.items()},
-                     root)
+                     root, np.array(z, dtype=int) if btype == P_TYPE else None)
 
 
 def _system(f: InoutFile) -> System:
@@ -342,7 +372,8 @@ def _system(f: InoutFile) -> System:
                           f"({', '.join('+'.join(str(i + 1) for i in g) for g in raw_groups) or 'none'}): "
                           "prebo cannot label it")
     spin = {names[idx[0]]: float(implied[k]) for k, idx in enumerate(raw_groups)}
-    state = State(N=0, parity=1, spin=spin, root=f.root)
+    N = 1 if f.basis_type == P_TYPE else 0
+    state = State(N=N, parity=(-1) ** N, spin=spin, root=f.root)
     try:
         return System(specs, state, symmetriser=sym)
     except PreboError as exc:
@@ -369,7 +400,8 @@ def _basis(f: InoutFile, c_A: float) -> Basis:
             _fail(f.path, _basis_line(f, k)[0], f"basis function {k + 1}: its laboratory-frame exponent is not "
                                                 "positive definite in double precision (L's reals span too many "
                                                 "orders of magnitude)")
-    basis = Basis(system, A, np.full(len(A), float(c_A)), [hpc.name] * len(A))
+    extras = {} if f.z is None else {"kind": "ecg-gvr", "u": hpc.U[f.z - 1], "K": np.zeros(len(A), dtype=int)}
+    basis = Basis(system, A, np.full(len(A), float(c_A)), [hpc.name] * len(A), **extras)
     try:
         basis.validate()
     except PreboError as exc:
@@ -409,13 +441,15 @@ def _basis_line(f: InoutFile, k: int) -> tuple[int | None, list[str]]:
 
 
 def read_inout(path, c_A: float = 1.0) -> Basis:
-    """An ecgpack ``*.inout.txt`` (RG_0S) as a `prebo.Basis` in laboratory-frame coordinates.
+    """An ecgpack ``*.inout.txt`` (RG_0S: plain ECGs; RG_1P: ECG-GVR functions of N = 1) as a
+    `prebo.Basis` in laboratory-frame coordinates.
 
     Particles keep the file's order, masses and charges; each gets prebo's name for it
     (``e``, ``alpha``, ...; nuclei prebo does not know: ``li7`` etc., others ``x1``, ``x2``)
-    with the file's mass, which may differ from prebo's CODATA value. Each function is
-    A = U_xᵀ blockdiag(L Lᵀ, c_A) U_x with x = ``hpc:0`` (relative to particle 1) and the
-    given `c_A` (the translation-free energy does not depend on it). The symmetry is the
+    with the file's mass, which may differ from prebo's CODATA value (ecgpack's 1e30: infinite).
+    Each function is A = U_xᵀ blockdiag(L Lᵀ, c_A) U_x with x = ``hpc:0`` (relative to particle
+    1) and the given `c_A` (the translation-free energy does not depend on it); an RG_1P
+    function's z_i is its global vector (module docstring). The symmetry is the
     file's SYMMETRY string's Y†Y (module docstring): the implied spin state's own operator
     when it is that, else carried explicitly (`System(..., symmetriser=...)`).
 
@@ -424,7 +458,8 @@ def read_inout(path, c_A: float = 1.0) -> Basis:
     `write_inout(..., source=...)`.
 
     Raises BasisFileError naming the file and line for anything prebo cannot take: complex
-    ECGs, L > 0 basis types, a malformed header or basis line, a size mismatch, a symmetry
+    ECGs, basis types other than RG_0S and RG_1P, a malformed header or basis line (an RG_1P
+    coordinate index outside 1..n), a size mismatch, two infinite masses, a symmetry
     exchanging different particles, or a file that is not an ecgpack file (recognised by its
     content, io.stored); InputError for a `path` that is not a file name."""
     path = path_name(path, "read_inout: path", "a file name (a str or path)")
@@ -441,9 +476,11 @@ def _fmt(x: float) -> str:
 
 
 def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFile | None = None) -> None:
-    """Write a plain-ECG `basis` as an ecgpack ``*.inout.txt`` (RG_0S).
+    """Write a plain-ECG `basis` as an ecgpack ``*.inout.txt`` (RG_0S), or an ECG-GVR one of a P
+    state (N = 1, every K = 0, every global vector one particle's coordinate relative to the
+    first: RG_1P, module docstring).
 
-    Parameters: `basis`, plain ECGs (UnsupportedError for another family); `path`, the
+    Parameters: `basis`, plain ECGs or such ECG-GVR functions (UnsupportedError for others); `path`, the
     file, written atomically (`write_atomic`); `energy` (Eh) for CURRENT_ENERGY, default the
     translation-free energy `prebo.evaluate` computes of the level WHICH_EIGENVALUE names, the
     lowest the state targets (`[state] root`; ecgpack optimises one); `source`, the `InoutFile`
@@ -456,16 +493,16 @@ def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFi
     L, so that read → write → read gives the same A bit for bit. (Through basis.json that
     link is lost and A comes back to rounding, ~1e-16 relative, which moves the energy of
     a nearly linearly dependent basis such as He-490 by ~1e-12 relative.) The header gives
-    the masses (m_e) and charges (e) in the basis's particle order and the SYMMETRY string
-    (`prebo.system.young.young_string`). InputError for a `basis` or `path` of the wrong type."""
+    the masses (m_e; an infinite one as INFINITE_MASS) and charges (e) in the basis's particle
+    order and the SYMMETRY string (`prebo.system.young.young_string`). InputError for a `basis`
+    or `path` of the wrong type."""
     if not isinstance(basis, Basis):
         raise InputError(f"write_inout: basis = {basis!r}: must be a prebo Basis")
     path_name(path, "write_inout: path", "a file name (a str or path)")
-    if basis.family.parameters != ("A", "c_A"):
-        raise UnsupportedError(f"ecgpack's RG_0S format holds plain ECGs only, not {basis.family.name}")
     system = basis.system
     n = system.n
     hpc = heavy_particle_centred(system.masses, 0)
+    z = _coordinate_indices(basis, hpc)
     rows, cols = _vech_indices(n - 1)
     imported = source.exponents() if source is not None else np.zeros((0, n - 1, n - 1))
     vech = []
@@ -490,9 +527,9 @@ def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFi
         energy = r["levels"][root]["energy"] if root else r["energy"]
     K = len(basis)
     out = [
-        f" BASIS_TYPE {SUPPORTED_TYPE}",
+        f" BASIS_TYPE {S_TYPE if z is None else P_TYPE}",
         f" PARTICLES {n:6d}",
-        " MASSES " + "".join(_fmt(m) for m in system.masses),
+        " MASSES " + "".join(_fmt(min(m, INFINITE_MASS)) for m in system.masses),
         " CHARGES " + "".join(_fmt(q) for q in system.charges),
         f" SYMMETRY {young}",
         f" BASIS_SIZE {K:6d}",
@@ -505,5 +542,27 @@ def write_inout(basis: Basis, path, energy: float | None = None, source: InoutFi
         f" {K:6d}" + _fmt(energy) + "      0      0      0",
         " ==============================",
     ]
-    out += [f" {k + 1:6d}" + "".join(_fmt(x) for x in v) for k, v in enumerate(vech)]
+    index = [""] * K if z is None else [f" {i:6d}" for i in z]
+    out += [f" {k + 1:6d}" + index[k] + "".join(_fmt(x) for x in v) for k, v in enumerate(vech)]
     write_atomic(path, "\n".join(out) + "\n")
+
+
+def _coordinate_indices(basis: Basis, hpc) -> np.ndarray | None:
+    """RG_1P's coordinate index i (1..n − 1) of every function of an ECG-GVR `basis` of N = 1 and
+    K = 0 whose global vector is a multiple of e_i in `hpc` (``hpc:0``; module docstring); None for
+    plain ECGs; UnsupportedError naming the first function ecgpack's formats do not hold."""
+    fam = basis.family
+    if fam.parameters == ("A", "c_A"):
+        return None
+    if fam.parameters != ("A", "u", "K", "c_A") or basis.N != 1:
+        raise UnsupportedError(f"ecgpack's {S_TYPE} and {P_TYPE} formats hold plain ECGs and ECG-GVR functions of "
+                               f"N = 1, not {fam.name} functions of N = {basis.N}")
+    ux = hpc.transform_vectors_to_x(basis.u)
+    z = np.argmax(np.abs(ux), axis=1)
+    for k, (v, i) in enumerate(zip(ux, z)):
+        others = np.delete(v, i)
+        if basis.K[k] != 0 or np.any(np.abs(others) > 1e-12 * abs(v[i])) or i == len(v) - 1:
+            raise UnsupportedError(f"function {k}: {P_TYPE} holds z_i exp(-r^T A r), K = 0 and the global vector one "
+                                   f"particle's position relative to the first; this one has K = {int(basis.K[k])} and "
+                                   f"u = {np.round(v, 12).tolist()} in those coordinates (hpc:0, the CM last)")
+    return z + 1

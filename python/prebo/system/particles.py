@@ -11,23 +11,54 @@ as the errors of the best ECG energies: the infinite-mass limit); charges 0 or 1
 falls as q²: 1e3 bohr and 5e-7 Eh for an electron at |q| = 1e-3). Within these ranges, and those
 of length_range and c_A (optimise/settings.py), every length and exponent the sampler draws is a
 finite double (optimise/sampler.py; tests/test_messages.py).
+
+A mass may also be infinite (`math.inf`, TOML's `inf`): a clamped particle, a nucleus in the
+Born–Oppenheimer sense, with no kinetic term (M_ii = 1/(2 m_i) = 0) and the centre of mass on it
+(m/m_tot = e_i, `prebo.coordinates.mass_fractions`); at most one particle of a system may be
+(`prebo.System`). JSON has no infinity: basis.json and result.json store such a mass as the string
+"inf" (`INFINITE`).
 """
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass
 from fractions import Fraction
+
+import numpy as np
 
 from ..errors import InputError
 from ..validation import Magnitude, Real, checked, half_integer
 
+#: the stored form of an infinite mass in basis.json and result.json (JSON has no infinity)
+INFINITE = "inf"
+
+
+@dataclass(frozen=True)
+class Mass:
+    """A finite mass of the range `finite`, or +∞ (a clamped particle; module docstring)."""
+
+    finite: Real
+
+    @property
+    def allowed(self) -> str:
+        """What the rule allows, for error messages."""
+        return f"{self.finite.allowed}, or inf (a clamped particle of infinite mass)"
+
+    def __call__(self, v) -> float:
+        if isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)) and v == math.inf:
+            return math.inf
+        return self.finite(v)
+
+
 #: particle masses in m_e and charges in e (module docstring)
-MASS = Real(1e-6, 1e12, True, True)
+MASS = Mass(Real(1e-6, 1e12, True, True))
 CHARGE = Magnitude(1e-3, 1e3)
 
 
 @dataclass(frozen=True)
 class Particle:
-    """A point particle: `name`, `mass` in m_e (1e-6..1e12, `MASS`), `charge` in e (0 or
+    """A point particle: `name`, `mass` in m_e (1e-6..1e12 or inf, `MASS`), `charge` in e (0 or
     1e-3 ≤ |q| ≤ 1e3, `CHARGE`), `spin` in ħ (0, 1/2, 1, ...); InputError for anything else."""
 
     name: str
@@ -49,8 +80,9 @@ class Particle:
         return self.spin.denominator == 2
 
     def to_dict(self) -> dict:
-        """{name, mass, charge, spin} as basis.json stores it."""
-        return {"name": self.name, "mass": self.mass, "charge": self.charge, "spin": float(self.spin)}
+        """{name, mass, charge, spin} as basis.json stores it (an infinite mass as `INFINITE`)."""
+        mass = INFINITE if self.mass == math.inf else self.mass
+        return {"name": self.name, "mass": mass, "charge": self.charge, "spin": float(self.spin)}
 
 
 _h = Fraction(1, 2)
@@ -72,8 +104,13 @@ ALIASES = {"e-": "e", "electron": "e", "positron": "e+", "proton": "p", "deutero
 
 
 def reduced_mass(m_a, m_b):
-    """μ = m_a m_b / (m_a + m_b) (m_e) of a pair of particles; elementwise for arrays."""
-    return m_a * m_b / (m_a + m_b)
+    """μ = m_a m_b / (m_a + m_b) (m_e) of a pair of particles, and its limit m_b for an infinite
+    m_a (m_a for an infinite m_b); elementwise for arrays."""
+    with np.errstate(invalid="ignore"):  # ∞/∞ of an infinite mass: its limit below
+        mu = m_a * m_b / (m_a + m_b)
+    if np.ndim(mu) == 0:
+        return m_b if math.isinf(m_a) else m_a if math.isinf(m_b) else mu
+    return np.where(np.isinf(m_a), m_b, np.where(np.isinf(m_b), m_a, mu))
 
 
 def particle(spec) -> Particle:

@@ -10,9 +10,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..coordinates import mass_fractions
 from ..errors import InputError, SpinError
 from ..validation import MAX_PARTICLES, MAX_SIZE, Integer, Real, Sign, checked, half_integer, strict_keywords
-from .particles import ALIASES, Particle, particle
+from .particles import ALIASES, INFINITE, Particle, particle
 from .symmetry import Group, Symmetriser, coupling_path, lowest_total_spin
 
 #: N: bound few-body states have far smaller ones (H₂'s last rotational level has N = 31); the
@@ -117,7 +118,8 @@ class System:
     """Particles in LFCC order (the input order), the state, and the symmetry operator.
 
     The Hamiltonian is eq. (1), H = -∇ᵀ M ∇ + Σ_{i<j} q_i q_j / |r_i - r_j| with
-    M = diag(1/(2 m_i)) (Eh; r in bohr, m in m_e, q in e).
+    M = diag(1/(2 m_i)) (Eh; r in bohr, m in m_e, q in e). One particle may have an infinite mass
+    (prebo.system.particles): M_ii = 0, m_tot = ∞ and the centre of mass on it (`cm_vector`).
 
     Parameters: `particles`, 2 to MAX_PARTICLES names (``"p"``, ``"e"``, see
     `prebo.system.particles.KNOWN`) or tables {name, mass, charge, spin}; `state`, a
@@ -135,6 +137,10 @@ class System:
             raise InputError(f"system: particles = {particles!r}: must be a list of 2 to {MAX_PARTICLES} "
                              "particle names or tables")
         self.particles: list[Particle] = [particle(p) for p in particles]
+        clamped = [p.name for p in self.particles if p.mass == math.inf]
+        if len(clamped) > 1:
+            raise InputError(f"system: particles {', '.join(map(repr, clamped))} have infinite masses: at most one "
+                             "particle may (the centre of mass sits on it)")
         if state is not None and not isinstance(state, State):
             raise InputError(f"system: state = {state!r}: must be a prebo.State")
         self.state = state if state is not None else State(**state_kw)
@@ -218,23 +224,25 @@ class System:
 
     @property
     def m_total(self) -> float:
-        """The total mass m_tot in m_e."""
+        """The total mass m_tot in m_e (∞ with an infinite mass)."""
         return float(self.masses.sum())
 
     @property
     def M(self) -> np.ndarray:
-        """Kinetic mass matrix M = diag(1/(2 m_i)) of eq. (1), in 1/m_e."""
+        """Kinetic mass matrix M = diag(1/(2 m_i)) of eq. (1), in 1/m_e (0 for an infinite mass)."""
         return np.diag(1.0 / (2.0 * self.masses))
 
     @property
     def M_internal(self) -> np.ndarray:
-        """M - 1 1ᵀ / (2 m_tot) (1/m_e): the kinetic operator with the CM kinetic energy removed exactly."""
+        """M - 1 1ᵀ / (2 m_tot) (1/m_e): the kinetic operator with the CM kinetic energy removed exactly
+        (M itself with an infinite mass: the CM does not move)."""
         return self.M - np.ones((self.n, self.n)) / (2.0 * self.m_total)
 
     @property
     def cm_vector(self) -> np.ndarray:
-        """m / m_tot: the last row of every U_x (eq. (4))."""
-        return self.masses / self.m_total
+        """m / m_tot: the last row of every U_x (eq. (4)); e_k for an infinite mass k
+        (`prebo.coordinates.mass_fractions`)."""
+        return mass_fractions(self.masses)
 
     def pairs(self) -> list[tuple[int, int, np.ndarray]]:
         """Every pair i < j with its LFCC vector w = e_i - e_j (r_ij = r_i - r_j = Σ_k w_k r_k)."""
@@ -269,9 +277,9 @@ class System:
 
     @classmethod
     def from_dict(cls, d: dict, symmetry: dict | None = None) -> "System":
-        """The system of `to_dict`, and the operator of a `Symmetriser.as_dict` block `symmetry`
-        checked against its state: the state's own (up to a factor and rounding), or one of the
-        state kept explicitly (`Symmetriser.check_projector`, an ecgpack import's); InputError,
+        """The system of `to_dict` (a mass INFINITE read as ∞), and the operator of a
+        `Symmetriser.as_dict` block `symmetry` checked against its state: the state's own (up to a
+        factor and rounding), or one of the state kept explicitly (`Symmetriser.check_projector`, an ecgpack import's); InputError,
         SpinError naming what is malformed, or that the stored operator is not that of the state."""
         if not isinstance(d, dict) or "particles" not in d:
             raise InputError("system: missing 'particles'")
@@ -284,7 +292,11 @@ class System:
         unknown = set(st) - {"N", "parity", "spin", "threshold", "roots", "weights"}
         if unknown:
             raise InputError(f"state: unknown keys {sorted(unknown)}")
-        system = cls(d["particles"], State(**st))
+        particles = d["particles"]
+        if isinstance(particles, list):  # an infinite mass is stored as INFINITE (JSON has no infinity)
+            particles = [p | {"mass": math.inf} if isinstance(p, dict) and p.get("mass") == INFINITE else p
+                         for p in particles]
+        system = cls(particles, State(**st))
         if symmetry is not None:
             system._take(Symmetriser.from_dict(symmetry), "the stored symmetry")
         return system

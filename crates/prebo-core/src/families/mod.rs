@@ -52,6 +52,9 @@ pub trait Family<const D: usize>: Sized + 'static {
     const NAME: &'static str;
     /// The arrays of the binding's parameter tuple, in order (`_core.pyi`).
     const FIELDS: &'static [Field];
+    /// The families whose functions are functions of this one too (a plain ECG is the ECG-GVR
+    /// function of K = 0): a basis of them may meet one of this family between two bases.
+    const CONTAINS: &'static [&'static str] = &[];
     /// Whether `rows(.., position)` evaluates every element in the orientation of a full build
     /// (lower index as bra), so that rows patched into the matrices give the bits of `matrices`.
     const ORIENTED: bool = true;

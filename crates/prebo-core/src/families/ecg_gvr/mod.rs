@@ -12,6 +12,8 @@
 //!   function (eqs. 26–26c);
 //! - `drachmann`: `V/|r_w|` (eq. 38) from the Coulomb elements of damped functions as
 //!   rank-one updates of one factorisation;
+//! - `transition`: the dipole's reduced elements between bases of N = 0 and N = 1 (length and
+//!   velocity forms) from quadratic forms of N = 0 functions;
 //! - `operators`: the family's own operator elements (`momentum`, `drachmann`) for the registry;
 //! - `coulomb` (tests only): the closed form of the Coulomb τ-integral.
 use nalgebra::SMatrix;
@@ -39,6 +41,7 @@ pub mod momentum;
 pub mod operators;
 pub mod series;
 pub mod tau;
+pub mod transition;
 
 /// The ECG-GVR family: parameters `A` (`k x n x n`), `u` (`k x n`), `K`, `c_A` (`GvrParams`); N is
 /// the context's.
@@ -48,6 +51,7 @@ impl<const D: usize> Family<D> for EcgGvr {
     const NAME: &'static str = "ecg-gvr";
     const FIELDS: &'static [Field] =
         &[Field::floats("A"), Field::floats("u"), Field::naturals("K"), Field::floats("c_A")];
+    const CONTAINS: &'static [&'static str] = &["pecg"];
     type Function<T: Real> = GvrFunction<D, T>;
     type Context = GvrOps<D>;
     type Params<'a> = GvrParams<'a>;

@@ -1,10 +1,11 @@
 //! ECG-GVR's own operator elements (`operators::Specialised`): the momentum operators and the
 //! orbit–orbit operator from the overlap's generating function (eqs. 26–26c, `momentum`; `p_g²`
 //! the kinetic element with `Λ = g g^T`), and Drachmann's two elements with every damped element
-//! read off one factorisation (`drachmann`), where the generic elements assume a Gaussian's
+//! read off one factorisation (`drachmann`), and the dipole between bases of N = 0 and N = 1
+//! (`transition`, no generic element), where the generic elements assume a Gaussian's
 //! gradients or integrate over damped functions one by one.
 use super::element::{element, GvrFunction, GvrOps};
-use super::{drachmann, momentum as own, EcgGvr};
+use super::{drachmann, momentum as own, transition, EcgGvr};
 use crate::operators::drachmann::{coulomb, COULOMB, GRADIENT};
 use crate::ecg::Vector;
 use crate::operators::{momentum, orbit, Elements, Specialised};
@@ -19,6 +20,8 @@ impl<const D: usize> Specialised<D> for EcgGvr {
             (COULOMB, All(|bra, ket, go, v| coulomb::all_of::<D, Self>(drachmann::inverse_products::<D>, bra, ket, go, v))),
             (GRADIENT, Each(drachmann::gradient_inv_r::<D>)),
             (orbit::NAME, Each(own::orbit::<D>)),
+            (transition::DIPOLE, Each(transition::dipole::<D>)),
+            (transition::VELOCITY, Each(transition::velocity::<D>)),
         ]
     }
 }

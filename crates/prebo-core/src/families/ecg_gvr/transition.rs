@@ -1,0 +1,181 @@
+//! Vector operators between a basis of N = 0 and one of N = 1: the electric dipole in length
+//! form, `d = Σ_k w_k r_k` with `w_k = q_k − Q m_k/m_tot` (the charges' dipole about the centre of
+//! mass; `Q`, `m_tot` the total charge and mass), and in velocity form, `Σ_k w'_k ∇_k` with
+//! `w'_k = q_k/m_k − Q/m_tot`; both vectors in the representation's coordinates (`w` like the
+//! Coulomb vectors, `w'` like a momentum). Their elements are reduced ones (Wigner–Eckart,
+//! Edmonds' convention `<N' M'|O_q|N M> = (−1)^{N'−M'} (N' 1 N; −M' q M) <N'‖O‖N>`), one per pair
+//! of a function of N = 0 (bra) and one of N = 1 (ket), each normalised:
+//!
+//! ```text
+//!     <1‖O‖0>_IJ = <p̂_J| v_J·O |φ̂_I> / <p̂_J| v_J² |p̂_J>^{1/2},
+//! ```
+//!
+//! where `p_J = |v|^{2K} exp(−r^T A r)`, `v_J = u^T r`, is the N = 0 partner of the ket
+//! `φ'_J = v_+ p_J` (ECG-GVR, M = N; a plain ECG is K = N = 0). Derivation (docs/transitions.md):
+//! `p_J φ_I` is invariant under rotations and reflections, so `∫ (v_J)_a O_b p_J φ_I =
+//! δ_ab ∫ v_J·O p_J φ_I / 3`; hence `<1 1|O_{+1}|0 0> = −(√2/3) <p_J|v_J·O|φ_I> / ‖φ'_J‖` with
+//! `‖φ'_J‖² = (2/3) <p_J|v_J²|p_J>`, and `<1‖O‖0> = √3 <1 1|O_{+1}|0 0>`; the overall sign,
+//! like an eigenvector's, is a convention (dropped here). For the length form `v_J·d` is the
+//! quadratic form `r^T (u_J w^T ⊗ I_3) r`; for the velocity form, with
+//! `φ_I = |v_I|^{2K_I} exp(−r^T A_I r)`,
+//!
+//! ```text
+//!     v_J·∇_w' φ_I = −2 (u_J^T r)·((A_I w')^T r) φ_I + 2 K_I (w'·u_I) (v_J·v_I) |v_I|^{2K_I−2} e^{−r^T A_I r},
+//! ```
+//!
+//! the second term a quadratic form against the function of power `K_I − 1`, whose norm is
+//! `x_I √((4K_I+1)(4K_I−1))` times smaller (`x_I = u_I^T A_I^{-1} u_I / 4`, the variance of each
+//! component of `v_I` under `|φ_I|²`'s Gaussian; `E|v|^{2p} = (2x)^p Γ(p+3/2)/Γ(3/2)`). Every
+//! quadratic form `<f| r^T (M ⊗ I_3) r |g>` is `−∂/∂α <f| g exp(−α r^T M r)>` at α = 0 (as `r2`).
+//!
+//! For exact states `<f‖∇_w'‖i> = −(E_f − E_i) <f‖d‖i>` (`[H, d] = −∇_w'`); the ratio of the two
+//! forms is the usual convergence diagnostic.
+use nalgebra::{Const, U1};
+
+use crate::ecg::{Mat, Vector};
+use super::element::{GvrFunction, GvrOps};
+use super::EcgGvr;
+use crate::families::Family;
+use crate::gradient::{seed, Dual};
+
+/// The length form, `v = [w]`.
+pub const DIPOLE: &str = "dipole";
+/// The velocity form, `v = [w']`.
+pub const VELOCITY: &str = "velocity";
+
+/// `<f| r^T (M ⊗ I_3) r |g>` of normalised functions for a symmetric `M`.
+pub fn quadratic<const D: usize>(f: &GvrFunction<D>, g: &GvrFunction<D>, go: &GvrOps<D>, m: &Mat<D>) -> f64 {
+    let alpha: Dual<1> = seed(0.0, std::iter::once(1.0));
+    let s = <EcgGvr as Family<D>>::overlap(&f.cast::<Dual<1>>(), &g.damped(&m.map(|x| alpha * x)), go);
+    -s.eps.unwrap_generic(Const::<1>, U1)[0]
+}
+
+/// `(a b^T + b a^T)/2`: the quadratic form of `(a^T r)·(b^T r)`.
+fn outer<const D: usize>(a: &Vector<D>, b: &Vector<D>) -> Mat<D> {
+    (a * b.transpose() + b * a.transpose()) * 0.5
+}
+
+/// `<p̂_J| v_J² |p̂_J>^{1/2}` of the ket's partner.
+fn norm<const D: usize>(ket: &GvrFunction<D>, go: &GvrOps<D>) -> f64 {
+    quadratic(ket, ket, go, &outer(&ket.u, &ket.u)).sqrt()
+}
+
+/// `<1‖d‖0>_IJ`, `v = [w]` (module docs); `bra` of N = 0, `ket` the partner of N = 1's function.
+pub fn dipole<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
+    quadratic(bra, ket, go, &outer(&ket.u, &v[0])) / norm(ket, go)
+}
+
+/// `<1‖∇_w'‖0>_IJ`, `v = [w']` (module docs); `bra` and `ket` as for `dipole`.
+pub fn velocity<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
+    let w = &v[0];
+    let mut e = -2.0 * quadratic(bra, ket, go, &outer(&ket.u, &(bra.a * w)));
+    if bra.k > 0 {
+        let k = bra.k as f64;
+        let lower = GvrFunction::new(bra.a, bra.u, bra.k - 1, bra.c_a, go, 0).expect("K − 1 of a checked function");
+        let x = bra.u.dot(&bra.a.cholesky().expect("a checked exponent").solve(&bra.u)) * 0.25;
+        let ratio = 1.0 / (x * ((4.0 * k + 1.0) * (4.0 * k - 1.0)).sqrt());
+        e += 2.0 * k * w.dot(&bra.u) * ratio * quadratic(&lower, ket, go, &outer(&ket.u, &bra.u));
+    }
+    e / norm(ket, go)
+}
+
+#[cfg(test)]
+mod tests {
+    //! Against Gauss–Hermite quadrature of the Cartesian elements with the ket's M = 0 component
+    //! `v_z p_J` (`<1‖O‖0> = √3 <1 0|O_z|0 0>`, Edmonds), for two and three coordinates and K up
+    //! to 1: the length form exactly (a polynomial under the Gaussian weight), the velocity form
+    //! by a central difference of the bra along `w'` inside the quadrature.
+    use super::*;
+    use crate::ecg::Operators;
+    use crate::operators::fixtures::{exponent, gauss_hermite};
+
+    /// `∫ g(r) exp(−Σ_c r_c^T B r_c) dr` (`r_c` the coordinates' component c) with `M` Gauss–Hermite
+    /// nodes per dimension after `r_c = L^{−T} y_c`, `B = L L^T`: exact for `g` a polynomial of degree < 2M.
+    fn integrate<const D: usize, const M: usize>(b: &Mat<D>, g: impl Fn(&[Vector<D>; 3]) -> f64) -> f64 {
+        let rule = gauss_hermite::<M>();
+        let l = b.cholesky().unwrap().l();
+        let (back, det) = (l.transpose().try_inverse().unwrap(), l.diagonal().product().powi(2));
+        let mut index = vec![0; 3 * D];
+        let mut total = 0.0;
+        loop {
+            let r: [Vector<D>; 3] = std::array::from_fn(|c| back * Vector::<D>::from_fn(|i, _| rule[index[c * D + i]].0));
+            total += index.iter().map(|&k| rule[k].1).product::<f64>() * g(&r);
+            match index.iter().position(|&k| k + 1 < M) {
+                Some(d) => {
+                    index[d] += 1;
+                    index[..d].fill(0);
+                }
+                None => return total * det.powf(-1.5),
+            }
+        }
+    }
+
+    /// `|u^T r|^{2K}`.
+    fn power<const D: usize>(u: &Vector<D>, k: u32, r: &[Vector<D>; 3]) -> f64 {
+        r.iter().map(|rc| u.dot(rc).powi(2)).sum::<f64>().powi(k as i32)
+    }
+
+    struct Pair<const D: usize> {
+        bra: (Mat<D>, Vector<D>, u32),
+        ket: (Mat<D>, Vector<D>, u32),
+    }
+
+    impl<const D: usize> Pair<D> {
+        fn new(seeds: (f64, f64), ks: (u32, u32)) -> Self {
+            let u = |s: f64| Vector::<D>::from_fn(|i, _| (1.3 * i as f64 + s).cos());
+            Self { bra: (exponent::<D>(seeds.0), u(seeds.0), ks.0), ket: (exponent::<D>(seeds.1), u(seeds.1 + 0.4), ks.1) }
+        }
+
+        fn functions(&self) -> (GvrFunction<D>, GvrFunction<D>, GvrOps<D>) {
+            let go = GvrOps::new(Operators { lambda: Mat::<D>::identity() * 0.5, pairs: vec![], cm_mass: None }, 0, 2).unwrap();
+            let f = |(a, u, k): (Mat<D>, Vector<D>, u32), i| GvrFunction::new(a, u, k, 1.0, &go, i).unwrap();
+            (f(self.bra, 0), f(self.ket, 1), go)
+        }
+
+        /// `√3 ∫ (v_z p_J)(r) φ_I(r + s) dr / (‖v_z p_J‖ ‖φ_I‖)`, `s = h w' ẑ` and `O_z` = `o(r)`.
+        fn cartesian<const M: usize>(&self, o: impl Fn(&[Vector<D>; 3]) -> f64, h: f64, w: &Vector<D>) -> f64 {
+            let ((ai, ui, ki), (aj, uj, kj)) = (self.bra, self.ket);
+            let shift = |r: &[Vector<D>; 3]| [r[0], r[1], r[2] + w * h];
+            let x = integrate::<D, M>(&(ai + aj), |r| {
+                let decay = (-2.0 * h * (ai * w).dot(&r[2]) - h * h * w.dot(&(ai * w))).exp();
+                uj.dot(&r[2]) * power(&uj, kj, r) * o(r) * power(&ui, ki, &shift(r)) * decay
+            });
+            let nj = integrate::<D, M>(&(aj * 2.0), |r| (uj.dot(&r[2]) * power(&uj, kj, r)).powi(2));
+            let ni = integrate::<D, M>(&(ai * 2.0), |r| power(&ui, ki, r).powi(2));
+            3f64.sqrt() * x / (nj * ni).sqrt()
+        }
+    }
+
+    fn length<const D: usize>(seeds: (f64, f64), ks: (u32, u32)) {
+        let pair = Pair::<D>::new(seeds, ks);
+        let (bra, ket, go) = pair.functions();
+        let w = Vector::<D>::from_fn(|i, _| [1.0, -2.0, 0.5][i % 3]);
+        let got = dipole(&bra, &ket, &go, &[w]);
+        let want = pair.cartesian::<4>(|r| w.dot(&r[2]), 0.0, &w);
+        assert!((got - want).abs() <= 1e-11 * want.abs(), "{ks:?}: {got} vs {want}");
+    }
+
+    #[test]
+    fn the_length_form_matches_quadrature_for_two_and_three_coordinates() {
+        for ks in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            length::<2>((0.3, 1.7), ks);
+        }
+        for ks in [(0, 0), (1, 1)] {
+            length::<3>((0.9, 2.4), ks);
+        }
+    }
+
+    #[test]
+    fn the_velocity_form_matches_a_central_difference_of_the_bra() {
+        for ks in [(0, 0), (1, 0), (2, 1)] {
+            let pair = Pair::<2>::new((0.6, 1.9), ks);
+            let (bra, ket, go) = pair.functions();
+            let w = Vector::<2>::new(0.7, -1.1);
+            let got = velocity(&bra, &ket, &go, &[w]);
+            let h = 1e-2;
+            let at = |s: f64| pair.cartesian::<7>(|_| 1.0, s * h, &w);
+            let want = (8.0 * (at(1.0) - at(-1.0)) - (at(2.0) - at(-2.0))) / (12.0 * h);
+            assert!((got - want).abs() <= 1e-7 * want.abs(), "{ks:?}: {got} vs {want}");
+        }
+    }
+}

@@ -1,0 +1,86 @@
+"""`prebo transitions`: the electric-dipole lines between the levels of two stored bases."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..errors import PreboError
+from .arguments import fraction, positive_integer
+from .files import load_basis
+from .tables import show
+
+
+def add(sub) -> None:
+    """The `prebo transitions` subcommand, added to the subparsers `sub`."""
+    p = sub.add_parser("transitions", help="electric-dipole lines between the levels of two bases")
+    for name in ("lower", "upper"):
+        p.add_argument(name, help=f"the {name} levels' basis: basis.json, a run folder holding one, "
+                                  "or an ecgpack FILE.inout.txt")
+    p.add_argument("--roots", type=positive_integer, nargs="+", default=[1], metavar="K",
+                   help="the lowest K levels of each basis (one K for both, or K_lower K_upper; default 1)")
+    p.add_argument("--coordinates", choices=["lab", "ti"], default="lab",
+                   help="lab: LFCC with CM elimination (default); ti: translationally invariant (shared c_A only)")
+    p.add_argument("--threshold", type=fraction, metavar="T",
+                   help="relative overlap eigenvalue below which directions are dropped (default: each "
+                        "basis's run's, else 4 x 2^-53)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=command)
+
+
+def command(args) -> int:
+    """`prebo transitions LOWER UPPER [--roots K [K]] [--coordinates lab|ti] [--threshold T] [--json]`:
+    for every pair of levels the reduced dipole moment in length and velocity form, the line and
+    oscillator strengths, the Einstein A coefficient, and each emitting level's lifetime
+    (level/transitions.py)."""
+    from ..level.transitions import transitions
+
+    if len(args.roots) > 2:
+        raise PreboError(f"--roots {' '.join(map(str, args.roots))}: one K for both bases, or K_lower K_upper")
+    (lower, t_lower), (upper, t_upper) = (load_basis(basis_file(p)) for p in (args.lower, args.upper))
+    threshold = args.threshold or max(t_lower, t_upper)
+    try:
+        r = transitions(lower, upper, tuple(args.roots * (3 - len(args.roots)))[:2], threshold, args.coordinates)
+    except PreboError as exc:
+        raise type(exc)(f"{args.lower}, {args.upper}: {exc}") from exc
+    if args.json:
+        print(json.dumps(r, allow_nan=False))
+    else:
+        _print(r)
+    return 0
+
+
+def basis_file(path: str) -> str:
+    """`path`, or the basis.json of the run folder `path`."""
+    p = Path(path)
+    return str(p / "basis.json") if p.is_dir() else path
+
+
+def _print(r: dict) -> None:
+    from rich.table import Table
+
+    names = ("lower", "upper")
+    label = {k: f"{names[v['basis']]} {v['root']} (N={v['N']}{'+' if v['parity'] > 0 else '−'})"
+             for k, v in enumerate(r["levels"])}
+    levels = Table("level", "energy (Eh)", title="levels")
+    for k, v in enumerate(r["levels"]):
+        levels.add_row(label[k], f"{v['energy']:.12f}")
+    show(levels)
+    lines = Table("lower → upper", "ν (cm⁻¹)", "<‖d‖> length (e a₀)", "velocity/length", "S (e² a₀²)", "f", "A (s⁻¹)",
+                  title="electric-dipole lines",
+                  caption="reduced moments <N'‖d‖N> (Edmonds), d about the centre of mass; f absorption from the "
+                          "lower level; A emission from the upper")
+    for line in r["lines"]:
+        pair = f"{label[line['lower']]} → {label[line['upper']]}"
+        if "forbidden" in line:
+            lines.add_row(pair, f"{line['cm-1']:.4f}", line["forbidden"], "", "", "", "")
+            continue
+        ratio = line["velocity/length"]
+        lines.add_row(pair, f"{line['cm-1']:.4f}", f"{line['length']:.9f}", "" if ratio is None else f"{ratio:.8f}",
+                      f"{line['line_strength']:.9e}", f"{line['oscillator_strength']:.9e}", f"{line['einstein_A']:.6e}")
+    show(lines)
+    if r["lifetimes"]:
+        life = Table("level", "lifetime (s)", "lines", title="radiative lifetimes",
+                     caption="1/Σ A over the lines to the lower levels computed")
+        for v in r["lifetimes"]:
+            life.add_row(label[v["level"]], f"{v['lifetime']:.6e}", str(v["lines"]))
+        show(life)
