@@ -39,7 +39,8 @@ def main() -> None:
             print(f"prebo run examples/{name}.toml: {wall:.0f} s wall")
         r = json.loads((args.out / name / "result.json").read_text())
         print(f"{name}: {r['n_basis']} {r['basis_type']} functions, state {r['state']}, stopped: "
-              f"{r['convergence']['stopped']} after {r['convergence']['seconds']:.0f} s of optimisation")
+              f"{r['convergence']['stopped']} after {r['convergence']['seconds']:.0f} s of optimisation, "
+              f"{r['wall_seconds']:.1f} s wall")
     out, wall = prebo("transitions", *(str(args.out / name) for name in RUNS), "--roots", "2", "--json")
     r = json.loads(out)
     print(f"\nprebo transitions {' '.join(str(args.out / n) for n in RUNS)} --roots 2 --json: {wall:.1f} s wall")
