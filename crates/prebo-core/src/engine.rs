@@ -216,17 +216,10 @@ fn between_d<const D: usize, F: Specialised<D>>(
     let (arity, elements) = registry::lookup_between::<D, F>(e.kind.name(), ket.kind.name(), name)?;
     let (bra_columns, ket_columns) = (as_family::<D, F>(e.kind, bra)?, as_family::<D, F>(ket.kind, ket_params)?);
     let (bra, ket_p) = (F::params(&bra_columns)?, F::params(&ket_columns)?);
-    let instances: Vec<Vec<Vector<D>>> = if arity == 0 {
-        check(v.len(), 0, "operator vectors")?;
-        vec![vec![]]
-    } else {
-        check(v.len(), v.len() / (arity * D) * (arity * D), "operator vectors")?;
-        v.chunks_exact(arity * D).map(|vk| vk.chunks_exact(D).map(Vector::<D>::from_row_slice).collect()).collect()
-    };
     let (ops, _) = e.rep.operators::<D>();
     let (_, ket_sym) = ket.rep.operators::<D>();
     let ctx = F::kinetic_only(&F::context(ops, e.n_ang, &[&bra, &ket_p])?);
-    path::between::<D, F>(&ctx, &ket_sym, &bra, &ket_p, instances.len(), |x, y| elements.of(x, y, &ctx, &instances))
+    path::between::<D, F>(&ctx, &ket_sym, &bra, &ket_p, |x, y, ctx, v| elements.of(x, y, ctx, v), arity, v)
 }
 
 /// The columns of a basis of family `kind` as those of `F`: as they are, or a plain ECG's `(A, c_A)`

@@ -142,10 +142,8 @@ pub fn operator<const D: usize, F: Family<D>>(
     arity: usize,
     v: &[f64],
 ) -> Result<Vec<f64>> {
-    let per = arity * D;
-    check(v.len(), v.len() / per * per, "operator vectors")?;
+    let instances = instances::<D>(arity, v)?;
     let b = images::<D, F>(ctx, sym, basis)?;
-    let instances: Vec<Vec<Vector<D>>> = v.chunks_exact(per).map(|vk| vk.chunks_exact(D).map(Vector::<D>::from_row_slice).collect()).collect();
     let (nb, p) = (b.len(), instances.len());
     let upper = assemble::upper(nb, |i, j| {
         b.images[j].iter().zip(&b.coef).fold(vec![0.0; p], |mut acc, (ket, c)| {
@@ -164,29 +162,31 @@ pub fn operator<const D: usize, F: Family<D>>(
     Ok(out)
 }
 
-/// The `p` matrices (`p x nb_bra x nb_ket`, row-major) of an operator with `p` instances between
-/// two bases of family `F`: `Σ_P c_P <phi_I| O |P phi'_J>`, the bras of `bra` as they are, the
-/// kets of `ket` with their images under the ket basis's own symmetry `ket_sym` (its operations
-/// and coefficients c_P); `element` is `<phi_I| O |phi'_J>` of every instance
-/// (`registry::lookup_between`). Rows in parallel.
+/// The matrices (`p x nb_bra x nb_ket`, row-major) of an operator between two bases of family
+/// `F`, one per instance of its `arity` vectors `v` (`instances`): `Σ_P c_P <phi_I| O |P phi'_J>`,
+/// the bras of `bra` as they are, the kets of `ket` with their images under the ket basis's own
+/// symmetry `ket_sym` (its operations and coefficients c_P); `elements` gives
+/// `<phi_I| O(v) |phi'_J>` of every instance (`registry::lookup_between`). Rows in parallel.
 pub fn between<const D: usize, F: Family<D>>(
     ctx: &F::Context,
     ket_sym: &Symmetry<D>,
     bra: &F::Params<'_>,
     ket: &F::Params<'_>,
-    p: usize,
-    element: impl Fn(&F::Function<f64>, &F::Function<f64>) -> Vec<f64> + Sync,
+    elements: impl Fn(&F::Function<f64>, &F::Function<f64>, &F::Context, &[Vec<Vector<D>>]) -> Vec<f64> + Sync,
+    arity: usize,
+    v: &[f64],
 ) -> Result<Vec<f64>> {
+    let instances = instances::<D>(arity, v)?;
     let bras = F::functions(bra, ctx)?;
     let kets = images::<D, F>(ctx, ket_sym, ket)?;
-    let nk = kets.len();
+    let (nb, nk, p) = (bras.len(), kets.len(), instances.len());
     let rows: Vec<Vec<f64>> = bras
         .par_iter()
         .map(|b| {
             let mut row = vec![0.0; p * nk];
             for j in 0..nk {
                 for (k, c) in kets.images[j].iter().zip(&kets.coef) {
-                    for (q, x) in element(b, k).into_iter().enumerate() {
+                    for (q, x) in elements(b, k, ctx, &instances).into_iter().enumerate() {
                         row[q * nk + j] += c * x;
                     }
                 }
@@ -194,13 +194,25 @@ pub fn between<const D: usize, F: Family<D>>(
             row
         })
         .collect();
-    let mut out = vec![0.0; p * bras.len() * nk];
+    let mut out = vec![0.0; p * nb * nk];
     for (i, row) in rows.iter().enumerate() {
-        for (q, values) in row.chunks_exact(nk.max(1)).enumerate().take(p) {
-            out[(q * bras.len() + i) * nk..][..nk].copy_from_slice(&values[..nk]);
+        for q in 0..p {
+            out[(q * nb + i) * nk..][..nk].copy_from_slice(&row[q * nk..][..nk]);
         }
     }
     Ok(out)
+}
+
+/// The instances of an operator's vectors `v` (`p x arity x n`, flat): `arity` D-vectors each; an
+/// operator of no vectors (the overlap) has one instance and takes none.
+pub fn instances<const D: usize>(arity: usize, v: &[f64]) -> Result<Vec<Vec<Vector<D>>>> {
+    if arity == 0 {
+        check(v.len(), 0, "operator vectors")?;
+        return Ok(vec![vec![]]);
+    }
+    let per = arity * D;
+    check(v.len(), v.len() / per * per, "operator vectors")?;
+    Ok(v.chunks_exact(per).map(|vk| vk.chunks_exact(D).map(Vector::<D>::from_row_slice).collect()).collect())
 }
 
 /// `Σ_IJ c_I c_J Σ_P c_P <phi_I| O_k |P phi_J>` of an operator with `len` components `O_k`

@@ -94,11 +94,8 @@ pub fn lookup<const D: usize, F: Specialised<D>>(bra: &str, ket: &str, name: &st
 /// of family `ket` (`path::between`).
 pub fn lookup_between<const D: usize, F: Specialised<D>>(bra: &str, ket: &str, name: &str) -> Result<(usize, Elements<D, F>)> {
     let ours = |family: &str| family == F::NAME || F::CONTAINS.contains(&family);
-    if ours(bra) && ours(ket) {
-        find(registry::<D, F>(two_bases::<D, F>()), F::NAME, F::NAME, name, names_between())
-    } else {
-        find(registry::<D, F>(two_bases::<D, F>()), bra, ket, name, names_between())
-    }
+    let (bra, ket) = if ours(bra) && ours(ket) { (F::NAME, F::NAME) } else { (bra, ket) };
+    find(registry::<D, F>(two_bases::<D, F>()), bra, ket, name, names_between())
 }
 
 /// The entry `name` of `operators` for the key (bra family, ket family, operator).

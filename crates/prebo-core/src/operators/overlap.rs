@@ -40,7 +40,7 @@ mod tests {
         let ctx = <Pecg as Family<N>>::context(operators(vec![]), 0, &[bra, ket]).unwrap();
         let (arity, elements) = registry::lookup_between::<N, Pecg>("pecg", "pecg", NAME).unwrap();
         assert_eq!(arity, 0);
-        path::between::<N, Pecg>(&ctx, ket_sym, bra, ket, 1, |x, y| elements.of(x, y, &ctx, &[vec![]])).unwrap()
+        path::between::<N, Pecg>(&ctx, ket_sym, bra, ket, |x, y, ctx, v| elements.of(x, y, ctx, v), 0, &[]).unwrap()
     }
 
     #[test]
