@@ -33,7 +33,7 @@ def command(args) -> int:
     """`prebo polarisability GROUND RESPONSE [--root K] [--omega W...] [--plot PNG [--points N]] [--json]`:
     α(ω) in a₀³ by Hylleraas' functional with the sum over the response basis's pseudostates as a
     check, and the first pole (level/response.py)."""
-    from ..level.response import polarisability
+    from ..level.response import first_order
 
     (ground, t0), (response, t1) = (load_basis(basis_file(p)) for p in (args.ground, args.response))
     png = None
@@ -43,12 +43,13 @@ def command(args) -> int:
     elif args.points != 200:
         raise InputError("--points: only with --plot")
     try:
-        r = polarisability(ground, response, args.omega, args.root, max(t0, t1))
+        problem = first_order(ground, response, args.root, max(t0, t1))
+        r = problem.at(args.omega)
         if png is not None:
             from ..plot import polarisability as draw
 
-            grid = np.linspace(0.0, r["pole"], args.points + 1)[:-1]
-            draw(grid, polarisability(ground, response, grid, args.root, max(t0, t1))["alpha"], r["pole"], png)
+            grid = np.linspace(0.0, problem.pole, args.points + 1)[:-1]
+            draw(grid, problem.at(grid)["alpha"], problem.pole, png)
     except PreboError as exc:
         raise type(exc)(f"{args.ground}, {args.response}: {exc}") from exc
     if args.json:

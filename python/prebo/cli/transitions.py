@@ -39,7 +39,8 @@ def command(args) -> int:
     (lower, t_lower), (upper, t_upper) = (load_basis(basis_file(p)) for p in (args.lower, args.upper))
     threshold = args.threshold or max(t_lower, t_upper)
     try:
-        r = transitions(lower, upper, tuple(args.roots * (3 - len(args.roots)))[:2], threshold, args.coordinates)
+        roots = tuple(args.roots) if len(args.roots) == 2 else args.roots[0]
+        r = transitions(lower, upper, roots, threshold, args.coordinates)
     except PreboError as exc:
         raise type(exc)(f"{args.lower}, {args.upper}: {exc}") from exc
     if args.json:

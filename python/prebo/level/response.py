@@ -18,6 +18,8 @@ strengths, is the same number in exact arithmetic and is reported as a check.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .. import eigen
@@ -28,17 +30,53 @@ from .evaluate import evaluate
 from .transitions import dipole_vectors, forbidden, same_particles
 
 
-def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,
-                   threshold: float = eigen.THRESHOLD) -> dict:
-    """The dipole polarisability (a₀³) of the level `root` of the N = 0 basis `ground`, with its
-    first-order function in the N = 1 basis `response` (module docstring), at the frequencies
-    `omega` (E_h; a number or a list, each below the first pole).
+@dataclass(frozen=True)
+class FirstOrder:
+    """The dipole's first-order problem of a level in a basis of N = 1, built once (`first_order`)
+    and evaluated at any frequencies (`at`): the level's energy `E0` (Eh), the reduced elements `r`
+    of the basis's functions with it, the basis's `H` (T_ti + V) and `S`, its pseudostates `C`
+    (S-orthonormal columns, the directions the overlap resolves) and their excitation energies `de`
+    (Eh), the first of them the first `pole`."""
 
-    Returns {"alpha": α(ω) per ω (Hylleraas), "sum_over_states": the same from the pseudostates,
-    "omega": the frequencies, "pole": the first pole E₁ − E₀ (E_h), "energy": E₀, "hylleraas": J
-    at ω = 0 (−α/2)}. InputError for bases of different particles or spin states, a ground basis
-    not of N = 0, a response basis not of N = 1 and opposite parity, ω not finite or at or above
-    the first pole."""
+    E0: float
+    r: np.ndarray
+    H: np.ndarray
+    S: np.ndarray
+    C: np.ndarray
+    de: np.ndarray
+
+    @property
+    def pole(self) -> float:
+        """The first pole, the basis's lowest excitation energy E₁ − E₀ (Eh)."""
+        return float(self.de[0])
+
+    def hylleraas(self, shift: float) -> float:
+        """J[ψ₁] at its minimiser over the pseudostates, for H − (E₀ + shift) (module docstring)."""
+        z = -self.C @ ((self.C.T @ self.r) / (self.de - shift))
+        return float(z @ (self.H - (self.E0 + shift) * self.S) @ z + 2 * z @ self.r)
+
+    def at(self, omega) -> dict:
+        """α(ω) at the frequencies `omega` (Eh; a number or a list, each below the first pole), as
+        `polarisability` returns it; InputError for ω not finite or at or above the pole."""
+        omegas = np.atleast_1d(np.asarray(omega, dtype=float))
+        if omegas.ndim != 1 or not np.all(np.isfinite(omegas)):
+            raise InputError(f"polarisability: omega = {omega!r}: must be finite frequencies (E_h)")
+        above = np.abs(omegas) >= self.pole
+        if np.any(above):
+            raise InputError(f"polarisability: omega = {omegas[above][0]:.6g} Eh is at or above the first pole "
+                             f"{self.pole:.6g} Eh (the response basis's lowest level of N = 1)")
+        strengths = (self.C.T @ self.r) ** 2
+        alpha = [-(self.hylleraas(x) + self.hylleraas(-x)) / 3 for x in omegas]
+        sos = [float(np.sum(strengths * (1 / (self.de - x) + 1 / (self.de + x)))) / 3 for x in omegas]
+        return {"alpha": alpha, "sum_over_states": sos, "omega": omegas.tolist(), "pole": self.pole,
+                "energy": self.E0, "hylleraas": self.hylleraas(0.0) / 3}
+
+
+def first_order(ground: Basis, response: Basis, root: int = 0, threshold: float = eigen.THRESHOLD) -> FirstOrder:
+    """The `FirstOrder` problem of the level `root` of the N = 0 basis `ground` in the N = 1 basis
+    `response`. InputError for bases of different particles or spin states, a ground basis not of
+    N = 0, a response basis not of N = 1 and opposite parity, or one with a level below the ground
+    level."""
     for b, what in ((ground, "ground"), (response, "response")):
         if not isinstance(b, Basis) or len(b) == 0:
             raise InputError(f"polarisability: {what} = {b!r}: must be a non-empty prebo.Basis")
@@ -51,9 +89,6 @@ def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,
     if why is not None:
         raise InputError(f"polarisability: the response basis cannot hold the dipole's first-order function ({why})")
     same_particles(ground.system, response.system)
-    omegas = np.atleast_1d(np.asarray(omega, dtype=float))
-    if omegas.ndim != 1 or not np.all(np.isfinite(omegas)):
-        raise InputError(f"polarisability: omega = {omega!r}: must be finite frequencies (E_h)")
     r0 = evaluate(ground, threshold=threshold, roots=root + 1, targets=[root])
     E0, c0 = float(r0["energy"]), r0["vectors"][:, 0]
     rep = laboratory(ground.system)
@@ -63,23 +98,19 @@ def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,
     rep.require_resolved(m)
     H, S = m["T_ti"] + m["V"], m["S"]
     states = eigen.solve(H, S, threshold, 1)
-    pole = float(states.energies[0] - E0)
-    if pole <= 0:
-        raise InputError(f"polarisability: the response basis has a level {-pole:.6g} Eh below the ground level")
-    above = np.abs(omegas) >= pole
-    if np.any(above):
-        raise InputError(f"polarisability: omega = {omegas[above][0]:.6g} Eh is at or above the first pole "
-                         f"{pole:.6g} Eh (the response basis's lowest level of N = 1)")
-    C, de = states.vectors, states.energies - E0
-    strengths = (C.T @ r) ** 2
+    if states.energies[0] <= E0:
+        raise InputError(f"polarisability: the response basis has a level {E0 - states.energies[0]:.6g} Eh below "
+                         "the ground level")
+    return FirstOrder(E0, r, H, S, states.vectors, states.energies - E0)
 
-    def hylleraas(shift: float) -> float:
-        """J[ψ₁] at its minimiser over the basis's resolved directions (the pseudostates C)."""
-        z = -C @ ((C.T @ r) / (de - shift))
-        return float(z @ (H - (E0 + shift) * S) @ z + 2 * z @ r)
 
-    alpha = [-(hylleraas(x) + hylleraas(-x)) / 3 for x in omegas]
-    sos = [float(np.sum(strengths * (1 / (de - x) + 1 / (de + x)))) / 3 for x in omegas]
-    J = hylleraas(0.0) / 3
-    return {"alpha": alpha, "sum_over_states": sos, "omega": omegas.tolist(), "pole": pole, "energy": E0,
-            "hylleraas": J}
+def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,
+                   threshold: float = eigen.THRESHOLD) -> dict:
+    """The dipole polarisability (a₀³) of the level `root` of the N = 0 basis `ground`, with its
+    first-order function in the N = 1 basis `response` (module docstring), at the frequencies
+    `omega` (E_h; a number or a list, each below the first pole): `first_order(...).at(omega)`.
+
+    Returns {"alpha": α(ω) per ω (Hylleraas), "sum_over_states": the same from the pseudostates,
+    "omega": the frequencies, "pole": the first pole E₁ − E₀ (E_h), "energy": E₀, "hylleraas": J
+    at ω = 0 (−α/2)}. InputError as `first_order` and `FirstOrder.at` raise it."""
+    return first_order(ground, response, root, threshold).at(omega)
