@@ -73,7 +73,7 @@ def test_he_evaluated_as_ecgpack_solves_it(tmp_path, references):
     them too (eigen.THRESHOLD, the default) and reproduces the file's energy (1.5e-13 above it), where
     the former default threshold, 1e-13, dropped 2 of the 490 directions and 1.7e-10 Eh."""
     from prebo.cli import main
-    from prebo.cli.files import load_basis
+    from prebo.io.load import load_basis
 
     assert main(["import", str(HE), "--out", str(tmp_path / "he.json")]) == 0
     for path in (HE, tmp_path / "he.json"):

@@ -171,7 +171,7 @@ def test_stored_basis_files_hold_what_the_format_says(path):
     levels where they stand. he-2-1s, he-inf-2-1s, h2plus-ladder and h2plus-n1 held that sum in
     `energy` and had no objective; h, h2-pecg and h2plus-pecg held the energy of the code they were
     written with (1e-10, 1.3e-11 and 1.1e-8 relative from their functions')."""
-    from prebo.cli.files import load_basis
+    from prebo.io.load import load_basis
     from prebo.io.basis_json import KEYS
 
     d = json.loads((ROOT / path).read_text())

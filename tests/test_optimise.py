@@ -192,7 +192,7 @@ def test_lowest_json_is_written_when_the_run_leaves_its_lowest_state_and_removed
 
     def state(n, energy):
         return SimpleNamespace(basis=basis.subset(slice(0, n)), energy=energy, coefficients=np.eye(n)[:, 0],
-                               lowest_root=energy, objective=SimpleNamespace(lowest=True))
+                               lowest_root=energy, objective=SimpleNamespace(lowest=True, recorded=False))
 
     lowest, path = Lowest(basis, 3, tmp_path, {"optimiser": {}}, resumed=False), tmp_path / "lowest.json"
     lowest.see(state(3, -0.4))

@@ -404,7 +404,7 @@ def test_plot_refuses_a_malformed_history_row(tmp_path, capsys, k, position, val
 @pytest.mark.parametrize("threshold", [float("nan"), float("inf"), "1e-13", None, True, 0.0, 1.5, -1e-13, 1])
 def test_a_stored_threshold_that_is_no_threshold_is_refused(tmp_path, capsys, threshold):
     """A NaN (or any other non-threshold) stored as the run's optimiser threshold fell back to
-    1e-13 without a word (cli.files.load_basis): one line naming the file, the key and the value."""
+    1e-13 without a word (io.load.load_basis): one line naming the file, the key and the value."""
     d = json.loads((H_RUN / "basis.json").read_text())
     d["optimiser"]["threshold"] = threshold
     f = tmp_path / "basis.json"

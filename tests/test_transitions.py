@@ -69,6 +69,17 @@ def test_laboratory_and_translationally_invariant_elements_agree():
         assert np.max(np.abs(lab - ti)) < 1e-11 * np.max(np.abs(lab))
 
 
+def test_bases_of_different_cm_exponents_give_the_internal_elements():
+    """A two-basis element is that of the internal functions: bases optimised at different c_A
+    (their CM Gaussians' overlap 0.977 at 0.7 and 1.0) give the lines and α of one c_A."""
+    same = transitions(hydrogen(0), hydrogen(1), roots=1)["lines"][0]
+    other = transitions(hydrogen(0, c_A=0.7), hydrogen(1, c_A=1.0), roots=1)["lines"][0]
+    for key in ("length", "velocity", "line_strength"):  # the levels at c_A = 1 move by ~5e-10 in rounding
+        assert abs(other[key]) == pytest.approx(abs(same[key]), rel=1e-8), key
+    alpha = prebo.polarisability(hydrogen(0), hydrogen(1, c_A=1.0))["alpha"][0]
+    assert alpha == pytest.approx(prebo.polarisability(hydrogen(0), hydrogen(1))["alpha"][0], rel=1e-8)
+
+
 def test_a_plain_bra_equals_the_ecg_gvr_bra_at_k_0():
     upper = hydrogen(1, EXPONENTS[3:10])
     w, w_v = dipole_vectors(upper.system)
@@ -113,7 +124,7 @@ def test_ecgpack_he_samples_give_the_elements_its_readme_prints():
     # ecgpack's RG_0S-1P He sample (tests/data/ecgpack/README.md): its README prints, digits cut off,
     # dE = 0.779 287 387, <S|z|P> = 0.395 665 167 for the M = 0 component (<1‖d‖0> = √3 <1 0|d_z|0 0>)
     # and <S|P_z|P> = i 0.314 193 144 with P_z the electrons' momentum (|velocity form| × ΔE / √3)
-    from prebo.cli.files import load_basis
+    from prebo.io.load import load_basis
 
     data = __import__("pathlib").Path(__file__).parent / "data" / "ecgpack"
     lower, upper = (load_basis(data / f"ecgpack-He-inf-{s}-10.inout.txt")[0] for s in ("1S", "2P"))
@@ -168,7 +179,7 @@ def test_bad_input_is_one_line(files, capsys, args, words):
 
 def test_a_forbidden_pair_is_reported_as_such_never_as_a_number():
     # para H2+ (N = 0) and ortho H2+ (N = 1): the protons' spin states differ
-    from prebo.cli.files import load_basis
+    from prebo.io.load import load_basis
 
     bases = __import__("pathlib").Path(__file__).parent.parent / "examples" / "bases"
     para, ortho = (load_basis(bases / name / "basis.json")[0] for name in ("h2plus-gvr", "h2plus-n1"))

@@ -5,7 +5,7 @@ import json
 
 from ..level.expectation import OPERATORS
 from .arguments import fraction, positive_integer
-from .files import load_basis
+from ..io.load import load_basis
 from .result import print_result, result, warn_if_unbound
 
 

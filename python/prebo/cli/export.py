@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .files import given, load_basis, output_file
+from ..io.load import load_basis
+from .files import given, output_file
 
 
 def add(sub) -> None:

@@ -1,4 +1,4 @@
-"""The files a command reads and writes: a stored basis (`load_basis`), an output file that replaces
+"""The files a command writes: an output file that replaces
 no input nor anything but a regular file, and an earlier one only with `--force` (`output_file`), and
 a run's folder (`claim`)."""
 from __future__ import annotations
@@ -64,22 +64,3 @@ def same_file(a, b) -> bool:
         return False
 
 
-def load_basis(path) -> tuple:
-    """A basis.json or an ecgpack file (ecgpack's own name: inout.txt), recognised by its content
-    whatever its name (io.stored), and the overlap threshold of the code that wrote it: a run's
-    (its "optimiser" block), else eigen.THRESHOLD (every direction double precision resolves, as
-    ecgpack keeps them)."""
-    from ..basis import Basis
-    from ..eigen import THRESHOLD
-    from ..errors import InputError
-    from ..io import basis_json, stored
-    from ..io.ecgpack import parse_inout
-
-    if str(path).endswith(".toml"):
-        raise InputError(f"{path}: a TOML input, not a basis; optimise it with `prebo run {path}`")
-    what, text = stored.read(path)
-    if what == "ecgpack":
-        return parse_inout(path, text).to_basis(), THRESHOLD
-    d = basis_json.parse(text, path)
-    basis = Basis.from_dict(d, str(path))  # d, its settings included, is checked from here on
-    return basis, (d.get("optimiser") or {}).get("threshold", THRESHOLD)

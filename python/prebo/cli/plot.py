@@ -6,7 +6,8 @@ from pathlib import Path
 
 from ..errors import OutputError, PreboError
 from .arguments import distance, finite, natural, positive_integer
-from .files import given, load_basis, output_file
+from ..io.load import load_basis
+from .files import given, output_file
 
 
 def add(sub) -> None:

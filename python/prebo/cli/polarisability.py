@@ -9,9 +9,9 @@ import numpy as np
 from ..errors import InputError, PreboError
 from .arguments import finite, natural, positive_integer
 from ..validation import path_name
-from .files import load_basis, output_file
+from ..io.load import basis_file, load_basis
+from .files import output_file
 from .tables import show
-from .transitions import basis_file
 
 
 def add(sub) -> None:

@@ -8,7 +8,7 @@ import sys
 from ..errors import NonFiniteError, PreboError
 from ..level.expectation import OPERATORS
 from .arguments import fraction, natural
-from .files import load_basis
+from ..io.load import load_basis
 from .result import bound
 from .tables import show
 

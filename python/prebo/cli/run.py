@@ -11,9 +11,9 @@ from ..errors import NonFiniteError, PreboError
 from ..parallel import world
 from ..validation import path_name
 from .arguments import seconds
-from .files import RESULT, claim, given, load_basis
+from ..io.load import basis_file, load_basis
+from .files import RESULT, claim, given
 from .result import print_result, result, warn_if_unbound
-from .transitions import basis_file
 
 
 def add(sub) -> None:
@@ -88,7 +88,7 @@ def command(args) -> int:
                 if root:
                     claim(out, args.force)
                 opts = job.optimiser if args.budget is None else replace(job.optimiser, budget=args.budget)
-                basis = optimise(job.system, opts, out=out, progress=not args.quiet)
+                basis = optimise(job.system, opts, out=out, progress=not args.quiet, response=job.response)
         # the settings to change are in the input (or the checkpoint): a state, size or settings that
         # do not fit together, or no trial that could start or grow the basis
         except (StalledError, InputError, UnsupportedError) as exc:
@@ -104,6 +104,9 @@ def command(args) -> int:
             print(f"prebo: warning: result.json without expectation values: {exc}", file=sys.stderr)
         for level in r.get("levels", [r]):  # each level's Breit–Pauli correction and regularised δ, p⁴
             level |= corrections(basis, level)
+        driving = job.response if args.resume is None else checkpoint_source(out / CHECKPOINT)
+        if driving is not None:  # a first-order function's run: the polarisability it gives
+            r["response"] = response(basis, driving)
         if partner is not None:  # the run's result stands without them: a warning
             try:
                 r["lines"] = lines(basis, partner, args.partner, len(r.get("levels", [r])), opts.threshold)
@@ -139,3 +142,24 @@ def lines(basis, partner, where: str, roots: int, threshold: float) -> dict:
     from ..level.transitions import transitions
 
     return {"partner": where} | transitions(basis, partner, (roots, max(partner.system.state.levels[0]) + 1), threshold)
+
+
+def checkpoint_source(path: Path):
+    """The response.Source of the checkpoint `path` of a response run (None for a run of levels)."""
+    from ..io import basis_json
+    from ..optimise.response import Source
+
+    d = basis_json.read(path)
+    return None if "response" not in d else Source.from_dict(d["response"], str(path))
+
+
+def response(basis, source) -> dict:
+    """result.json's `response`: the operator, the ground level (`root`, `energy`), the functional's
+    minimum the run reached (`objective`, Eh) and the dipole polarisability α(ω) (a₀³) at the
+    source's frequency that the run's basis gives (level/response.FirstOrder.at: the Hylleraas
+    value, the sum over its pseudostates and the first pole)."""
+    from ..level.response import first_order
+
+    order = first_order(source.ground, basis, source.root, source.threshold)
+    return {"operator": source.operator, "root": source.root, "objective": basis.convergence["objective"]} \
+        | order.at(source.omega)

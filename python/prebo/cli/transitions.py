@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ..errors import PreboError
 from .arguments import fraction, positive_integer
-from .files import load_basis
+from ..io.load import basis_file, load_basis
 from .tables import show
 
 
@@ -48,12 +48,6 @@ def command(args) -> int:
     else:
         _print(r)
     return 0
-
-
-def basis_file(path: str) -> str:
-    """`path`, or the basis.json of the run folder `path`."""
-    p = Path(path)
-    return str(p / "basis.json") if p.is_dir() else path
 
 
 def _print(r: dict) -> None:

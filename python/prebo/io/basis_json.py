@@ -45,7 +45,7 @@ CONVENTIONS = {
 #: the keys of a basis file: the basis, then the energy, the settings and a run's state (prebo.optimise.resume)
 KEYS = ("format", "version", "conventions", "system", "symmetry", "basis_type", "functions", "coefficients",
         "energy", "objective", "optimiser", "progress", "rng", "history", "elapsed", "schedule", "stopped", "momentum",
-        "levels", "followed", "provenance")
+        "levels", "followed", "response", "provenance")
 #: every function's arrays beside its family's extras (name -> shape, "n": particles); and a channel
 COMMON = {"A": ("n", "n"), "c_A": ()}
 #: bytes allowed per function (twice a checkpoint's two copies of a function of 8 particles) and

@@ -2,7 +2,7 @@
 object, its opening brace first) or an ecgpack file (`ecgpack`: a line of its header first;
 ecgpack's own name for it is inout.txt). The file is opened and read once, its first PREFIX bytes
 deciding what it is before the rest is read: a FIFO is not consumed twice, and a device such as
-/dev/zero is refused at once rather than read to MAX_BYTES. The loaders (prebo.cli.files.load_basis:
+/dev/zero is refused at once rather than read to MAX_BYTES. The loaders (prebo.io.load.load_basis:
 either kind; prebo.Basis.load, ecgpack.read_inout: their own) read through `read`.
 """
 from __future__ import annotations

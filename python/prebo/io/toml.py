@@ -5,6 +5,14 @@
                  or roots = [0, 2], weights = [1, 0.5])                                       -> State
     [basis]      type = "pecg", size = 100, c_A = 1.0, K_max = 20     -> Optimiser.kind (a prebo.basis.family), .size, .c_A, .K_max
     [optimiser]  trials = 20, sweeps = 1, seed = 1, channels = "pairs", length_range = [0.01, 15]
+    [response]   ground = "he/basis.json", operator = "dipole", root = 0, omega = 0.0
+                 -> optimise(..., response=Source.of(ground basis, operator, root, omega))
+
+With [response] the run optimises the first-order function of the level `root` of the stored
+basis `ground` (a basis.json, a run folder or an ecgpack file; relative to the input's folder) on
+Hylleraas' functional (optimise/response.py): [system] and [state] may be left out, and are then
+the ground basis's particles and the symmetry its dipole reaches (N + 1, the other parity, the
+same spins).
 
 Every value is checked against optimise.settings.SETTINGS, the settings left out are chosen for the
 system (optimise.defaults), the basis family is checked against the state and the coordinate
@@ -22,14 +30,17 @@ if sys.version_info >= (3, 11):
 else:  # Python 3.10: the same parser as a package
     import tomli as tomllib
 
-from ..basis import family
-from ..errors import InputError
+from ..basis import Basis, family
+from ..errors import InputError, PreboError
+from ..level.transitions import forbidden, same_particles
 from ..optimise import Optimiser, coordinate_sets
 from ..system import State, System
 from ..optimise.defaults import resolved
+from ..optimise.response import Source
 from ..optimise.settings import SETTINGS, check
 from ..validation import path_name
 from .basis_json import TOO_DEEP, nested, read_text
+from .load import basis_file, load_basis
 
 #: [basis] key -> Optimiser setting; [optimiser] takes every other setting
 BASIS_KEYS = {"type": "kind", "size": "size", "c_A": "c_A", "K_max": "K_max"}
@@ -43,6 +54,7 @@ class Job:
     title: str
     system: System
     optimiser: Optimiser
+    response: Source | None = None
 
 
 def _table(d: dict, name: str, allowed: set) -> dict:
@@ -55,19 +67,25 @@ def _table(d: dict, name: str, allowed: set) -> dict:
     return t
 
 
-def from_dict(d: dict) -> Job:
-    """A Job from the parsed TOML mapping (module docstring); InputError naming the key."""
+def from_dict(d: dict, folder: Path = Path(".")) -> Job:
+    """A Job from the parsed TOML mapping (module docstring; paths relative to `folder`);
+    InputError naming the key."""
     if not isinstance(d, dict):
         raise InputError("an input is a table of title, [system], [state], [basis] and [optimiser], "
                          f"got {reprlib.repr(d)}")
-    unknown = set(d) - {"title", "system", "state", "basis", "optimiser"}
+    unknown = set(d) - {"title", "system", "state", "basis", "optimiser", "response"}
     if unknown:
         raise InputError(f"unknown top-level keys or tables {sorted(unknown)} (allowed: title, [system], [state], "
-                         "[basis], [optimiser])")
+                         "[basis], [optimiser], [response])")
     system_t = _table(d, "system", {"particles"})
     state_t = _table(d, "state", {"N", "parity", "spin", "threshold", "root", "roots", "weights"})
     basis_t = _table(d, "basis", set(BASIS_KEYS))
     opt_t = _table(d, "optimiser", OPTIMISER_KEYS)
+    response_t = _table(d, "response", {"ground", "operator", "root", "omega"})
+    ground = _ground(response_t, folder) if "response" in d else None
+    if ground is not None:  # what is left out: the ground's particles, the symmetry the dipole reaches
+        reached = _reached(ground[0].system)
+        system_t, state_t = system_t or reached[0], state_t or reached[1]
     if "particles" not in system_t:
         raise InputError("[system] needs 'particles'")
     title = d.get("title")
@@ -82,7 +100,53 @@ def from_dict(d: dict) -> Job:
     if "K_max" in basis_t and not family(opts.kind).K_limit:
         raise InputError(f"[basis] K_max: {opts.kind} functions have no power K (K_max is a setting of ecg-gvr)")
     coordinate_sets(system, opts.channels)
-    return Job(title or system.label(), system, opts)
+    response = None if ground is None else _source(ground, response_t, system, opts)
+    return Job(title or system.label(), system, opts, response)
+
+
+def _ground(t: dict, folder: Path) -> tuple:
+    """The ground basis of a [response] table and its overlap threshold (io.load.load_basis)."""
+    if "ground" not in t:
+        raise InputError("[response] needs 'ground', the stored basis of the level (a basis.json, a run folder "
+                         "or an ecgpack file)")
+    name = t["ground"]
+    if not isinstance(name, str):
+        raise InputError(f"[response] ground = {reprlib.repr(name)}: must be a file or folder name")
+    path = folder / name
+    try:
+        return load_basis(basis_file(str(path)))
+    except PreboError as exc:
+        raise InputError(f"[response] ground = {name!r}: {exc}") from exc
+
+
+def _reached(ground: System) -> tuple[dict, dict]:
+    """[system] and [state] of the symmetry a dipole reaches from a level of `ground`'s: its
+    particles, N + 1, the other parity, the same spins."""
+    particles = [p.to_dict() | {"mass": p.mass} for p in ground.particles]  # an infinite mass as ∞
+    return {"particles": particles}, {"N": ground.state.N + 1, "parity": -ground.state.parity,
+                                      "spin": ground.to_dict()["state"]["spin"]}
+
+
+def _source(ground: tuple, t: dict, system: System, opts: Optimiser) -> Source:
+    """The response.Source of a [response] table for a run of `system` with `opts`; InputError for
+    a ground basis of other particles or a symmetry its operator does not reach."""
+    basis, threshold = ground
+    try:
+        same_particles(basis.system, system)
+    except InputError as exc:
+        raise InputError(f"[response] ground: {exc}") from exc
+    why = forbidden(basis, Basis.empty(system, opts.kind))
+    if why is not None:
+        raise InputError(f"[response]: the run's symmetry cannot hold the dipole's first-order function of the "
+                         f"ground level ({why})")
+    settings = {k: t[k] for k in ("operator", "root", "omega") if k in t}
+    if "root" in settings and (isinstance(settings["root"], bool) or not isinstance(settings["root"], int)
+                               or settings["root"] < 0):
+        raise InputError(f"[response] root = {settings['root']!r}: must be a level's index (0: the lowest)")
+    try:
+        return Source.of(basis, threshold=threshold, **settings)
+    except PreboError as exc:
+        raise InputError(f"[response]: {exc}") from exc
 
 
 def load(path) -> Job:
@@ -97,6 +161,6 @@ def load(path) -> Job:
         raise InputError(f"{path}: not valid TOML ({exc})") from exc
     nested(d, f"{path}: TOML", InputError)
     try:
-        return from_dict(d)
+        return from_dict(d, path.parent)
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from exc

@@ -36,7 +36,8 @@ from .expansion import Expansion
 from .history import Step
 from .lowest import Lowest
 from .methods import Run, methods
-from .objective import Levels
+from .objective import Levels, Objective
+from .response import Hylleraas, Source, driven
 from .momentum import Momentum
 from .report import Reporter
 from .resume import followed_roots, load_checkpoint, resumed
@@ -46,7 +47,7 @@ from .settings import Optimiser
 
 
 def optimise(system: System, opts: Optimiser, out: Path | None = None, progress: bool = True,
-             resume: dict | None = None) -> Basis:
+             resume: dict | None = None, response: Source | None = None) -> Basis:
     """Optimise a basis of `opts.kind` for the state of `system`, with the schedule of `opts`
     (schedule.kind_of): growth to `opts.size` and refinement, replacement and joint passes chosen by
     the energy each gains per second until the basis has converged or is exhausted; or a fixed
@@ -62,7 +63,9 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
     checkpoint; OutputError if a new run's folder holds one already), owned by the run while it
     runs (io/lock.py; OutputError if another run owns it); progress: show a live
     line; resume: a checkpoint's content (resume.load_checkpoint) to continue exactly where
-    it stopped.
+    it stopped; response: optimise the first-order function of a level (response.Source) on
+    Hylleraas' functional (response.Hylleraas) instead of the levels of `system.state`, the basis's
+    symmetry (the functional's value is the checkpoint's and the convergence report's "objective").
     Returns the lowest state of at most `opts.size` functions the run passed through (with a
     fixed schedule's pruning, not always where it stopped; lowest.Lowest): its basis with the
     state's coefficients and `convergence`, the report of convergence.py; its energy (hartree)
@@ -76,14 +79,17 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         raise InputError(f"optimise: opts = {opts!r}: must be a prebo.Optimiser")
     if out is not None:
         path_name(out, "optimise: out", "a folder (a str or path), or None")
+    if response is not None and not isinstance(response, Source):
+        raise InputError(f"optimise: response = {response!r}: must be a prebo.optimise.response.Source, or None")
     ranks = world()
     if not ranks.root:  # rank 0 alone writes (parallel.py); the others run the same steps
         out, progress = None, False
     with nullcontext() if out is None else owned(out):
-        return _run(system, opts, out, progress, resume, ranks)
+        return _run(system, opts, out, progress, resume, ranks, response)
 
 
-def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resume: dict | None, ranks) -> Basis:
+def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resume: dict | None, ranks,
+         response: Source | None) -> Basis:
     """The run of `optimise`, in the folder `out` it owns (if any), on the MPI `ranks`."""
     held = None if out is None or resume is not None else checkpoint_in(out)
     if held:
@@ -99,6 +105,8 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
     rep = laboratory(system)
     threshold = lowest_threshold(system).energy
     start, followed = Levels(targets, weights, threshold=threshold), []  # the levels at their targets
+    if response is not None:  # a first-order function: its basis need hold no bound level
+        rep, start, threshold = driven(rep, response), Hylleraas(response.E0, response.omega), np.inf
     objective = start
     if resume is None:
         basis, history, elapsed, schedule, stopped = Basis.empty(system, opts.kind), [], 0.0, schedule_of(opts), None
@@ -117,7 +125,7 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
         that every rank decides alike by time."""
         return ranks.agreed(round(elapsed + time.perf_counter() - t_start, 1), "clock")
 
-    def expansion(b: Basis, objective: Levels) -> Expansion:
+    def expansion(b: Basis, objective: Objective) -> Expansion:
         """The expansion of basis `b` with the run's representation and linear-dependence settings."""
         return Expansion(b, rep, opts.threshold, opts.min_norm, opts.max_overlap, objective)
 
@@ -139,8 +147,10 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                 "energy": ex.lowest_root, "optimiser": opts.to_dict(), "progress": cursor.to_dict(),
                 "rng": rng.bit_generator.state, "history": [step.row() for step in history], "elapsed": seconds,
                 "schedule": schedule.to_dict(), "stopped": stopped, "momentum": run.momentum.to_dict()}
-                | ({} if ex.objective.lowest else {"objective": objective, "levels": list(ex.objective.roots),
-                                                   "followed": [f.row() for f in followed]}))
+                | ({"objective": objective} if ex.objective.recorded else {})
+                | ({} if ex.objective.lowest else {"levels": list(ex.objective.roots),
+                                                   "followed": [f.row() for f in followed]})
+                | ({} if response is None else {"response": response.to_dict()}))
 
     with run.report, eigen.lapack_threads(opts.size):
         while cursor.phase != "done":
@@ -183,15 +193,19 @@ def _run(system: System, opts: Optimiser, out: Path | None, progress: bool, resu
                                    ex.eig.overlap_condition, ex.sigma)
     if not ex.objective.lowest:
         best.convergence |= {"levels": list(ex.objective.roots), "followed": [f.row() for f in followed]}
+    if response is not None:
+        best.convergence |= {"objective": lowest.energy}
     return best
 
 
 def resume_from(folder: Path, progress: bool = True, budget: float | None = None) -> tuple[Basis, Optimiser]:
     """Continue the run whose checkpoint is folder/basis.json, with `budget` (seconds of the whole
-    run) in place of the checkpoint's if given; the finished basis and its settings."""
+    run) in place of the checkpoint's if given; the finished basis and its settings. A response
+    run's source is rebuilt from the checkpoint's "response" block (response.Source.from_dict)."""
     folder, ranks = path_name(folder, "resume_from: folder", "a folder (a str or path)"), world()
     with owned(folder) if ranks.root else nullcontext():  # before it is read
         d, system, opts = ranks.agreed(load_checkpoint(folder) if ranks.root else None)  # rank 0 reads
         if budget is not None:
             opts = replace(opts, budget=budget)
-        return optimise(system, opts, out=Path(folder), progress=progress, resume=d), opts
+        response = None if "response" not in d else Source.from_dict(d["response"], str(Path(folder) / CHECKPOINT))
+        return optimise(system, opts, out=Path(folder), progress=progress, resume=d, response=response), opts

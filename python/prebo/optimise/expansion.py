@@ -19,6 +19,7 @@ from ..basis import Basis
 from ..errors import LinearDependenceError
 from ..matrices import Matrices
 from .objective import Followed, Levels, Objective
+from .response import Driven
 
 
 #: how many times what a change adds to the uncertainty it must gain (`Expansion.keep_if_lower`)
@@ -33,6 +34,7 @@ class Snapshot:
 
     basis: Basis
     m: Matrices
+    b: np.ndarray | None
     eig: eigen.Eigen | None
     energy: float
     sigma: float
@@ -43,7 +45,8 @@ class Snapshot:
 class Expansion:
     """The basis `basis` with its matrices `m` (matrices.Matrices: S, T, T_ti, V; hartree), eigen-solution `eig`, the
     `energy` (hartree) of the `objective` (objective.py: the lowest root, or a weighted sum of
-    targeted levels) and `sigma`, the energy's numerical uncertainty (module docstring; inf beyond
+    targeted levels, or a response functional, response.py, whose functions' source terms `b` a
+    driven representation adds to the matrices; None without) and `sigma`, the energy's numerical uncertainty (module docstring; inf beyond
     eigen.FIRST_ORDER, where no change is kept: the optimiser does not take the basis where its
     first-order uncertainty fails). After a change of several functions at once (`put_group`,
     `replace_basis`) the targeted levels are followed by overlap (Levels.follow; one function
@@ -60,8 +63,23 @@ class Expansion:
         self.basis, self.rep, self.threshold = basis, rep, threshold
         self.min_norm, self.max_overlap, self.objective = min_norm, max_overlap, objective
         self.followed, self.drafted = None, False
-        self.m = Matrices.of(rep.matrices(basis)) if len(basis) else Matrices.empty()
+        self.m, self.b = self.built(basis)
         self.solve()
+
+    def built(self, basis: Basis) -> tuple[Matrices, np.ndarray | None]:
+        """The matrices of `basis` and its functions' source terms (None where the representation
+        adds none)."""
+        if not len(basis):
+            return Matrices.empty(), np.zeros(0) if isinstance(self.rep, Driven) else None
+        m = self.rep.matrices(basis)
+        return Matrices.of(m), m.get("b")
+
+    def sources(self, new, keep: np.ndarray | None = None) -> tuple | None:
+        """The source terms of an update (objective.py): those of the basis (its functions `keep`)
+        and those `new` of the functions added; None without source terms."""
+        if self.b is None:
+            return None
+        return self.b if keep is None else self.b[keep], new
 
     def solve(self, before: tuple | None = None) -> None:
         """Solve the eigenproblem of the current matrices (energy inf for no functions); `before`:
@@ -78,8 +96,8 @@ class Expansion:
                 self.followed = Followed(self.objective.roots, roots)
                 self.objective = self.objective.to(roots)
                 self.eig = self.objective.solve(H, self.m.S, self.threshold)
-        self.energy = self.objective.value(self.eig)
-        self.sigma = self.objective.uncertainty(self.eig, self.m)
+        self.energy = self.objective.value(self.eig, self.b)
+        self.sigma = self.objective.uncertainty(self.eig, self.m, self.b)
 
     @staticmethod
     def prior(eig, objective: Levels, mapping: np.ndarray) -> tuple | None:
@@ -103,20 +121,20 @@ class Expansion:
     @property
     def coefficients(self) -> np.ndarray:
         """The state's coefficients c, S-normalised (the objective's eigenvector)."""
-        return self.objective.vector(self.eig)
+        return self.objective.vector(self.eig, self.b)
 
     @property
     def vectors(self) -> np.ndarray:
         """The eigenvectors of every targeted level (nb x levels, in the order of the objective's
         `roots`), S-normalised."""
-        return self.objective.vectors(self.eig)
+        return self.objective.vectors(self.eig, self.b)
 
     def sound(self) -> bool:
         """Whether every targeted level's internal kinetic energy c^T T_ti c is positive beyond the
         energy's uncertainty, as that of any wave function is: rounding that dominates an
         ill-conditioned basis's elements (integrals.py, cancellation) can make it negative, and
         its energy then means nothing (two electrons "bound" at -0.13 Eh)."""
-        return all(lv.c @ self.m.T_ti @ lv.c > self.sigma for lv in self.objective.levels(self.eig))
+        return all(lv.c @ self.m.T_ti @ lv.c > self.sigma for lv in self.objective.levels(self.eig, self.b))
 
     def gains(self, energy: float) -> bool:
         """Whether `energy` lies below the current energy by more than its uncertainty."""
@@ -124,12 +142,12 @@ class Expansion:
 
     def snapshot(self) -> Snapshot:
         """The state to restore if a change does not pay (`keep_if_lower`)."""
-        return Snapshot(self.basis.subset(slice(None)), self.m.map(np.copy), self.eig, self.energy, self.sigma,
-                        self.objective, self.followed)
+        return Snapshot(self.basis.subset(slice(None)), self.m.map(np.copy), None if self.b is None else self.b.copy(),
+                        self.eig, self.energy, self.sigma, self.objective, self.followed)
 
     def restore(self, before: Snapshot) -> None:
         """Go back to the state `before` (`snapshot`)."""
-        self.basis, self.m, self.eig, self.energy = before.basis, before.m, before.eig, before.energy
+        self.basis, self.m, self.b, self.eig, self.energy = before.basis, before.m, before.b, before.eig, before.energy
         self.sigma, self.objective, self.followed = before.sigma, before.objective, before.followed
 
     def keep_if_lower(self, before: Snapshot) -> bool:
@@ -166,7 +184,7 @@ class Expansion:
         (`resolved`) and it lowers the energy beyond the uncertainty."""
         before = self.snapshot()
         self.basis = basis
-        self.m = Matrices.of(self.rep.matrices(basis))
+        self.m, self.b = self.built(basis)
         if not self.resolved():
             self.restore(before)
             return False
@@ -206,6 +224,7 @@ class Expansion:
         keep = np.arange(len(self.basis)) != i
         self.basis = self.basis.subset(np.flatnonzero(keep))
         self.m = self.m.map(lambda M: M[np.ix_(keep, keep)])
+        self.b = None if self.b is None else self.b[keep]
         self.solve()
 
     def virial(self) -> float:
@@ -229,7 +248,8 @@ class Expansion:
         if eig is None:
             eig = self.eig if exclude is None else self.without(exclude)
         E, C = (eig.energies, eig.vectors) if eig is not None else (np.zeros(0), np.zeros((0, 0)))
-        energies = self.objective.with_added_many(E, C, H[:, keep], S[:, keep], d.H, d.S, self.min_norm)
+        energies = self.objective.with_added_many(E, C, H[:, keep], S[:, keep], d.H, d.S, self.min_norm,
+                                                  self.sources(rows.get("b"), keep))
         if keep.any():
             with np.errstate(invalid="ignore", divide="ignore"):  # S_nn ≤ 0: refused as implausible below
                 overlap = np.abs(S[:, keep]) / np.sqrt(np.outer(d.S, np.diag(self.m.S)[keep]))
@@ -264,7 +284,7 @@ class Expansion:
         this process evaluates by itself, without the other MPI ranks, and which places a change
         without solving (`solve_and_keep_if_lower`: the expansion re-checks it)."""
         twin, snapshot = copy.copy(self), self.snapshot()
-        twin.basis, twin.m = snapshot.basis, snapshot.m
+        twin.basis, twin.m, twin.b = snapshot.basis, snapshot.m, snapshot.b
         twin.rep, twin.drafted = self.rep.alone(), True
         return twin
 
@@ -282,8 +302,11 @@ class Expansion:
         else:
             self.basis.replace(i, f)
         if row is None or not self.rep.oriented(self.basis):
-            self.m = Matrices.of(self.rep.matrices(self.basis))
+            self.m, self.b = self.built(self.basis)
             return
+        if self.b is not None:  # a function's source term depends on it alone
+            self.b = np.append(self.b, row["b"]) if i == nb else self.b.copy()
+            self.b[i] = row["b"]
         rows, values = Matrices.of(row).to_dict(), Matrices.columns(d).to_dict()
         patched = {}
         for k, M in self.m.to_dict().items():

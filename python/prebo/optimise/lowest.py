@@ -24,7 +24,7 @@ class Lowest:
     None before the first function); `basis` is the run's (its system and kind). With a folder
     `out`, out/lowest.json holds it whenever the run stands elsewhere, written as a basis file with
     `extra` (the settings) when the run leaves it — its `energy` the lowest root's, and for a run
-    for excited levels the `objective` too; a `resumed` run reads it back (BasisFileError if it is
+    for excited levels or a response the `objective` too; a `resumed` run reads it back (BasisFileError if it is
     not of this run; a new run never starts in a folder holding one, driver.optimise)."""
 
     def __init__(self, basis: Basis, size: int, out: Path | None, extra: dict, resumed: bool):
@@ -51,8 +51,8 @@ class Lowest:
         if 0 < nb <= self.size and expansion.energy <= self.energy:
             self.energy, self.basis = expansion.energy, expansion.basis.subset(slice(None))
             self.basis.coefficients = expansion.coefficients
-            self.record = {"energy": expansion.lowest_root} | ({} if expansion.objective.lowest
-                                                               else {"objective": self.energy})
+            self.record = {"energy": expansion.lowest_root} | ({"objective": self.energy}
+                                                               if expansion.objective.recorded else {})
             if self.path is not None and self.written:
                 self.path.unlink(missing_ok=True)
             self.written = False

@@ -217,7 +217,7 @@ class PruneStep:
         index removed."""
         ex = run.expansion
         run.report.trials(len(ex.basis))
-        i = int(np.argmin(ex.objective.without_each(ex.eig.energies, ex.eig.vectors)))
+        i = int(np.argmin(ex.objective.without_each(ex.eig.energies, ex.eig.vectors, ex.b)))
         j = partners(ex, i, 1)[0]
         ex.remove(i)
         refine_group(ex, j - (j > i), self.minimiser.group, self.minimiser.evaluations, self.minimiser.method)

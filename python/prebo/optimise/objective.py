@@ -7,8 +7,12 @@ value from an eigen-solution of the basis's matrices (`solve`, `holds`, `value`,
 secular-equation updates of the eigen module), its update after a change of the basis
 (`follow`, `to`: the root indices it stands at, `roots`) and what a run reports and stores
 (`lowest`: nothing to follow, the checkpoint's "levels" and "followed" absent). `Levels` is one
-implementation; another objective — a response functional such as the Hylleraas functional
-J[ψ1] — implements the same methods and runs through the same driver (driver.optimise).
+implementation; another, a response functional, Hylleraas' J[ψ₁] of a first-order function
+(response.Hylleraas), implements the same methods and runs through the same driver
+(driver.optimise). Its functional also reads each function's source term ⟨φ_j|V|ψ₀⟩, which a
+driven representation adds to the rows (response.Driven, the key "b"): every method takes them as
+`b` (the basis's for a solution; the basis's and the added functions' for an update), and `Levels`,
+whose roots need none, takes None.
 
 `Levels` is the weighted sum Σ_k w_k E_k of the targeted roots k of H c = E S c — the lowest root E_0
 alone by default — each an upper bound to the exact level k of the symmetry the basis is
@@ -99,15 +103,24 @@ class BlockLevel:
 class Objective(ABC):
     """What the driver, the expansion and the methods ask of an objective (module docstring). (E,
     C): the eigenvalues and S-orthonormal eigenvectors of the basis functions are added to or
-    removed from; h, s: the new functions' rows, h_nn, s_nn their diagonals (H = T_ti + V)."""
+    removed from; h, s: the new functions' rows, h_nn, s_nn their diagonals (H = T_ti + V); b:
+    the source terms (module docstring), None for `Levels`."""
 
     #: the root indices the objective stands at (the checkpoint's "levels")
     roots: tuple
+    #: the objective's symbol on the progress line
+    symbol: str
 
     @property
     @abstractmethod
     def lowest(self) -> bool:
         """Whether the objective is the lowest root alone: nothing to follow or to store beside it."""
+
+    @property
+    @abstractmethod
+    def recorded(self) -> bool:
+        """Whether a checkpoint, lowest.json and the convergence report record the objective's value
+        ("objective") beside the lowest root's energy."""
 
     @abstractmethod
     def to(self, roots: tuple) -> Objective:
@@ -122,44 +135,44 @@ class Objective(ABC):
         """Whether the eigen-solution holds what the objective needs (else its value is inf)."""
 
     @abstractmethod
-    def levels(self, eig: eigen.Eigen) -> list[Level]:
+    def levels(self, eig: eigen.Eigen, b=None) -> list[Level]:
         """The levels the objective is made of, as the solution holds them (reported, checked sound)."""
 
     @abstractmethod
-    def value(self, eig: eigen.Eigen) -> float:
+    def value(self, eig: eigen.Eigen, b=None) -> float:
         """The objective (Eh) of an eigen-solution; inf where it does not hold it."""
 
     @abstractmethod
-    def vector(self, eig: eigen.Eigen) -> np.ndarray:
+    def vector(self, eig: eigen.Eigen, b=None) -> np.ndarray:
         """The coefficients a basis stores (S-normalised)."""
 
     @abstractmethod
-    def vectors(self, eig: eigen.Eigen) -> np.ndarray:
+    def vectors(self, eig: eigen.Eigen, b=None) -> np.ndarray:
         """The eigenvectors of every level (nb x levels), in the order of `roots`."""
 
     @abstractmethod
-    def uncertainty(self, eig: eigen.Eigen, m: Matrices) -> float:
+    def uncertainty(self, eig: eigen.Eigen, m: Matrices, b=None) -> float:
         """The objective's numerical uncertainty (Eh) for the basis's matrices `m`."""
 
     @abstractmethod
-    def with_added(self, E, C, h, s, h_nn, s_nn, min_norm: float) -> float:
+    def with_added(self, E, C, h, s, h_nn, s_nn, min_norm: float, b=None) -> float:
         """The objective with one function added."""
 
     @abstractmethod
-    def with_added_gradient(self, E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float):
+    def with_added_gradient(self, E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float, b=None):
         """`with_added` and its gradient along the function's parameters (rows dh, ds, dh_nn, ds_nn)."""
 
     @abstractmethod
-    def with_added_many(self, E, C, H, S, h_nn, s_nn, min_norm: float) -> np.ndarray:
+    def with_added_many(self, E, C, H, S, h_nn, s_nn, min_norm: float, b=None) -> np.ndarray:
         """`with_added` for each of many functions."""
 
     @abstractmethod
     def with_block(self, E, C, h, s, H_ff, S_ff, min_norm: float,
-                   near: np.ndarray | None = None) -> tuple[float, list[BlockLevel]]:
+                   near: np.ndarray | None = None, b=None) -> tuple[float, list[BlockLevel]]:
         """The objective with a block of functions added, and its levels for the gradient."""
 
     @abstractmethod
-    def without_each(self, E: np.ndarray, C: np.ndarray) -> np.ndarray:
+    def without_each(self, E: np.ndarray, C: np.ndarray, b=None) -> np.ndarray:
         """The objective without each function in turn."""
 
     @abstractmethod
@@ -175,6 +188,8 @@ class Levels(Objective):
     dissociation threshold; module docstring). (E, C): the eigenvalues and S-orthonormal
     eigenvectors of the basis a function or a block is added to."""
 
+    symbol = "E"
+
     def __init__(self, targets: tuple = (0,), weights: tuple | None = None, roots: tuple | None = None,
                  threshold: float = -np.inf):
         self.targets = tuple(int(r) for r in targets)
@@ -186,6 +201,11 @@ class Levels(Objective):
     def lowest(self) -> bool:
         """Whether the objective is the lowest root alone (nothing to follow)."""
         return self.targets == (0,)
+
+    @property
+    def recorded(self) -> bool:
+        """Whether the objective is more than the lowest root."""
+        return not self.lowest
 
     def to(self, roots: tuple) -> Levels:
         """The objective with the levels at the root indices `roots`."""
@@ -200,28 +220,28 @@ class Levels(Objective):
         """Whether the eigen-solution holds every targeted root."""
         return eig.kept > max(self.roots)
 
-    def levels(self, eig: eigen.Eigen) -> list[Level]:
+    def levels(self, eig: eigen.Eigen, b=None) -> list[Level]:
         """The targeted levels the eigen-solution holds."""
         return [Level(w, r, float(eig.energies[r]), eig.vectors[:, r])
                 for r, w in zip(self.roots, self.weights) if r < eig.kept]
 
-    def value(self, eig: eigen.Eigen) -> float:
+    def value(self, eig: eigen.Eigen, b=None) -> float:
         """Σ w_k E_k (hartree) of an eigen-solution; inf if it does not hold every targeted root."""
         if not self.holds(eig):
             return np.inf
         return sum(lv.weight * lv.E for lv in self.levels(eig))
 
-    def vector(self, eig: eigen.Eigen) -> np.ndarray:
+    def vector(self, eig: eigen.Eigen, b=None) -> np.ndarray:
         """The eigenvector of the first targeted level, S-normalised (the coefficients a basis
         stores; while the basis holds fewer roots, its highest)."""
         return eig.vectors[:, min(self.roots[0], eig.kept - 1)]
 
-    def vectors(self, eig: eigen.Eigen) -> np.ndarray:
+    def vectors(self, eig: eigen.Eigen, b=None) -> np.ndarray:
         """The eigenvectors of every targeted level (nb x levels, in the order of the targets; each
         as `vector`), S-normalised."""
         return eig.vectors[:, [min(r, eig.kept - 1) for r in self.roots]]
 
-    def uncertainty(self, eig: eigen.Eigen, m: Matrices) -> float:
+    def uncertainty(self, eig: eigen.Eigen, m: Matrices, b=None) -> float:
         """Σ w_k σ_k (hartree): the levels' first-order uncertainties (eigen.energy_uncertainty) for
         the matrices `m`, added as if fully correlated (an upper bound); inf where first order
         fails (eigen.FIRST_ORDER)."""
@@ -233,14 +253,14 @@ class Levels(Objective):
         """The (root, weight) of the targeted levels a basis of `n` directions holds."""
         return [(r, w) for r, w in zip(self.roots, self.weights) if r < n]
 
-    def with_added(self, E, C, h, s, h_nn, s_nn, min_norm: float) -> float:
+    def with_added(self, E, C, h, s, h_nn, s_nn, min_norm: float, b=None) -> float:
         """The objective with one function of rows h, s and diagonal h_nn, s_nn added
         (eigen.roots_with_added; the roots the grown basis holds, module docstring)."""
         held = self.held(len(E) + 1)
         e = eigen.roots_with_added(E, C, h, s, h_nn, s_nn, min_norm, [r for r, _ in held])
         return float(sum(w * e_r for (_, w), e_r in zip(held, e)))
 
-    def with_added_gradient(self, E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float):
+    def with_added_gradient(self, E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm: float, b=None):
         """`with_added` and its gradient along the function's parameters (eigen.roots_with_added_gradient)."""
         held = self.held(len(E) + 1)
         e, g = eigen.roots_with_added_gradient(E, C, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, min_norm,
@@ -250,7 +270,7 @@ class Levels(Objective):
             e_sum, g_sum = e_sum + w * e_r, g_sum + w * g_r
         return float(e_sum), g_sum
 
-    def with_added_many(self, E, C, H, S, h_nn, s_nn, min_norm: float) -> np.ndarray:
+    def with_added_many(self, E, C, H, S, h_nn, s_nn, min_norm: float, b=None) -> np.ndarray:
         """`with_added` for each of many functions, rows H, S (eigen.roots_with_added_many): the sum
         over the targeted roots the grown basis holds (module docstring)."""
         held = self.held(len(E) + 1)
@@ -261,7 +281,7 @@ class Levels(Objective):
         return total
 
     def with_block(self, E, C, h, s, H_ff, S_ff, min_norm: float,
-                   near: np.ndarray | None = None) -> tuple[float, list[BlockLevel]]:
+                   near: np.ndarray | None = None, b=None) -> tuple[float, list[BlockLevel]]:
         """The objective with a block of functions added (eigen.roots_with_block), and each level
         (BlockLevel: its eigenvector (C a, β)); (inf, []) where a root is not lowered or the block
         is linearly dependent. `near`: the eigenvalues before the block changed, where each root's
@@ -276,7 +296,7 @@ class Levels(Objective):
             total, parts = total + w * e, parts + [BlockLevel(w, e, a, beta, norm2)]
         return total, parts
 
-    def without_each(self, E: np.ndarray, C: np.ndarray) -> np.ndarray:
+    def without_each(self, E: np.ndarray, C: np.ndarray, b=None) -> np.ndarray:
         """The objective without each function in turn (eigen.root_without_each per root)."""
         return sum(w * eigen.root_without_each(E, C, r) for r, w in zip(self.roots, self.weights))
 

@@ -10,6 +10,8 @@ weighted sum over its levels),
 
 where ∂H_ij, ∂S_ij are the derivatives of function i's row (i as bra) and ∂H_ii, ∂S_ii those of
 its diagonal — exactly what Representation.row_gradient returns for function i against the basis.
+A response functional (response.py) is one 'level' c = z at E = E₀ + ω, plus 2 z_i ∂b_i/∂θ_i
+from its source terms.
 N such rows give the matrices and the gradient: the cost of ~(1 + W/4) matrix builds per step.
 A θ that leaves the valid region (Parametrisation, Representation.plausible) or lets the
 overlap matrix's condition number grow beyond max(10 × its start, 1e9) scores worse than the start:
@@ -64,6 +66,7 @@ class Joint:
             return 0.5 * (M + M.T)  # i as bra and j as bra agree to rounding
 
         S, T_ti, V = matrix("S"), matrix("T_ti"), matrix("V")
+        b = None if st.b is None else np.array([r["b"][0] for r, _ in parts])  # a response functional's sources
         if not st.rep.plausible({"S": S}, diag, np.diag(S)).all():
             return fail
         try:
@@ -72,16 +75,17 @@ class Joint:
             return fail
         if eig.kept < nb or eig.overlap_condition > self.max_condition:
             return fail
-        total = st.objective.value(eig)
+        total = st.objective.value(eig, b)
         if not np.isfinite(total):
             return fail
         gradient = 0.0
-        for level in st.objective.levels(eig):  # Σ_levels w ∂E/∂θ
+        for level in st.objective.levels(eig, b):  # Σ_levels w ∂E/∂θ
             E, c, grad = level.E, level.c, []
             for i, (r, d) in enumerate(zip(rows, derivatives)):
                 dH, dS = r.T_ti[1:] + r.V[1:], r.S[1:]
                 off = (dH - E * dS) @ c - (dH[:, i] - E * dS[:, i]) * c[i]  # Σ_{j≠i}
-                grad.append(2.0 * c[i] * off + c[i] ** 2 * ((d.T_ti + d.V) - E * d.S))
+                g = 2.0 * c[i] * off + c[i] ** 2 * ((d.T_ti + d.V) - E * d.S)
+                grad.append(g if b is None else g + 2.0 * c[i] * parts[i][0]["b"][1:])  # and 2 zᵀ∂b
             gradient = gradient + level.weight * np.concatenate(grad)
         if total < self.best_E:
             self.best_E, self.best = total, basis

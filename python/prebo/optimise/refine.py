@@ -69,7 +69,8 @@ class FunctionEnergy:
         if not st.rep.plausible({"S": rows["S"][:, self.keep]}, diag, self.S_rest)[0]:
             return self.worse
         r, d = Matrices.of(rows), Matrices.columns(diag[0])
-        e = st.objective.with_added(self.E, self.C, r.H[0, self.keep], r.S[0, self.keep], d.H, d.S, st.min_norm)
+        e = st.objective.with_added(self.E, self.C, r.H[0, self.keep], r.S[0, self.keep], d.H, d.S, st.min_norm,
+                                    st.sources(rows.get("b", [None])[0], self.keep))
         if not np.isfinite(e):
             return self.worse
         self._seen(e, f)
@@ -89,7 +90,7 @@ class FunctionEnergy:
         r, d = Matrices.of(rows), Matrices.columns(diag)
         H, S, h_nn, s_nn = r.H, r.S, d.H, d.S
         e, g = st.objective.with_added_gradient(self.E, self.C, H[0], S[0], h_nn[0], s_nn[0], H[1:], S[1:],
-                                                h_nn[1:], s_nn[1:], st.min_norm)
+                                                h_nn[1:], s_nn[1:], st.min_norm, st.sources(rows.get("b"), self.keep))
         if not (np.isfinite(e) and np.all(np.isfinite(g))):
             return self.worse, np.zeros_like(theta)
         self._seen(e, f)
@@ -109,7 +110,7 @@ class GroupEnergy:
         keep[self.idx] = False
         sub = expansion.without(self.idx)
         self.E, self.C = (sub.energies, sub.vectors) if sub is not None else (np.zeros(0), np.zeros((0, 0)))
-        self.rest = basis.subset(np.flatnonzero(keep))
+        self.keep, self.rest = keep, basis.subset(np.flatnonzero(keep))
         self.S_rest = np.diag(expansion.m.S)[keep]
         self.p = [Parametrisation.of(basis.subset([i])) for i in self.idx]
         self.split = np.cumsum([len(p.theta()) for p in self.p])[:-1]
@@ -150,8 +151,10 @@ class GroupEnergy:
                         B[m, o] = B[o, m] = M[m][0, nr + c]
             return B
 
+        sources = None if st.b is None else [r["b"] for r, _ in rows]  # member m's source and its derivatives
         total, levels = st.objective.with_block(self.E, self.C, h, s, block(H, H_nn), block(S, S_nn), st.min_norm,
-                                                near=st.eig.energies)
+                                                near=st.eig.energies,
+                                                b=st.sources(sources and np.array([b[0] for b in sources]), self.keep))
         if not np.isfinite(total):
             return self.worse, np.zeros_like(theta)
         grad = 0.0
@@ -161,6 +164,8 @@ class GroupEnergy:
             for m in range(k):
                 dX = H[m][1:] - e * S[m][1:]
                 g = 2.0 * beta[m] * (dX[:, :nr] @ c_rest + dX[:, nr:] @ beta[others[m]])
+                if sources is not None:  # a response functional's 2 zᵀ∂b (response.py)
+                    g = g + 2.0 * beta[m] * sources[m][1:]
                 g_level.append((g + beta[m] ** 2 * (H_nn[m][1:] - e * S_nn[m][1:])) / level.norm2)
             grad = grad + level.weight * np.concatenate(g_level)
         if not np.all(np.isfinite(grad)):

@@ -50,10 +50,10 @@ class Reporter:
             return
         rate = self.n_trials / max(time.perf_counter() - self.t0, 1e-9)
         gain = old - st.energy if np.isfinite(old) else float("nan")
-        if st.objective.lowest:
-            energy = f"E = {st.energy:.12f}"
+        if st.objective.lowest:  # the lowest root E, or a response functional J
+            energy = f"{st.objective.symbol} = {st.energy:.12f}"
         else:  # each targeted level, then the change of the objective Σ w_k E_k
-            energy = "  ".join(f"E_{lv.root} = {lv.E:.12f}" for lv in st.objective.levels(st.eig))
+            energy = "  ".join(f"E_{lv.root} = {lv.E:.12f}" for lv in st.objective.levels(st.eig, st.b))
         info = f"{energy}  ΔE = {gain:.2e}  η = {st.virial():.1e}  {rate:.1f} trials/s"
         description, done, total = schedule.progress(cursor, len(st.basis))
         self.progress.update(self.task, description=description, completed=done, total=total, info=info)

@@ -1,0 +1,190 @@
+"""The response objective (optimise/response.py): Hylleraas' functional of a first-order function,
+its updates against a direct solve, and a run of the one driver on it (TOML [response], resume,
+bad input)."""
+import json
+import math
+import signal
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from prebo import System, State, evaluate
+from prebo.eigen import solve
+from prebo.matrices import Matrices
+from prebo.optimise import Optimiser, optimise
+from prebo.optimise.response import Hylleraas, Source
+
+from conftest import cli_error, functions, mid_schedule
+
+E0 = -0.5
+
+
+def pencil(rng, n: int):
+    """A random pencil (H, S) whose every level lies above E0, and sources b."""
+    X = rng.normal(size=(n, n))
+    S = X @ X.T + n * np.eye(n)
+    d = 1.0 / np.sqrt(np.diag(S))
+    S = S * np.outer(d, d)
+    Y = rng.normal(size=(n, n))
+    H = (E0 + 0.3) * S + 0.1 * (Y @ Y.T)
+    return H, S, rng.normal(size=n)
+
+
+def direct(H, S, b, shift=E0):
+    """J = −bᵀ(H − shift S)⁻¹b by a dense solve."""
+    return float(-b @ np.linalg.solve(H - shift * S, b))
+
+
+@pytest.fixture
+def problem():
+    return pencil(np.random.default_rng(7), 9)
+
+
+def test_value_is_the_minimum_of_the_functional(problem):
+    H, S, b = problem
+    J = Hylleraas(E0).value(solve(H, S, 1e-14), b)
+    assert J == pytest.approx(direct(H, S, b), rel=1e-12)
+    z = -np.linalg.solve(H - E0 * S, b)
+    for trial in (z, z + 1e-3 * np.random.default_rng(1).normal(size=len(z))):  # a minimum: any other ψ₁ is above
+        assert trial @ (H - E0 * S) @ trial + 2 * trial @ b >= J - 1e-12
+
+
+def test_updates_against_a_direct_solve(problem):
+    H, S, b = problem
+    obj, n = Hylleraas(E0, 0.05), len(b)
+    shift = E0 + 0.05
+    rest = solve(H[:-3, :-3], S[:-3, :-3], 1e-14)
+    E, C = rest.energies, rest.vectors
+    # one function (the 7th) added
+    k = n - 3
+    one = obj.with_added(E, C, H[k, :k], S[k, :k], H[k, k], S[k, k], 1e-10, (b[:k], b[k]))
+    assert one == pytest.approx(direct(H[:k + 1, :k + 1], S[:k + 1, :k + 1], b[:k + 1], shift), rel=1e-11)
+    # each of the last three added alone
+    many = obj.with_added_many(E, C, H[k:, :k], S[k:, :k], np.diag(H)[k:], np.diag(S)[k:], 1e-10, (b[:k], b[k:]))
+    for m, j in enumerate(range(k, n)):
+        idx = list(range(k)) + [j]
+        assert many[m] == pytest.approx(direct(H[np.ix_(idx, idx)], S[np.ix_(idx, idx)], b[idx], shift), rel=1e-11)
+    # all three at once
+    J, (level,) = obj.with_block(E, C, H[k:, :k], S[k:, :k], H[k:, k:], S[k:, k:], 1e-10, b=(b[:k], b[k:]))
+    assert J == pytest.approx(direct(H, S, b, shift), rel=1e-11)
+    z = -np.linalg.solve(H - shift * S, b)
+    assert np.allclose(np.concatenate([C @ level.a, level.beta]), z, rtol=1e-9, atol=1e-12)
+    # each removed from the whole basis
+    whole = solve(H, S, 1e-14)
+    without = obj.without_each(whole.energies, whole.vectors, b)
+    for i in range(n):
+        keep = np.arange(n) != i
+        assert without[i] == pytest.approx(direct(H[np.ix_(keep, keep)], S[np.ix_(keep, keep)], b[keep], shift),
+                                           rel=1e-10)
+
+
+def test_gradient_of_an_added_function_against_differences(problem):
+    """Rows, diagonal and source of the added function moving linearly along two directions:
+    the gradient against central differences."""
+    H, S, b = problem
+    obj, k = Hylleraas(E0), len(b) - 1
+    rest = solve(H[:k, :k], S[:k, :k], 1e-14)
+    rng = np.random.default_rng(3)
+    dh, ds = rng.normal(size=(2, k)) * 0.05, rng.normal(size=(2, k)) * 0.01
+    dh_nn, ds_nn, db = rng.normal(size=2) * 0.05, np.array([0.0, 0.0]), rng.normal(size=2)
+
+    def at(t):
+        return (H[k, :k] + t @ dh, S[k, :k] + t @ ds, H[k, k] + t @ dh_nn, S[k, k] + t @ ds_nn, b[k] + t @ db)
+
+    h, s, h_nn, s_nn, b_n = at(np.zeros(2))
+    J, g = obj.with_added_gradient(rest.energies, rest.vectors, h, s, h_nn, s_nn, dh, ds, dh_nn, ds_nn, 1e-10,
+                                   (b[:k], np.concatenate([[b_n], db])))
+    assert J == pytest.approx(direct(H, S, b), rel=1e-11)
+    for p in range(2):
+        e = np.eye(2)[p] * 1e-5
+        up, down = (obj.with_added(rest.energies, rest.vectors, *x[:4], 1e-10, (b[:k], x[4])) for x in (at(e), at(-e)))
+        assert g[p] == pytest.approx((up - down) / 2e-5, rel=1e-6)
+
+
+def test_no_minimum_at_or_above_a_pole(problem):
+    H, S, b = problem
+    eig = solve(H, S, 1e-14)
+    above = Hylleraas(float(eig.energies[0]) + 1e-3)
+    assert not above.holds(eig) and above.value(eig, b) == math.inf
+    assert above.uncertainty(eig, Matrices(S, H, H, 0 * H), b) == math.inf
+
+
+@pytest.fixture(scope="module")
+def hydrogen_ground():
+    """Hydrogen's 1s (finite proton mass) in 40 Gaussians exp(−a r²), a = 0.002·1.7^k, of the
+    relative coordinate."""
+    from prebo.coordinates import jacobi
+    from prebo.basis import Basis
+
+    system = System(["p", "e"], State())
+    coords = jacobi(system.masses)
+    A = np.array([coords.to_lab(np.array([[0.002 * 1.7 ** k]]), 0.7) for k in range(40)])
+    return Basis(system, A, np.full(len(A), 0.7))
+
+
+def exact_alpha(system) -> float:
+    """9/(2μ³), hydrogen's static polarisability with the reduced mass μ."""
+    m = system.masses
+    return 4.5 / (m[0] * m[1] / (m[0] + m[1])) ** 3
+
+
+def test_the_driver_lowers_the_functional_to_the_polarisability(hydrogen_ground):
+    """Hydrogen's 1s: a run on J[ψ₁] (growth, sweeps, refinement) gives α = −2J, equal to what the
+    fixed-basis polarisability gives on the run's basis, below the exact 9/2 of the ground basis's
+    ψ₀ only by what the ground state misses."""
+    from prebo.level.response import polarisability
+
+    src = Source.of(hydrogen_ground)
+    mu = hydrogen_ground.system.masses[0] / (hydrogen_ground.system.masses[0] + 1)
+    assert src.E0 == pytest.approx(-mu / 2, abs=1e-10)
+    opts = Optimiser(kind="ecg-gvr", size=10, trials=30, sweeps=1, refine=1, refine_method="powell", seed=3,
+                     schedule="fixed")
+    basis = optimise(System(["p", "e"], State(N=1, parity=-1)), opts, progress=False, response=src)
+    J = basis.convergence["objective"]
+    alpha = polarisability(hydrogen_ground, basis)
+    assert -2 * J == pytest.approx(alpha["alpha"][0], rel=1e-9)  # two solves of an overlap of condition ~1e8
+    assert abs(-2 * J / exact_alpha(hydrogen_ground.system) - 1) < 1e-3
+
+
+def test_a_response_input_runs_and_a_killed_run_resumes_to_the_same_basis(hydrogen_ground, tmp_path):
+    """`prebo run` of a [response] input of four lines and a schedule: result.json's response
+    block (α = −2J = the sum over states); the run killed mid-schedule resumes to the functions and
+    bits of the whole run."""
+    hydrogen_ground.save(tmp_path / "ground.json")
+    (tmp_path / "h.toml").write_text('[response]\nground = "ground.json"\n[basis]\nsize = 8\n'
+                                     '[optimiser]\nschedule = "fixed"\nrefine_method = "powell"\n')
+
+    def run(*args):
+        return subprocess.Popen([sys.executable, "-m", "prebo", "run", *map(str, args), "--quiet"],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    whole = run(tmp_path / "h.toml", "--out", tmp_path / "whole")
+    assert whole.wait(timeout=300) == 0, whole.stderr.read()
+    r = json.loads((tmp_path / "whole" / "result.json").read_text())["response"]
+    assert r["alpha"][0] == pytest.approx(-2 * r["objective"], rel=1e-10)
+    assert r["alpha"][0] == pytest.approx(r["sum_over_states"][0], rel=1e-8)
+    assert abs(r["alpha"][0] / exact_alpha(hydrogen_ground.system) - 1) < 1e-2
+    killed = run(tmp_path / "h.toml", "--out", tmp_path / "killed")
+    mid_schedule(tmp_path / "killed")
+    killed.send_signal(signal.SIGKILL)
+    killed.wait()
+    assert json.loads((tmp_path / "killed" / "basis.json").read_text())["progress"]["phase"] != "done"
+    resumed = run("--resume", tmp_path / "killed")
+    assert resumed.wait(timeout=300) == 0, resumed.stderr.read()
+    assert functions(tmp_path / "killed") == functions(tmp_path / "whole")
+    assert json.loads((tmp_path / "killed" / "result.json").read_text())["response"] == r
+
+
+@pytest.mark.parametrize("bad, what", [('ground = "missing.json"', "missing.json"),
+                                       ('ground = "ground.json"\nroot = -1', "root"),
+                                       ('ground = "ground.json"\noperator = "quadrupole"', "operator"),
+                                       ('ground = "ground.json"\nomega = "x"', "omega"),
+                                       ('operator = "dipole"', "ground"),
+                                       ('ground = "ground.json"\n[state]\nN = 1\nparity = 1', "parity")])
+def test_bad_response_settings_get_one_line(hydrogen_ground, tmp_path, capsys, bad, what):
+    hydrogen_ground.save(tmp_path / "ground.json")
+    (tmp_path / "bad.toml").write_text(f"[response]\n{bad}\n[basis]\nsize = 4\n")
+    err = cli_error(capsys, "run", tmp_path / "bad.toml", "--out", tmp_path / "out", "--quiet")
+    assert what in err
