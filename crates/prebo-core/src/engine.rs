@@ -352,7 +352,6 @@ impl Engine {
         v: &[f64],
     ) -> Result<Vec<f64>> {
         self.joins(name, ket)?;
-        Form::of(name)?;
         if self.kind == Kind::Fecg || ket.kind != Kind::EcgGvr {
             return Err(CoreError::Unsupported(format!(
                 "operator {name:?}: derivatives between a {} bra and a {} ket (a plain or ECG-GVR bra and an ECG-GVR ket)",

@@ -30,6 +30,10 @@
 //!
 //! For exact states `<f‖∇_w'‖i> = −(E_f − E_i) <f‖d‖i>` (`[H, d] = −∇_w'`); the ratio of the two
 //! forms is the usual convergence diagnostic.
+//!
+//! Derivatives along the ket's parameters (`Form`, `path::between_gradient`; docs/transitions.md):
+//! the ket of dual numbers carries them through its normalisation and `‖v_J p_J‖`, and each
+//! quadratic form, a derivative in α itself, through hyper-dual numbers (`Damping`).
 use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, HyperDualSVec64};
 
