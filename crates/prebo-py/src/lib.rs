@@ -165,7 +165,7 @@ impl Engine {
         let nb = self.core.count(&b)?;
         let rows = 1 + da.len() / (self.core.rep.n * self.core.rep.n);
         let m = py.allow_threads(|| self.core.between_gradient(name, &b, &ket.core, &k, &Directions { a: &da, v: &du }, &v))?;
-        let p = if nb == 0 { 0 } else { m.len() / (rows * nb) };
+        let p = m.len().checked_div(rows * nb).unwrap_or(0);
         Ok(Array3::from_shape_vec((p, rows, nb), m).expect("p x (1 + P) x nb values").into_pyarray(py))
     }
 
