@@ -90,6 +90,41 @@ def test_a_plain_bra_equals_the_ecg_gvr_bra_at_k_0():
         assert np.array_equal(plain, gvr)
 
 
+def test_the_derivatives_along_the_ket_function_match_a_difference_of_the_elements():
+    # He 1S (plain ECGs) against one ECG-GVR function of 1P, K = 1, along θ of its parametrisation
+    from prebo.optimise import Optimiser, Sampler
+    from prebo.optimise.parametrisation import Parametrisation
+
+    def sample(state, kind, count):
+        system = prebo.System(["alpha", "e", "e"], state)
+        opts = Optimiser(kind=kind, K_max=int(kind == "ecg-gvr"), channels="all", length_range=(0.3, 3.0), seed=5)
+        sampler = Sampler(system, opts, np.random.default_rng(5))
+        fs = [sampler.fresh() for _ in range(count)]
+        for g in fs[1:]:
+            fs[0].append(g)
+        return fs[0]
+
+    bra = sample(prebo.State(N=0, spin={"e": 0}), "pecg", 4)
+    p = Parametrisation.of(sample(prebo.State(N=1, parity=-1, spin={"e": 0}), "ecg-gvr", 1))
+    theta = p.theta() + 0.2 * np.random.default_rng(2).standard_normal(len(p.theta()))
+    rep = laboratory(p.f.system)
+    w, w_v = dipole_vectors(p.f.system)
+    assert len(rep.sym_c) == 2
+    for name, v, momentum in [("dipole", w, False), ("velocity", w_v, True)]:
+        exact = rep.between_gradient(name, bra, p.function(theta), *p.directions(theta), v[None], momentum)[0]
+        assert exact.shape == (1 + len(theta), len(bra))
+
+        def values(t):
+            return rep.between(name, bra, p.function(t), v[None], momentum)[0, :, 0]
+
+        assert np.array_equal(exact[0], values(theta))
+        for k in range(len(theta)):
+            e = np.zeros_like(theta)
+            e[k] = 1e-4
+            fd = (8 * (values(theta + e) - values(theta - e)) - (values(theta + 2 * e) - values(theta - 2 * e))) / 12e-4
+            assert np.max(np.abs(exact[1 + k] - fd)) < 1e-8 * np.max(np.abs(exact[1:])), (name, k)
+
+
 def test_bad_pairs_are_refused_in_one_line():
     with pytest.raises(InputError, match="one symmetry"):
         transitions(hydrogen(0), hydrogen(0))

@@ -98,6 +98,15 @@ class Engine:
         the Coulomb vectors), "velocity", O = Σ_k w'_k ∇_k (w' momentum-like);
         crates/prebo-core/src/families/ecg_gvr/transition.rs."""
 
+    def between_gradient(self, name: str, bra: Params, ket: Engine, ket_params: Params, dA: ArrayLike,
+                         du: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
+        """`between` for a ket basis of one ECG-GVR function (`ket_params`) with the derivatives
+        along P directions of its parameters, dA (P, n, n) of A and du (P, n) of u, as
+        `row_gradient`'s: (p, 1 + P, nb_bra), row 0 of each instance `between`'s column (its
+        bits), row 1 + k the derivative along direction k. "dipole" and "velocity" between a plain
+        or ECG-GVR bra of N = 0 and the ket of N = 1; exact (dual numbers,
+        crates/prebo-core/src/path.rs `between_gradient`). Laboratory frame."""
+
     def density(self, params: Params, w: ArrayLike, C: ArrayLike, r: ArrayLike) -> NDArray[np.float64]:
         """Spherically averaged densities <Ψ|ρ̄_w(r)|Ψ> (bohr⁻³) of the states Ψ = Σ_I c_I Yφ_I
         (C: (nb, ns), the columns) at the radii r (bohr), one per vector w (p, n) given in this

@@ -147,6 +147,20 @@ class Representation:
         ci, cj = np.asarray(bra.c_A, dtype=float)[:, None], np.asarray(ket.c_A, dtype=float)[None, :]
         return (2.0 * np.sqrt(ci * cj) / (ci + cj)) ** 1.5
 
+    def between_gradient(self, name: str, bra, f, dA: np.ndarray, dv: np.ndarray, v: np.ndarray,
+                         momentum: bool = False) -> np.ndarray:
+        """`between(name, bra, f, v, momentum)` for the one-function ECG-GVR basis `f` (the ket), with
+        the exact derivatives along P directions of its parameters as `row_gradient`'s: dA (P x n x n)
+        of A, dv (P x n) of u. Returns (p, 1 + P, nb_bra): row 0 of each instance `between`'s
+        column, row 1 + k its derivative along direction k (docs/transitions.md). "dipole" and
+        "velocity"; laboratory frame only."""
+        if self.coords is not None:
+            raise ValueError("two-basis gradients are computed in the laboratory frame")
+        engine = self.engine(bra)
+        return engine.between_gradient(name, self.arrays(bra), self.engine(f), self.arrays(f),
+                                       np.ascontiguousarray(dA, dtype=float), np.ascontiguousarray(dv, dtype=float),
+                                       self.vectors(v, momentum))
+
     def density(self, f, w: np.ndarray, C: np.ndarray, r: np.ndarray) -> np.ndarray:
         """The spherically averaged densities (p, states, len(r)) of r_w (bohr⁻³) at the radii `r`
         (bohr) in the states Σ_k C_ks Yφ_k of the basis `f`, one per laboratory-frame vector w (p, n)."""

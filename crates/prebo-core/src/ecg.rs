@@ -44,16 +44,18 @@ impl<T> Real for T where
 {
 }
 
-/// The `f64` value of a scalar, and whether it carries derivatives: a kernel whose inner loop
-/// depends on a few scalars can run that loop in `f64` with hand-derived partial derivatives
-/// and chain them onto the dual numbers (`chain`).
+/// The `f64` value of a scalar, and the order of the derivatives it carries: a kernel whose inner
+/// loop depends on a few scalars can run that loop in `f64` with hand-derived partial derivatives
+/// and chain them onto first-order dual numbers (`chain`); an expansion about the value
+/// (`inverse_log_det`) is carried to `ORDER`.
 pub trait Value {
-    const DUAL: bool;
+    /// 0 for `f64`, 1 for dual numbers, 2 for hyper-dual numbers (whose `ε_1 ε_2` terms survive).
+    const ORDER: u32;
     fn value(&self) -> f64;
 }
 
 impl Value for f64 {
-    const DUAL: bool = false;
+    const ORDER: u32 = 0;
     #[inline(always)]
     fn value(&self) -> f64 {
         *self
@@ -61,7 +63,15 @@ impl Value for f64 {
 }
 
 impl<const W: usize> Value for num_dual::DualSVec64<W> {
-    const DUAL: bool = true;
+    const ORDER: u32 = 1;
+    #[inline(always)]
+    fn value(&self) -> f64 {
+        self.re
+    }
+}
+
+impl<const M: usize, const N: usize> Value for num_dual::HyperDualSVec64<M, N> {
+    const ORDER: u32 = 2;
     #[inline(always)]
     fn value(&self) -> f64 {
         self.re
@@ -69,7 +79,8 @@ impl<const W: usize> Value for num_dual::DualSVec64<W> {
 }
 
 /// `f` at the inputs `x_k`, given its value `f0` and partial derivatives `∂f/∂x_k` there:
-/// `f0 + Σ_k ∂f/∂x_k (x_k − value(x_k))` carries the inputs' derivatives by the chain rule.
+/// `f0 + Σ_k ∂f/∂x_k (x_k − value(x_k))` carries the inputs' derivatives by the chain rule (to
+/// first order: exact for `Value::ORDER` ≤ 1).
 #[inline]
 pub fn chain<T: Real, const K: usize>(f0: f64, inputs: [T; K], partials: [f64; K]) -> T {
     inputs.iter().zip(partials).fold(re(f0), |acc, (x, p)| acc + (*x - x.value()) * p)
@@ -104,21 +115,31 @@ pub fn log_det_cholesky<T: Real, const D: usize>(chol: &Cholesky<T, nalgebra::Co
 }
 
 /// `B^{-1}` and `ln|B|` of a positive-definite `B`; `None` when `B` has no Cholesky factor in
-/// floating point. Dual numbers are expanded to first order (exact for them) around the value
-/// `B_0`: `B^{-1} = B_0^{-1} − B_0^{-1}(B − B_0)B_0^{-1}`, `ln|B| = ln|B_0| + Tr(B_0^{-1}(B − B_0))`,
-/// so the factorisation and the inverse run in `f64`.
+/// floating point. Numbers with derivatives are expanded around the value `B_0` to their order
+/// (`Value::ORDER`, where the expansion is exact: a product of more derivative parts vanishes),
+/// with `X = B_0^{-1}(B − B_0)`: `B^{-1} = Σ_k (−X)^k B_0^{-1}` (Neumann series, by Horner:
+/// `B^{-1} ← B_0^{-1} − X B^{-1}`), `ln|B| = ln|B_0| + Σ_k (−1)^{k+1} Tr(X^k)/k`; so the
+/// factorisation and the inverse run in `f64`.
 #[inline]
 pub fn inverse_log_det<T: Real, const D: usize>(b: &SMatrix<T, D, D>) -> Option<(SMatrix<T, D, D>, T)> {
     let b0: Mat<D> = b.map(|x| x.value());
     let chol = Cholesky::new(b0)?;
     let (binv0, log_det0) = (chol.inverse(), log_det_cholesky(&chol));
-    if !T::DUAL {
+    if T::ORDER == 0 {
         return Some((binv0.map(re), re(log_det0)));
     }
     let db = SMatrix::<T, D, D>::from_fn(|i, j| b[(i, j)] - b0[(i, j)]);
     let x = mul(&binv0, &db); // B_0^{-1}(B − B_0)
-    let binv = SMatrix::from_fn(|i, j| (0..D).fold(re(binv0[(i, j)]), |acc, k| acc - x[(i, k)] * binv0[(k, j)]));
-    Some((binv, (0..D).fold(re(log_det0), |acc, k| acc + x[(k, k)])))
+    let mut binv = SMatrix::from_fn(|i, j| (0..D).fold(re(binv0[(i, j)]), |acc, k| acc - x[(i, k)] * binv0[(k, j)]));
+    let mut log_det = (0..D).fold(re(log_det0), |acc, k| acc + x[(k, k)]);
+    let mut power = x; // X^k
+    for k in 2..=T::ORDER {
+        binv = SMatrix::from_fn(|i, j| (0..D).fold(re(binv0[(i, j)]), |acc, l| acc - x[(i, l)] * binv[(l, j)]));
+        power = mul(&x, &power);
+        let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
+        log_det += (0..D).fold(T::zero(), |acc, l| acc + power[(l, l)]) * (sign / k as f64);
+    }
+    Some((binv, log_det))
 }
 
 /// `a b` by plain sums, for `a` of `T` or of constants (`f64`); nalgebra's generic product also
@@ -249,5 +270,35 @@ mod tests {
         assert!(close(&log_det, &log_det_ref));
         assert!(binv.iter().zip(binv_ref.iter()).all(|(a, r)| close(a, r)));
         assert!(inverse_log_det(&Mat::<2>::new(1.0, 2.0, 2.0, 1.0)).is_none(), "indefinite B has no factor");
+    }
+
+    #[test]
+    fn inverse_log_det_matches_a_hyper_dual_cholesky_to_second_order() {
+        use nalgebra::{Const, U1};
+        use num_dual::{Derivative, HyperDualSVec64};
+        type H = HyperDualSVec64<2, 1>;
+        // B(θ_1, θ_2, α) with every part non-zero, the ε_1 ε_2 one included
+        let sym = |m: Mat<3>| m + m.transpose();
+        let b0 = Mat::<3>::new(2.0, 0.3, -0.4, 0.3, 1.5, 0.2, -0.4, 0.2, 0.9);
+        let d1 = [sym(Mat::<3>::new(0.5, 0.5, 0.0, 0.0, 0.0, -0.2, 0.0, 0.0, 0.3)), sym(Mat::<3>::new(0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, -0.5))];
+        let d2 = sym(Mat::<3>::new(0.3, -0.1, 0.2, 0.0, 0.4, 0.1, 0.0, 0.0, 0.2));
+        let d12 = [sym(Mat::<3>::new(0.1, 0.2, 0.0, 0.0, -0.3, 0.0, 0.1, 0.0, 0.05)), sym(Mat::<3>::new(0.0, 0.1, 0.1, 0.0, 0.0, 0.2, 0.0, 0.0, 0.1))];
+        let b = SMatrix::<H, 3, 3>::from_fn(|i, j| {
+            let (e1, e12) = (SMatrix::<f64, 2, 1>::new(d1[0][(i, j)], d1[1][(i, j)]), SMatrix::<f64, 2, 1>::new(d12[0][(i, j)], d12[1][(i, j)]));
+            H::new(b0[(i, j)], Derivative::some(e1), Derivative::some(SMatrix::<f64, 1, 1>::new(d2[(i, j)])), Derivative::some(e12))
+        });
+        let (binv, log_det) = inverse_log_det(&b).unwrap();
+        let chol = Cholesky::new(b).unwrap();
+        let (binv_ref, log_det_ref) = (chol.inverse(), log_det_cholesky(&chol));
+        let parts = |x: &H| {
+            let (e1, e2) = (x.eps1.unwrap_generic(Const::<2>, U1), x.eps2.unwrap_generic(U1, Const::<1>));
+            [x.re, e1[0], e1[1], e2[0], x.eps1eps2.unwrap_generic(Const::<2>, Const::<1>)[0], x.eps1eps2.unwrap_generic(Const::<2>, Const::<1>)[1]]
+        };
+        let close = |a: &H, r: &H| parts(a).iter().zip(parts(r)).all(|(x, y)| (x - y).abs() < 1e-13);
+        assert!(close(&log_det, &log_det_ref), "{log_det} vs {log_det_ref}");
+        assert!(binv.iter().zip(binv_ref.iter()).all(|(a, r)| close(a, r)));
+        // the second-order term −Tr(X_1 X_2) that a first-order expansion misses is there
+        let first = (b0.try_inverse().unwrap() * d12[0]).trace();
+        assert!((parts(&log_det_ref)[4] - first).abs() > 0.1);
     }
 }

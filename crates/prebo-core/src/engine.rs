@@ -5,7 +5,9 @@
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Vector, MAX_DIM};
 use crate::error::{CoreError, Result};
+use crate::gradient::KetElement;
 use crate::families::fecg::Fecg;
+use crate::families::ecg_gvr::transition::Form;
 use crate::families::ecg_gvr::EcgGvr;
 use crate::families::pecg::Pecg;
 use crate::families::Family;
@@ -222,6 +224,29 @@ fn between_d<const D: usize, F: Specialised<D>>(
     path::between::<D, F>(&ctx, &ket_sym, &bra, &ket_p, |x, y, ctx, v| elements.of(x, y, ctx, v), arity, v)
 }
 
+/// `between_gradient` for the family `F` of both bases (`as_family`), the context at the bra's N.
+fn between_gradient_d<const D: usize, F: Specialised<D>>(
+    e: &Engine,
+    name: &str,
+    bra: &[Column],
+    ket: &Engine,
+    ket_params: &[Column],
+    dir: &Directions,
+    v: &[f64],
+) -> Result<Vec<f64>>
+where
+    Form: KetElement<D, F>,
+{
+    let (arity, elements) = registry::lookup_between::<D, F>(e.kind.name(), ket.kind.name(), name)?;
+    let (bra_columns, ket_columns) = (as_family::<D, F>(e.kind, bra)?, as_family::<D, F>(ket.kind, ket_params)?);
+    let (bra, ket_p) = (F::params(&bra_columns)?, F::params(&ket_columns)?);
+    let (ops, _) = e.rep.operators::<D>();
+    let (_, ket_sym) = ket.rep.operators::<D>();
+    let ctx = F::kinetic_only(&F::context(ops, e.n_ang, &[&bra, &ket_p])?);
+    let elements = |x: &F::Function<f64>, y: &F::Function<f64>, ctx: &F::Context, v: &[Vec<Vector<D>>]| elements.of(x, y, ctx, v);
+    path::between_gradient::<D, F>(&ctx, &ket_sym, &bra, &ket_p, dir, elements, &Form::of(name)?, arity, v)
+}
+
 /// The columns of a basis of family `kind` as those of `F`: as they are, or a plain ECG's `(A, c_A)`
 /// as the ECG-GVR `(A, u = e_1, K = 0, c_A)` (`Family::CONTAINS`).
 fn as_family<const D: usize, F: Family<D>>(kind: Kind, columns: &[Column]) -> Result<Vec<Column>> {
@@ -305,6 +330,41 @@ impl Engine {
     /// rank k > 0 (`registry::rank`) joins a bra of N = 0 to a ket of N = k; the overlap two
     /// bases of one N. The bra's operators (its representation) serve both.
     pub fn between(&self, name: &str, bra: &[Column], ket: &Engine, ket_params: &[Column], v: &[f64]) -> Result<Vec<f64>> {
+        self.joins(name, ket)?;
+        match (self.kind, ket.kind) {
+            (Kind::Pecg, Kind::Pecg) => dispatch!(@dim self, between_d, Pecg, (self, name, bra, ket, ket_params, v)),
+            (Kind::Fecg, _) | (_, Kind::Fecg) => dispatch!(@dim self, between_d, Fecg, (self, name, bra, ket, ket_params, v)),
+            _ => dispatch!(@dim self, between_d, EcgGvr, (self, name, bra, ket, ket_params, v)),
+        }
+    }
+
+    /// `between`'s column of a ket basis of one function `ket_params`, with its derivatives along
+    /// the directions `dir` of that function's parameters: `p x (1 + P) x nb_bra` (row 0 of each
+    /// instance the values, `path::between_gradient`), for the dipole's forms between a plain or
+    /// ECG-GVR bra and an ECG-GVR ket (`transition::Form`).
+    pub fn between_gradient(
+        &self,
+        name: &str,
+        bra: &[Column],
+        ket: &Engine,
+        ket_params: &[Column],
+        dir: &Directions,
+        v: &[f64],
+    ) -> Result<Vec<f64>> {
+        self.joins(name, ket)?;
+        if self.kind == Kind::Fecg || ket.kind != Kind::EcgGvr {
+            return Err(CoreError::Unsupported(format!(
+                "operator {name:?}: derivatives between a {} bra and a {} ket (a plain or ECG-GVR bra and an ECG-GVR ket)",
+                self.kind.name(),
+                ket.kind.name()
+            )));
+        }
+        dispatch!(@dim self, between_gradient_d, EcgGvr, (self, name, bra, ket, ket_params, dir, v))
+    }
+
+    /// Whether this engine's bases meet those of `ket` under the two-basis operator `name`: the
+    /// same coordinates, and the N of each its rank joins (`registry::rank`).
+    fn joins(&self, name: &str, ket: &Engine) -> Result<()> {
         if ket.rep.n != self.rep.n {
             return Err(CoreError::ShapeMismatch(format!("a bra of {} coordinates and a ket of {}", self.rep.n, ket.rep.n)));
         }
@@ -316,11 +376,7 @@ impl Engine {
                 self.n_ang, ket.n_ang, wanted.0, wanted.1
             )));
         }
-        match (self.kind, ket.kind) {
-            (Kind::Pecg, Kind::Pecg) => dispatch!(@dim self, between_d, Pecg, (self, name, bra, ket, ket_params, v)),
-            (Kind::Fecg, _) | (_, Kind::Fecg) => dispatch!(@dim self, between_d, Fecg, (self, name, bra, ket, ket_params, v)),
-            _ => dispatch!(@dim self, between_d, EcgGvr, (self, name, bra, ket, ket_params, v)),
-        }
+        Ok(())
     }
 
     /// The spherically averaged densities `<Ψ| ρ̄_w(r) |Ψ>` (operators/density.rs) of the states

@@ -11,9 +11,10 @@ use crate::ecg::{Element, Mat, Vector};
 use crate::error::Result;
 use crate::families::Family;
 use crate::params::{check, Directions, Parameters, Symmetry};
-use crate::gradient::{self, Dual};
+use crate::gradient::{self, Dual, KetElement, MAX_LANES};
 use crate::images::Images;
 use crate::matrices::Matrices;
+use nalgebra::{Const, U1};
 use rayon::prelude::*;
 
 /// The functions of `p` with their images under `sym`.
@@ -199,6 +200,80 @@ pub fn between<const D: usize, F: Family<D>>(
         for q in 0..p {
             out[(q * nb + i) * nk..][..nk].copy_from_slice(&row[q * nk..][..nk]);
         }
+    }
+    Ok(out)
+}
+
+/// One chunk of at most W directions of `between_gradient`: per bra, per instance, the derivatives
+/// of the element along the `da.len()` directions.
+#[allow(clippy::too_many_arguments)]
+fn between_chunk<const D: usize, F: Family<D>, const W: usize>(
+    ctx: &F::Context,
+    ket_sym: &Symmetry<D>,
+    bras: &[F::Function<f64>],
+    f: &F::Function<f64>,
+    da: &[Mat<D>],
+    dv: &[f64],
+    element: &impl KetElement<D, F>,
+    instances: &[Vec<Vector<D>>],
+) -> Result<Vec<Vec<f64>>> {
+    let ket = Images::new(vec![F::seeded::<W>(f, da, dv, ctx)?], ket_sym, ctx)?;
+    let count = da.len();
+    Ok(bras
+        .par_iter()
+        .map(|b| {
+            let mut out = Vec::with_capacity(instances.len() * count);
+            for v in instances {
+                let x = ket.images[0].iter().zip(&ket.coef).fold(Dual::<W>::from(0.0), |acc, (k, c)| acc + element.element(b, k, ctx, v) * *c);
+                out.extend(x.eps.unwrap_generic(Const::<W>, U1).iter().take(count));
+            }
+            out
+        })
+        .collect())
+}
+
+/// `between`'s column of a ket basis of one function `ket` (`elements` as for `between`), with its
+/// derivatives along the directions `dir` of that function's parameters: `p x (1 + P) x nb_bra`
+/// (row-major; row 0 of each instance `between`'s values, row `1 + k` the derivative along
+/// direction k). For the derivatives the function is seeded with the directions
+/// (`Family::seeded`, chunks of at most `MAX_LANES`), its images taken under `ket_sym` and
+/// `element` evaluated against each bra, whose functions carry none.
+#[allow(clippy::too_many_arguments)]
+pub fn between_gradient<const D: usize, F: Family<D>>(
+    ctx: &F::Context,
+    ket_sym: &Symmetry<D>,
+    bra: &F::Params<'_>,
+    ket: &F::Params<'_>,
+    dir: &Directions,
+    elements: impl Fn(&F::Function<f64>, &F::Function<f64>, &F::Context, &[Vec<Vector<D>>]) -> Vec<f64> + Sync,
+    element: &impl KetElement<D, F>,
+    arity: usize,
+    v: &[f64],
+) -> Result<Vec<f64>> {
+    check(ket.len(), 1, "ket functions")?;
+    let values = between::<D, F>(ctx, ket_sym, bra, ket, elements, arity, v)?;
+    let instances = instances::<D>(arity, v)?;
+    let bras = F::functions(bra, ctx)?;
+    let f = F::functions(ket, ctx)?.remove(0);
+    let (da, per) = dir.exponents::<D>()?;
+    let (nb, rows) = (bras.len(), 1 + da.len());
+    let mut out = vec![0.0; instances.len() * rows * nb];
+    for (q, x) in values.chunks_exact(nb.max(1)).enumerate() {
+        out[q * rows * nb..][..nb].copy_from_slice(x);
+    }
+    let mut first = 0;
+    while first < da.len() {
+        let count = (da.len() - first).min(MAX_LANES);
+        let (a, u) = (&da[first..first + count], &dir.v[first * per..(first + count) * per]);
+        let chunk = lanes!(count, between_chunk(ctx, ket_sym, &bras, &f, a, u, element, &instances))?;
+        for (i, derivatives) in chunk.iter().enumerate() {
+            for (q, d) in derivatives.chunks_exact(count).enumerate() {
+                for (k, x) in d.iter().enumerate() {
+                    out[(q * rows + first + 1 + k) * nb + i] = *x;
+                }
+            }
+        }
+        first += count;
     }
     Ok(out)
 }

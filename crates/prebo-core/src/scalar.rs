@@ -5,7 +5,7 @@
 use std::ops::{Add, Div, Mul, Sub};
 
 use nalgebra::{ComplexField, RealField};
-use num_dual::{Dual64, DualSVec64, HyperDual64};
+use num_dual::{Dual64, DualSVec64, HyperDual64, HyperDualSVec64};
 
 /// Arithmetic with itself and with `f64` constants, and the few functions of one value the shared
 /// formulas need. The functions are associated functions (`T::sqrt(x)`), not methods, so they do
@@ -99,6 +99,9 @@ macro_rules! dual_scalar {
 }
 
 dual_scalar!([const W: usize] DualSVec64<W>, |x| RealField::clamp(x, Self::from(-1.0), Self::from(1.0)));
+// Vector hyper-dual numbers, for the derivatives of Gaussian-weighted elements (the damping's
+// derivative inside the parameters', `families::ecg_gvr::transition`), clamped as the dual ones.
+dual_scalar!([const M: usize, const N: usize] HyperDualSVec64<M, N>, |x| RealField::clamp(x, Self::from(-1.0), Self::from(1.0)));
 
 // Hyper-dual numbers (one mixed second derivative), for ECG-GVR's `p_g⁴` and orbit–orbit elements
 // (`families::ecg_gvr::momentum`): `clamp_unit` clamps the value only, since the shared formulas

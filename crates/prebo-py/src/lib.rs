@@ -147,6 +147,28 @@ impl Engine {
         Ok(Array3::from_shape_vec((p, nb, nk), m).expect("p x nb x nk values").into_pyarray(py))
     }
 
+    #[pyo3(signature = (name, bra, ket, ket_params, dA, du, v))]
+    #[allow(clippy::too_many_arguments, non_snake_case)]
+    fn between_gradient<'py>(
+        &self,
+        py: Python<'py>,
+        name: &str,
+        bra: &Bound<'py, PyAny>,
+        ket: &Engine,
+        ket_params: &Bound<'py, PyAny>,
+        dA: &Bound<'py, PyAny>,
+        du: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> Result<Bound<'py, PyArray3<f64>>> {
+        let (b, k) = (columns(self.core.kind, bra)?, columns(ket.core.kind, ket_params)?);
+        let (da, du, v) = (floats(dA, "dA")?, floats(du, "du")?, floats(v, "v")?);
+        let nb = self.core.count(&b)?;
+        let rows = 1 + da.len() / (self.core.rep.n * self.core.rep.n);
+        let m = py.allow_threads(|| self.core.between_gradient(name, &b, &ket.core, &k, &Directions { a: &da, v: &du }, &v))?;
+        let p = m.len().checked_div(rows * nb).unwrap_or(0);
+        Ok(Array3::from_shape_vec((p, rows, nb), m).expect("p x (1 + P) x nb values").into_pyarray(py))
+    }
+
     #[allow(non_snake_case)]
     fn density<'py>(
         &self,

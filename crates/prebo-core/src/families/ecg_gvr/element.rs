@@ -300,7 +300,8 @@ pub fn element<const D: usize, T: Real>(bra: &GvrFunction<D, T>, ket: &GvrFuncti
         let c = dot_f(&mul(&wv.transpose(), &binv).transpose(), wv); // w^T B^{-1} w
         let sq = (c * 2.0).sqrt();
         let inputs = [x, y, z, dot_f(&gi, wv) / sq, dot_f(&gj, wv) / sq];
-        let integral = if T::DUAL {
+        // the f64 node loop with its partials chained on (first order); hyper-duals run it in `T`
+        let integral = if T::ORDER == 1 {
             let (f0, partials) = quadrature_partials(inputs.map(|s| s.value()), rule, &series);
             chain(f0, inputs, partials)
         } else {

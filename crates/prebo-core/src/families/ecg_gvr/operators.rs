@@ -20,8 +20,8 @@ impl<const D: usize> Specialised<D> for EcgGvr {
             (COULOMB, All(|bra, ket, go, v| coulomb::all_of::<D, Self>(drachmann::inverse_products::<D>, bra, ket, go, v))),
             (GRADIENT, Each(drachmann::gradient_inv_r::<D>)),
             (orbit::NAME, Each(own::orbit::<D>)),
-            (transition::DIPOLE, Each(transition::dipole::<D>)),
-            (transition::VELOCITY, Each(transition::velocity::<D>)),
+            (transition::DIPOLE, Each(transition::dipole::<D, f64>)),
+            (transition::VELOCITY, Each(transition::velocity::<D, f64>)),
         ]
     }
 }

@@ -30,53 +30,134 @@
 //!
 //! For exact states `<f‖∇_w'‖i> = −(E_f − E_i) <f‖d‖i>` (`[H, d] = −∇_w'`); the ratio of the two
 //! forms is the usual convergence diagnostic.
-use nalgebra::{Const, U1};
+//!
+//! Derivatives along the ket's parameters (`Form`, `path::between_gradient`; docs/transitions.md):
+//! the ket of dual numbers carries them through its normalisation and `‖v_J p_J‖`, and each
+//! quadratic form, a derivative in α itself, through hyper-dual numbers (`Damping`).
+use nalgebra::{Const, SMatrix, SVector, U1};
+use num_dual::{Derivative, HyperDualSVec64};
 
-use crate::ecg::{Mat, Vector};
+use crate::ecg::{re, Real, Vector};
+use crate::error::{CoreError, Result};
 use super::element::{GvrFunction, GvrOps};
 use super::EcgGvr;
 use crate::families::Family;
-use crate::gradient::{seed, Dual};
+use crate::gradient::{seed, Dual, KetElement};
 
 /// The length form, `v = [w]`.
 pub const DIPOLE: &str = "dipole";
 /// The velocity form, `v = [w']`.
 pub const VELOCITY: &str = "velocity";
 
-/// `<f| r^T (M ⊗ I_3) r |g>` of normalised functions for a symmetric `M`.
-pub fn quadratic<const D: usize>(f: &GvrFunction<D>, g: &GvrFunction<D>, go: &GvrOps<D>, m: &Mat<D>) -> f64 {
-    let alpha: Dual<1> = seed(0.0, std::iter::once(1.0));
-    let s = <EcgGvr as Family<D>>::overlap(&f.cast::<Dual<1>>(), &g.damped(&m.map(|x| alpha * x)), go);
-    -s.eps.unwrap_generic(Const::<1>, U1)[0]
+/// A scalar with one derivative more, along the damping α of `quadratic`'s overlap: `f64` →
+/// `Dual<1>`; `Dual<W>` (W parameter directions θ_p) → the hyper-dual `HyperDualSVec64<W, 1>`,
+/// whose `ε_1 ε_2` part is `∂²/∂θ_p ∂α` (exact through `ecg::inverse_log_det`'s second order).
+pub trait Damping: Real {
+    type Damped: Real;
+    /// `x` with no α-derivative.
+    fn lift(x: Self) -> Self::Damped;
+    /// α = 0, `∂α/∂α = 1`.
+    fn alpha() -> Self::Damped;
+    /// `∂x/∂α` with its derivatives along the parameters.
+    fn slope(x: &Self::Damped) -> Self;
+}
+
+impl Damping for f64 {
+    type Damped = Dual<1>;
+    fn lift(x: f64) -> Dual<1> {
+        Dual::from(x)
+    }
+    fn alpha() -> Dual<1> {
+        seed(0.0, std::iter::once(1.0))
+    }
+    fn slope(x: &Dual<1>) -> f64 {
+        x.eps.unwrap_generic(Const::<1>, U1)[0]
+    }
+}
+
+impl<const W: usize> Damping for Dual<W> {
+    type Damped = HyperDualSVec64<W, 1>;
+    fn lift(x: Dual<W>) -> Self::Damped {
+        HyperDualSVec64::new(x.re, x.eps, Derivative::none(), Derivative::none())
+    }
+    fn alpha() -> Self::Damped {
+        HyperDualSVec64::new(0.0, Derivative::none(), Derivative::some(SMatrix::<f64, 1, 1>::new(1.0)), Derivative::none())
+    }
+    fn slope(x: &Self::Damped) -> Dual<W> {
+        let mixed = x.eps1eps2.unwrap_generic(Const::<W>, Const::<1>);
+        Dual::new(x.eps2.unwrap_generic(U1, Const::<1>)[0], Derivative::some(mixed))
+    }
+}
+
+/// `f` over the scalar of one derivative more (`Damping`), none of it along α.
+fn lift<const D: usize, T: Damping>(f: &GvrFunction<D, T>) -> GvrFunction<D, T::Damped> {
+    GvrFunction { a: f.a.map(T::lift), u: f.u.map(T::lift), k: f.k, c_a: f.c_a, c_u: T::lift(f.c_u), log_norm: T::lift(f.log_norm) }
+}
+
+/// `<f| r^T (M ⊗ I_3) r |g>` of normalised functions for a symmetric `M`: `−∂/∂α` of the overlap
+/// of `f` and `g exp(−α r^T (M ⊗ I_3) r)` at α = 0; for `T` of dual numbers with its derivatives.
+pub fn quadratic<const D: usize, T: Damping>(f: &GvrFunction<D, T>, g: &GvrFunction<D, T>, go: &GvrOps<D>, m: &SMatrix<T, D, D>) -> T {
+    let alpha = T::alpha();
+    let mut damped = lift(g);
+    damped.a += m.map(|x| alpha * T::lift(x));
+    -T::slope(&<EcgGvr as Family<D>>::overlap(&lift(f), &damped, go))
 }
 
 /// `(a b^T + b a^T)/2`: the quadratic form of `(a^T r)·(b^T r)`.
-fn outer<const D: usize>(a: &Vector<D>, b: &Vector<D>) -> Mat<D> {
-    (a * b.transpose() + b * a.transpose()) * 0.5
+fn outer<const D: usize, T: Real>(a: &SVector<T, D>, b: &SVector<T, D>) -> SMatrix<T, D, D> {
+    SMatrix::from_fn(|i, j| (a[i] * b[j] + a[j] * b[i]) * 0.5)
 }
 
 /// `<p̂_J| v_J² |p̂_J>^{1/2}` of the ket's partner.
-fn norm<const D: usize>(ket: &GvrFunction<D>, go: &GvrOps<D>) -> f64 {
+fn norm<const D: usize, T: Damping>(ket: &GvrFunction<D, T>, go: &GvrOps<D>) -> T {
     quadratic(ket, ket, go, &outer(&ket.u, &ket.u)).sqrt()
 }
 
-/// `<1‖d‖0>_IJ`, `v = [w]` (module docs); `bra` of N = 0, `ket` the partner of N = 1's function.
-pub fn dipole<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
-    quadratic(bra, ket, go, &outer(&ket.u, &v[0])) / norm(ket, go)
+/// `<1‖d‖0>_IJ`, `v = [w]` (module docs); `bra` of N = 0, `ket` the partner of N = 1's function
+/// (of dual numbers for the derivatives along its parameters, `between_gradient`).
+pub fn dipole<const D: usize, T: Damping>(bra: &GvrFunction<D>, ket: &GvrFunction<D, T>, go: &GvrOps<D>, v: &[Vector<D>]) -> T {
+    quadratic(&bra.cast(), ket, go, &outer(&ket.u, &v[0].map(re))) / norm(ket, go)
 }
 
 /// `<1‖∇_w'‖0>_IJ`, `v = [w']` (module docs); `bra` and `ket` as for `dipole`.
-pub fn velocity<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
+pub fn velocity<const D: usize, T: Damping>(bra: &GvrFunction<D>, ket: &GvrFunction<D, T>, go: &GvrOps<D>, v: &[Vector<D>]) -> T {
     let w = &v[0];
-    let mut e = -2.0 * quadratic(bra, ket, go, &outer(&ket.u, &(bra.a * w)));
+    let mut e = quadratic(&bra.cast(), ket, go, &outer(&ket.u, &(bra.a * w).map(re))) * -2.0;
     if bra.k > 0 {
         let k = bra.k as f64;
         let lower = GvrFunction::new(bra.a, bra.u, bra.k - 1, bra.c_a, go, 0).expect("K − 1 of a checked function");
         let x = bra.u.dot(&bra.a.cholesky().expect("a checked exponent").solve(&bra.u)) * 0.25;
         let ratio = 1.0 / (x * ((4.0 * k + 1.0) * (4.0 * k - 1.0)).sqrt());
-        e += 2.0 * k * w.dot(&bra.u) * ratio * quadratic(&lower, ket, go, &outer(&ket.u, &bra.u));
+        e += quadratic(&lower.cast(), ket, go, &outer(&ket.u, &bra.u.map(re))) * (2.0 * k * w.dot(&bra.u) * ratio);
     }
     e / norm(ket, go)
+}
+
+/// The two forms as elements of a ket that carries directions (`path::between_gradient`).
+#[derive(Clone, Copy, Debug)]
+pub enum Form {
+    Length,
+    Velocity,
+}
+
+impl Form {
+    /// The form of the two-basis operator `name`.
+    pub fn of(name: &str) -> Result<Self> {
+        match name {
+            DIPOLE => Ok(Form::Length),
+            VELOCITY => Ok(Form::Velocity),
+            _ => Err(CoreError::Unsupported(format!("operator {name:?}: no derivatives along the ket's parameters ({DIPOLE}, {VELOCITY})"))),
+        }
+    }
+}
+
+impl<const D: usize> KetElement<D, EcgGvr> for Form {
+    fn element<const W: usize>(&self, bra: &GvrFunction<D>, ket: &GvrFunction<D, Dual<W>>, go: &GvrOps<D>, v: &[Vector<D>]) -> Dual<W> {
+        match self {
+            Form::Length => dipole(bra, ket, go, v),
+            Form::Velocity => velocity(bra, ket, go, v),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -86,8 +167,11 @@ mod tests {
     //! to 1: the length form exactly (a polynomial under the Gaussian weight), the velocity form
     //! by a central difference of the bra along `w'` inside the quadrature.
     use super::*;
-    use crate::ecg::Operators;
+    use crate::ecg::{Mat, Operators};
+    use crate::engine::{Engine, Kind, Representation};
     use crate::operators::fixtures::{exponent, gauss_hermite};
+    use crate::params::{Column, Directions};
+    use crate::test_support::Rng;
 
     /// `∫ g(r) exp(−Σ_c r_c^T B r_c) dr` (`r_c` the coordinates' component c) with `M` Gauss–Hermite
     /// nodes per dimension after `r_c = L^{−T} y_c`, `B = L L^T`: exact for `g` a polynomial of degree < 2M.
@@ -163,6 +247,91 @@ mod tests {
         for ks in [(0, 0), (1, 1)] {
             length::<3>((0.9, 2.4), ks);
         }
+    }
+
+    /// Engines of `D` coordinates (no Coulomb pairs): the bra's of family `bra` and N = 0, the
+    /// ket's of ECG-GVR and N = 1 with two images, `(1 − P_12)/2`.
+    fn engines<const D: usize>(bra: Kind) -> (Engine, Engine) {
+        let swap = Mat::<D>::from_fn(|i, j| f64::from(match i { 0 => j == 1, 1 => j == 0, _ => i == j }));
+        let rep = |sym: Vec<(Mat<D>, f64)>| Representation {
+            n: D,
+            lambda: (Mat::<D>::identity() * 0.5).as_slice().to_vec(),
+            pair_w: vec![],
+            pair_q: vec![],
+            sym_t: sym.iter().flat_map(|(t, _)| t.transpose().as_slice().to_vec()).collect(),
+            sym_c: sym.iter().map(|(_, c)| *c).collect(),
+            cm_mass: None,
+        };
+        let bra = Engine::new(bra, rep(vec![(Mat::<D>::identity(), 1.0)]), 0).unwrap();
+        let ket = Engine::new(Kind::EcgGvr, rep(vec![(Mat::<D>::identity(), 0.5), (swap, -0.5)]), 1).unwrap();
+        (bra, ket)
+    }
+
+    /// The columns of functions `(A, u, K)` of family `kind` (`u`, `K` ignored for a plain ECG).
+    fn columns<const D: usize>(kind: Kind, f: &[(Mat<D>, Vector<D>, u32)]) -> Vec<Column> {
+        let a = f.iter().flat_map(|(a, ..)| a.transpose().as_slice().to_vec()).collect();
+        let c_a = Column::Floats(vec![1.0; f.len()]);
+        match kind {
+            Kind::Pecg => vec![Column::Floats(a), c_a],
+            _ => vec![
+                Column::Floats(a),
+                Column::Floats(f.iter().flat_map(|(_, u, _)| u.as_slice().to_vec()).collect()),
+                Column::Naturals(f.iter().map(|(.., k)| *k).collect()),
+                c_a,
+            ],
+        }
+    }
+
+    /// `between_gradient` of a one-function ket against a bra basis of three functions (K_I = `ks.0`,
+    /// the ket's K_J = `ks.1`) along `p` random directions: row 0 has `between`'s bits, rows 1.. its
+    /// derivatives by a fourth-order central difference of `between` (step 1e-3).
+    fn derivatives<const D: usize>(bra_kind: Kind, ks: (u32, u32), p: usize, seed: u64) {
+        let mut rng = Rng(seed);
+        let u = |rng: &mut Rng| Vector::<D>::from_fn(|_, _| rng.signed());
+        let bras: Vec<_> = (0..3).map(|i| (exponent::<D>(0.4 + 0.9 * i as f64), u(&mut rng), ks.0)).collect();
+        let (a, uj) = (exponent::<D>(2.3) * 0.7, u(&mut rng));
+        let da: Vec<Mat<D>> = (0..p).map(|_| Mat::<D>::from_fn(|_, _| rng.signed() * 0.3)).map(|m| m + m.transpose()).collect();
+        let du: Vec<Vector<D>> = (0..p).map(|_| u(&mut rng)).collect();
+        let (bra_engine, ket_engine) = engines::<D>(bra_kind);
+        let bra = columns(bra_kind, &bras);
+        let w = Vector::<D>::from_fn(|i, _| [1.0, -2.0, 0.5][i % 3]);
+        let flat = |m: &[Mat<D>]| m.iter().flat_map(|m| m.transpose().as_slice().to_vec()).collect::<Vec<_>>();
+        let (dir_a, dir_u) = (flat(&da), du.iter().flat_map(|v| v.as_slice().to_vec()).collect::<Vec<_>>());
+        let dir = Directions { a: &dir_a, v: &dir_u };
+        for name in [DIPOLE, VELOCITY] {
+            let between = |t: &[f64]| {
+                let (a, uj) = t.iter().zip(da.iter().zip(&du)).fold((a, uj), |(a, u), (t, (d, e))| (a + d * *t, u + e * *t));
+                let ket = columns(Kind::EcgGvr, &[(a, uj, ks.1)]);
+                bra_engine.between(name, &bra, &ket_engine, &ket, w.as_slice()).unwrap()
+            };
+            let ket = columns(Kind::EcgGvr, &[(a, uj, ks.1)]);
+            let got = bra_engine.between_gradient(name, &bra, &ket_engine, &ket, &dir, w.as_slice()).unwrap();
+            assert_eq!(got.len(), (1 + p) * 3);
+            let values = between(&vec![0.0; p]);
+            assert_eq!(got[..3].iter().map(|x| x.to_bits()).collect::<Vec<_>>(), values.iter().map(|x| x.to_bits()).collect::<Vec<_>>(), "{name}: values");
+            let h = 1e-3;
+            for k in 0..p {
+                let step = |s: f64| between(&(0..p).map(|l| if l == k { s * h } else { 0.0 }).collect::<Vec<_>>());
+                let (p1, m1, p2, m2) = (step(1.0), step(-1.0), step(2.0), step(-2.0));
+                for i in 0..3 {
+                    let want = (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h);
+                    let d = got[(1 + k) * 3 + i];
+                    assert!((d - want).abs() <= 1e-8 * want.abs().max(1e-2), "{name} D={D} K={ks:?} direction {k}, bra {i}: {d} vs {want}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_ket_derivatives_match_a_difference_of_the_elements() {
+        for bra in [Kind::Pecg, Kind::EcgGvr] {
+            for kj in [0, 1] {
+                let ki = if bra == Kind::Pecg { 0 } else { 1 };
+                derivatives::<2>(bra, (ki, kj), 4, 7 + kj as u64);
+                derivatives::<3>(bra, (ki, kj), 5, 11 + kj as u64);
+            }
+        }
+        derivatives::<3>(Kind::EcgGvr, (0, 1), 18, 5); // two chunks of directions
     }
 
     #[test]
