@@ -153,13 +153,14 @@ class Representation:
         the exact derivatives along P directions of its parameters as `row_gradient`'s: dA (P x n x n)
         of A, dv (P x n) of u. Returns (p, 1 + P, nb_bra): row 0 of each instance `between`'s
         column, row 1 + k its derivative along direction k (docs/transitions.md). "dipole" and
-        "velocity"; laboratory frame only."""
+        "velocity"; laboratory frame only; internal elements as `between`'s (c_A does not move)."""
         if self.coords is not None:
             raise ValueError("two-basis gradients are computed in the laboratory frame")
         engine = self.engine(bra)
-        return engine.between_gradient(name, self.arrays(bra), self.engine(f), self.arrays(f),
-                                       np.ascontiguousarray(dA, dtype=float), np.ascontiguousarray(dv, dtype=float),
-                                       self.vectors(v, momentum))
+        out = engine.between_gradient(name, self.arrays(bra), self.engine(f), self.arrays(f),
+                                      np.ascontiguousarray(dA, dtype=float), np.ascontiguousarray(dv, dtype=float),
+                                      self.vectors(v, momentum))
+        return out / self.centre_of_mass(bra, f).T[:, None, :] if self.cm_mass is not None else out
 
     def density(self, f, w: np.ndarray, C: np.ndarray, r: np.ndarray) -> np.ndarray:
         """The spherically averaged densities (p, states, len(r)) of r_w (bohr⁻³) at the radii `r`
