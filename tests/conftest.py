@@ -202,3 +202,13 @@ def prebo_process(*args, timeout: float = 300, **kw) -> subprocess.CompletedProc
     return subprocess.run([sys.executable, "-m", "prebo", *map(str, args)], capture_output=True, text=True,
                           timeout=timeout, **kw)
 
+
+def hydrogen_1s(count: int = 40) -> "prebo.Basis":
+    """Hydrogen's 1s (finite proton mass) in `count` Gaussians exp(−a r²), a = 0.002·1.7^k, of the
+    relative coordinate (c_A = 0.7): 1e-11 Eh from −μ/2 at 40."""
+    from prebo.coordinates import jacobi
+
+    system = prebo.System(["p", "e"])
+    coords = jacobi(system.masses)
+    A = np.array([coords.to_lab(np.array([[0.002 * 1.7 ** k]]), 0.7) for k in range(count)])
+    return prebo.Basis(system, A, np.full(len(A), 0.7))

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import INPUT, functions, mid_schedule
+from conftest import INPUT, functions, hydrogen_1s, mid_schedule
 
 pytest.importorskip("mpi4py")
 MPIEXEC = shutil.which("mpiexec") or pytest.skip("no mpiexec on the PATH", allow_module_level=True)
@@ -102,3 +102,18 @@ def test_a_two_rank_run_equals_a_one_rank_run_of_its_batch_and_resumes_after_a_k
         assert functions(tmp_path / folder) == functions(tmp_path / "one")
     energies = [json.loads((tmp_path / k / "result.json").read_text())["energy"] for k in ("one", "two", "killed", "on-one")]
     assert len(set(energies)) == 1
+
+
+def test_a_response_run_on_two_ranks_equals_one_rank_of_its_batch(tmp_path):
+    """A first-order function's run (TOML [response], optimise/response.py) shares its rows as a
+    level's does; the source terms each rank evaluates alike: two ranks give the basis and the
+    polarisability of one process with batch = 2, bit for bit."""
+    hydrogen_1s().save(tmp_path / "ground.json")
+    text = '[response]\nground = "ground.json"\n[basis]\nsize = 6\n[optimiser]\nschedule = "fixed"\nsweeps = 1\n'
+    (tmp_path / "in.toml").write_text(text)
+    (tmp_path / "batch.toml").write_text(text + "batch = 2\n")
+    finished(prebo_run(1, tmp_path / "batch.toml", "--out", tmp_path / "one"), 300)
+    finished(prebo_run(2, tmp_path / "in.toml", "--out", tmp_path / "two"), 300)
+    assert functions(tmp_path / "two") == functions(tmp_path / "one")
+    one, two = (json.loads((tmp_path / d / "result.json").read_text())["response"] for d in ("one", "two"))
+    assert one == two

@@ -16,7 +16,7 @@ from prebo.matrices import Matrices
 from prebo.optimise import Optimiser, optimise
 from prebo.optimise.response import Hylleraas, Source
 
-from conftest import cli_error, functions, mid_schedule
+from conftest import cli_error, functions, hydrogen_1s, mid_schedule
 
 E0 = -0.5
 
@@ -113,15 +113,7 @@ def test_no_minimum_at_or_above_a_pole(problem):
 
 @pytest.fixture(scope="module")
 def hydrogen_ground():
-    """Hydrogen's 1s (finite proton mass) in 40 Gaussians exp(−a r²), a = 0.002·1.7^k, of the
-    relative coordinate."""
-    from prebo.coordinates import jacobi
-    from prebo.basis import Basis
-
-    system = System(["p", "e"], State())
-    coords = jacobi(system.masses)
-    A = np.array([coords.to_lab(np.array([[0.002 * 1.7 ** k]]), 0.7) for k in range(40)])
-    return Basis(system, A, np.full(len(A), 0.7))
+    return hydrogen_1s()
 
 
 def exact_alpha(system) -> float:
