@@ -60,6 +60,12 @@ def print_result(r: dict) -> None:
     t.add_row("basis", f"{r['n_basis']} {r['basis_type']} functions")
     t.add_row("particles", " ".join(p["name"] for p in r["particles"]))
     t.add_row("overlap condition", f"{r['overlap_condition']:.2e} ({r['kept']} kept)")
+    if "response" in r:  # a first-order function's run (optimise/response.py)
+        x = r["response"]
+        t.add_row("Hylleraas functional J", f"{x['objective']:.12f} a.u. ({x['operator']} on root {x['root']}, "
+                  f"E₀ = {x['energy']:.12f} Eh)")
+        t.add_row(f"polarisability α(ω = {x['omega'][0]:g} Eh)", f"{x['alpha'][0]:.12f} a₀³ (sum over states "
+                  f"{x['sum_over_states'][0]:.12f}; first pole {x['pole']:.6f} Eh)")
     if r.get("convergence"):
         c = r["convergence"]
         t.add_row("stopped", f"{STOPPED[c['stopped']]} after {c['seconds']:.1f} s")

@@ -31,7 +31,7 @@ gradients it returns (Representation.between, between_gradient).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -141,8 +141,7 @@ class Driven(Representation):
 
 def driven(rep: Representation, source: Source) -> Driven:
     """The representation `rep` with the source terms of `source` (`Driven`)."""
-    fields = {k: getattr(rep, k) for k in ("lam", "pair_w", "pair_q", "sym_t", "sym_c", "cm_mass", "coords", "ranks")}
-    return Driven(**fields, source=source)
+    return Driven(**{f.name: getattr(rep, f.name) for f in fields(rep)}, source=source)  # its engines shared
 
 
 class Hylleraas(Objective):
