@@ -123,7 +123,7 @@ def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: f
     if (states[0].N, states[0].parity) == (states[1].N, states[1].parity) and \
             lower.system.symmetriser.equivalent(upper.system.symmetriser):
         raise InputError(f"both bases are of one symmetry (N = {states[0].N}, parity {states[0].parity:+d}); "
-                         "an electric-dipole line joins N to N ± 1 of opposite parity")
+                         "a line joins N to N ± 1 of opposite parity (E1) or N ± 2 of the same parity (E2)")
     roots = tuple(roots) if isinstance(roots, (tuple, list)) else (roots, roots)
     if len(roots) != 2:
         raise InputError(f"transitions: roots = {roots!r}: must be K or (K_lower, K_upper)")
