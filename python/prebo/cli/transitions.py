@@ -1,4 +1,5 @@
-"""`prebo transitions`: the electric-dipole lines between the levels of two stored bases."""
+"""`prebo transitions`: the electric-dipole or electric-quadrupole lines between the levels of two
+stored bases."""
 from __future__ import annotations
 
 import json
@@ -12,7 +13,7 @@ from .tables import show
 
 def add(sub) -> None:
     """The `prebo transitions` subcommand, added to the subparsers `sub`."""
-    p = sub.add_parser("transitions", help="electric-dipole lines between the levels of two bases")
+    p = sub.add_parser("transitions", help="electric-dipole or quadrupole lines between the levels of two bases")
     for name in ("lower", "upper"):
         p.add_argument(name, help=f"the {name} levels' basis: basis.json, a run folder holding one, "
                                   "or an ecgpack FILE.inout.txt")
@@ -30,8 +31,8 @@ def add(sub) -> None:
 def command(args) -> int:
     """`prebo transitions LOWER UPPER [--roots K [K]] [--coordinates lab|ti] [--threshold T] [--json]`:
     for every pair of levels the reduced dipole moment in length and velocity form, the line and
-    oscillator strengths, the Einstein A coefficient, and each emitting level's lifetime
-    (level/transitions.py)."""
+    oscillator strengths and the Einstein A coefficient, or the reduced quadrupole moment, its line
+    strength and Einstein A coefficient; and each emitting level's lifetime (level/transitions.py)."""
     from ..level.transitions import transitions
 
     if len(args.roots) > 2:
@@ -60,6 +61,21 @@ def _print(r: dict) -> None:
     for k, v in enumerate(r["levels"]):
         levels.add_row(label[k], f"{v['energy']:.12f}")
     show(levels)
+    if any("quadrupole" in line for line in r["lines"]):
+        _quadrupole(r, label)
+    else:
+        _dipole(r, label)
+    if r["lifetimes"]:
+        life = Table("level", "lifetime (s)", "lines", title="radiative lifetimes",
+                     caption="1/Σ A over the lines to the lower levels computed")
+        for v in r["lifetimes"]:
+            life.add_row(label[v["level"]], f"{v['lifetime']:.6e}", str(v["lines"]))
+        show(life)
+
+
+def _dipole(r: dict, label: dict) -> None:
+    from rich.table import Table
+
     lines = Table("lower → upper", "ν (cm⁻¹)", "<‖d‖> length (e a₀)", "velocity/length", "S (e² a₀²)", "f", "A (s⁻¹)",
                   title="electric-dipole lines",
                   caption="reduced moments <N'‖d‖N> (Edmonds), d about the centre of mass; f absorption from the "
@@ -73,9 +89,15 @@ def _print(r: dict) -> None:
         lines.add_row(pair, f"{line['cm-1']:.4f}", f"{line['length']:.9f}", "" if ratio is None else f"{ratio:.8f}",
                       f"{line['line_strength']:.9e}", f"{line['oscillator_strength']:.9e}", f"{line['einstein_A']:.6e}")
     show(lines)
-    if r["lifetimes"]:
-        life = Table("level", "lifetime (s)", "lines", title="radiative lifetimes",
-                     caption="1/Σ A over the lines to the lower levels computed")
-        for v in r["lifetimes"]:
-            life.add_row(label[v["level"]], f"{v['lifetime']:.6e}", str(v["lines"]))
-        show(life)
+
+
+def _quadrupole(r: dict, label: dict) -> None:
+    from rich.table import Table
+
+    lines = Table("lower → upper", "ν (cm⁻¹)", "<‖Q‖> (e a₀²)", "S (e² a₀⁴)", "A (s⁻¹)", title="electric-quadrupole lines",
+                  caption="reduced moments <N'‖Q‖N> (Edmonds), Q about the centre of mass; A emission from the upper")
+    for line in r["lines"]:
+        pair = f"{label[line['lower']]} → {label[line['upper']]}"
+        lines.add_row(pair, f"{line['cm-1']:.4f}", f"{line['quadrupole']:.9f}", f"{line['line_strength']:.9e}",
+                      f"{line['einstein_A']:.6e}")
+    show(lines)

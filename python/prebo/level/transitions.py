@@ -1,5 +1,6 @@
 """Lines between the levels of two bases: reduced dipole moments in length and velocity form, line
-and oscillator strengths, Einstein A coefficients and radiative lifetimes (docs/transitions.md).
+and oscillator strengths, Einstein A coefficients and radiative lifetimes; reduced quadrupole
+moments, their line strengths and Einstein A coefficients (docs/transitions.md).
 
 Conventions (hartree atomic units; constants CODATA 2018, E. Tiesinga et al., Rev. Mod. Phys. 93,
 025010 (2021)):
@@ -14,11 +15,18 @@ Conventions (hartree atomic units; constants CODATA 2018, E. Tiesinga et al., Re
 - the line strength S = |<1‖d‖0>|² (e² a_0², summed over both levels' M);
 - the absorption oscillator strength f = (2/3) ΔE S / (2N_l + 1), N_l the lower level's;
 - the Einstein coefficient A = (4/3) α³ ΔE³ S / (2N_u + 1) (E_h/ħ), given in s⁻¹;
+- the quadrupole about the centre of mass, Q_2q = Σ_k q_k |ρ_k|² C_2q(ρ̂_k), ρ_k = r_k − R_CM, and
+  its reduced moment <2‖Q‖0> (Edmonds, e a_0²) from the level of N = 2 to the level of N = 0;
+  its line strength S = |<2‖Q‖0>|² (e² a_0⁴) and Einstein coefficient
+  A = (1/15) α⁵ ΔE⁵ S / (2N_u + 1) (E_h/ħ), the standard E2 rate (NIST's
+  A = 1.1199 × 10¹⁸ S / (g_u λ⁵[Å]) s⁻¹, W. L. Wiese and J. R. Fuhr, J. Phys. Chem. Ref. Data 38,
+  565 (2009));
 - the lifetime of a level, 1/Σ A over the lines to the lower levels computed (an upper bound to
   the radiative lifetime when other lower levels are missing).
-The two bases are of the same particles; a line joins levels of N and N ± 1 of opposite parity and
-one spin state (electric-dipole selection rules). The elements (crates/prebo-core, registry
-"dipole" and "velocity") are derived for N = 0 ↔ 1.
+The two bases are of the same particles and one spin state; an electric-dipole line joins levels
+of N and N ± 1 of opposite parity (not 0 and 0), an electric-quadrupole line levels of N and
+N' ≤ N + 2 of the same parity with N + N' ≥ 2. The elements (crates/prebo-core, registry
+"dipole", "velocity" and "quadrupole") are derived for N = 0 ↔ 1 and N = 0 ↔ 2.
 """
 from __future__ import annotations
 
@@ -43,16 +51,35 @@ def dipole_vectors(system) -> tuple[np.ndarray, np.ndarray]:
     return q - q.sum() * system.cm_vector, q / system.masses - q.sum() / system.m_total
 
 
+def quadrupole_matrix(system) -> np.ndarray:
+    """M = Σ_k q_k m_k m_kᵀ, m_k = e_k − m/m_tot (laboratory frame): the quadrupole's Cartesian tensor
+    about the CM, Σ_k q_k ρ_k ρ_kᵀ = Σ_ij M_ij r_i r_jᵀ (ρ_k = m_kᵀr = r_k − R_CM)."""
+    m = np.eye(len(system.charges)) - system.cm_vector[None, :]
+    return m.T @ (system.charges[:, None] * m)
+
+
+def multipole(a: Basis, b: Basis) -> str | None:
+    """The electric multipole whose lines join the levels of the bases `a` and `b` of one spin state:
+    "dipole" (opposite parity, |ΔN| ≤ 1, not N = 0 and 0), "quadrupole" (the same parity,
+    |ΔN| ≤ 2 ≤ N_a + N_b), or None."""
+    sa, sb = a.system.state, b.system.state
+    if sa.parity != sb.parity:
+        return "dipole" if abs(sa.N - sb.N) <= 1 and sa.N + sb.N >= 1 else None
+    return "quadrupole" if abs(sa.N - sb.N) <= 2 <= sa.N + sb.N else None
+
+
 def forbidden(a: Basis, b: Basis) -> str | None:
-    """Why no electric-dipole line joins the levels of the bases `a` and `b`, or None."""
+    """Why neither an electric-dipole nor an electric-quadrupole line joins the levels of the bases
+    `a` and `b`, or None."""
     sa, sb = a.system.state, b.system.state
     if not a.system.symmetriser.equivalent(b.system.symmetriser):
         return "spin-forbidden: the levels' spin states differ"
+    if multipole(a, b) is not None:
+        return None
     if sa.parity == sb.parity:
-        return f"parity-forbidden: both levels have parity {sa.parity:+d}"
-    if abs(sa.N - sb.N) > 1 or sa.N == sb.N == 0:
-        return f"forbidden for an electric dipole: N = {sa.N} and {sb.N}"
-    return None
+        return (f"forbidden for an electric dipole (both levels of parity {sa.parity:+d}) and quadrupole "
+                f"(N = {sa.N} and {sb.N})")
+    return f"forbidden for an electric dipole (N = {sa.N} and {sb.N}) and quadrupole (the parities differ)"
 
 
 def same_particles(a, b) -> None:
@@ -72,16 +99,18 @@ def _levels(basis: Basis, roots: int, threshold: float, coordinates: str) -> tup
 
 def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: float = eigen.THRESHOLD,
                 coordinates: str = "lab") -> dict:
-    """The electric-dipole lines between the lowest levels of the basis `lower` and those of `upper`
-    (each level's energy from `evaluate`), with the conventions of the module docstring; `roots`,
-    how many levels of each (K, or (K_lower, K_upper)).
+    """The electric-dipole or electric-quadrupole lines (`multipole`) between the lowest levels of
+    the basis `lower` and those of `upper` (each level's energy from `evaluate`), with the
+    conventions of the module docstring; `roots`, how many levels of each (K, or (K_lower, K_upper)).
 
     Returns {"levels": [{basis (0: lower, 1: upper), root, N, parity, energy}], "lines": [{lower,
     upper (indices into levels, by energy), Eh, cm-1, length, velocity, velocity/length,
-    line_strength, oscillator_strength, einstein_A (s⁻¹)} or, for a forbidden pair, {lower, upper,
-    Eh, cm-1, forbidden: why}], "lifetimes": [{level, lifetime (s), lines}]}.
+    line_strength, oscillator_strength, einstein_A (s⁻¹)} for a dipole line, {lower, upper, Eh,
+    cm-1, quadrupole, line_strength, einstein_A} for a quadrupole line, or, for a forbidden pair,
+    {lower, upper, Eh, cm-1, forbidden: why}], "lifetimes": [{level, lifetime (s), lines}]}.
     InputError for bases of different particles, of one symmetry, or of floating ECGs (no definite
-    N); UnsupportedError for an allowed pair the elements are not derived for (N > 1)."""
+    N); UnsupportedError for an allowed pair the elements are not derived for (dipole lines but
+    N = 0 ↔ 1, quadrupole lines but N = 0 ↔ 2)."""
     bases = (lower, upper)
     for b in bases:
         if not isinstance(b, Basis) or len(b) == 0:
@@ -94,7 +123,7 @@ def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: f
     if (states[0].N, states[0].parity) == (states[1].N, states[1].parity) and \
             lower.system.symmetriser.equivalent(upper.system.symmetriser):
         raise InputError(f"both bases are of one symmetry (N = {states[0].N}, parity {states[0].parity:+d}); "
-                         "an electric-dipole line joins N to N ± 1 of opposite parity")
+                         "a line joins N to N ± 1 of opposite parity (E1) or N ± 2 of the same parity (E2)")
     roots = tuple(roots) if isinstance(roots, (tuple, list)) else (roots, roots)
     if len(roots) != 2:
         raise InputError(f"transitions: roots = {roots!r}: must be K or (K_lower, K_upper)")
@@ -102,8 +131,11 @@ def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: f
     levels = [{"basis": k, "root": i, "N": states[k].N, "parity": states[k].parity, "energy": e}
               for k in (0, 1) for i, e in enumerate(energies[k])]
     why = forbidden(lower, upper)
-    if why is None:
+    kind = multipole(lower, upper) if why is None else None
+    if kind == "dipole":
         length, velocity = _reduced(bases, vectors, energies, coordinates)
+    elif kind == "quadrupole":
+        quadrupole = _quadrupole(bases, vectors, coordinates)
     lines = []
     for i, a in enumerate(levels[:len(energies[0])]):
         for j, b in enumerate(levels[len(energies[0]):], len(energies[0])):
@@ -112,6 +144,13 @@ def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: f
             line = {"lower": lo, "upper": hi, "Eh": de, "cm-1": de * HARTREE_CM}
             if why is not None:
                 lines.append(line | {"forbidden": why})
+                continue
+            if kind == "quadrupole":
+                q = quadrupole[a["root"], b["root"]]
+                lines.append(line | {
+                    "quadrupole": q, "line_strength": q * q,
+                    "einstein_A": ALPHA ** 5 * de ** 5 * q * q / 15 / (2 * levels[hi]["N"] + 1) / AU_TIME,
+                })
                 continue
             d_l, d_v = length[a["root"], b["root"]], velocity[a["root"], b["root"]]
             S = d_l * d_l
@@ -143,6 +182,21 @@ def _reduced(bases, vectors, energies, coordinates: str) -> tuple[np.ndarray, np
     with np.errstate(divide="ignore", invalid="ignore"):
         velocity = -(c0.T @ V @ c1) / de
     return (length.T, velocity.T) if flip else (length, velocity)
+
+
+def _quadrupole(bases, vectors, coordinates: str) -> np.ndarray:
+    """<2‖Q‖0> between every level of `bases[0]` (rows) and of `bases[1]` (columns), one of N = 0 and
+    one of N = 2."""
+    flip = bases[0].N != 0
+    zero, two = (1, 0) if flip else (0, 1)
+    if (bases[zero].N, bases[two].N) != (0, 2):
+        raise UnsupportedError(f"quadrupole elements between N = {bases[0].N} and N = {bases[1].N}: derived for "
+                               "N = 0 ↔ 2 only")
+    system = bases[zero].system
+    rep = laboratory(system) if coordinates == "lab" else translationally_invariant(system)
+    Q = rep.between("quadrupole", bases[zero], bases[two], quadrupole_matrix(system))[0]
+    q = vectors[zero].T @ Q @ vectors[two]
+    return q.T if flip else q
 
 
 def _lifetimes(lines: list[dict]) -> list[dict]:

@@ -34,10 +34,27 @@
 //! Derivatives along the ket's parameters (`Form`, `path::between_gradient`; docs/transitions.md):
 //! the ket of dual numbers carries them through its normalisation and `‖v_J p_J‖`, and each
 //! quadratic form, a derivative in α itself, through hyper-dual numbers (`Damping`).
+//!
+//! The electric quadrupole about the centre of mass between a basis of N = 0 and one of N = 2,
+//! `Q_2q = Σ_k q_k |ρ_k|² C_2q(ρ̂_k)`, `ρ_k = r_k − R_CM = m_k^T r` (`m_k = e_k − m/m_tot`): its
+//! Cartesian tensor is `T = Σ_ij M_ij r_i r_j^T` with `M = Σ_k q_k m_k m_k^T` (`v`: the D columns
+//! of `M`, in the representation's coordinates on both sides, like the Coulomb vectors), and
+//!
+//! ```text
+//!     <2‖Q‖0>_IJ = <p̂_J| (3/2) Σ_ij M_ij (v_J·r_i)(v_J·r_j) − (1/2) v_J² r^T M r |φ̂_I> / <p̂_J| v_J⁴ |p̂_J>^{1/2}
+//! ```
+//!
+//! for the ket `φ'_J = v_+² p_J` (M = N = 2). Derivation (docs/transitions.md): `<2 M|Q_M|0 0> =
+//! <2‖Q‖0>/√5` for every M, so the element is a fifth of the sum over M, and the addition theorem
+//! `Σ_M C_2M(â)^* C_2M(b̂) = P_2(â·b̂)` turns `Σ_M (|v|² C_2M(v̂))^* Q_2M` into the invariant
+//! `(3/2) Σ_k q_k (v·ρ_k)² − (1/2) v² Σ_k q_k ρ_k²`; the norm `‖|v|² C_2M(v̂) p_J‖² =
+//! <p_J|v⁴|p_J>/5` likewise. Each product of two quadratic forms is `∂²/∂α∂β` of the overlap of
+//! `φ_I` and `p_J exp(−α r^T M_1 r − β r^T M_2 r)` at 0, exact with a hyper-dual number (`second`),
+//! `D + 2` overlaps per pair. Length form only (`quadrupole`, registered of rank 2).
 use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, HyperDualSVec64};
 
-use crate::ecg::{re, Real, Vector};
+use crate::ecg::{re, Mat, Real, Vector};
 use crate::error::{CoreError, Result};
 use super::element::{GvrFunction, GvrOps};
 use super::EcgGvr;
@@ -48,6 +65,8 @@ use crate::gradient::{seed, Dual, KetElement};
 pub const DIPOLE: &str = "dipole";
 /// The velocity form, `v = [w']`.
 pub const VELOCITY: &str = "velocity";
+/// The electric quadrupole, `v` the D columns of `M = Σ_k q_k m_k m_k^T`.
+pub const QUADRUPOLE: &str = "quadrupole";
 
 /// A scalar with one derivative more, along the damping α of `quadratic`'s overlap: `f64` →
 /// `Dual<1>`; `Dual<W>` (W parameter directions θ_p) → the hyper-dual `HyperDualSVec64<W, 1>`,
@@ -131,6 +150,28 @@ pub fn velocity<const D: usize, T: Damping>(bra: &GvrFunction<D>, ket: &GvrFunct
         e += quadratic(&lower.cast(), ket, go, &outer(&ket.u, &bra.u.map(re))) * (2.0 * k * w.dot(&bra.u) * ratio);
     }
     e / norm(ket, go)
+}
+
+/// `<f| (r^T (M_1 ⊗ I_3) r)(r^T (M_2 ⊗ I_3) r) |g>` of normalised functions: `∂²/∂α∂β` of the
+/// overlap of `f` and `g exp(−α r^T M_1 r − β r^T M_2 r)` at 0, the `ε_1 ε_2` part of a hyper-dual
+/// number (ε_1 ↔ α, ε_2 ↔ β; exact through `ecg::inverse_log_det`'s second order).
+pub fn second<const D: usize>(f: &GvrFunction<D>, g: &GvrFunction<D>, go: &GvrOps<D>, m1: &Mat<D>, m2: &Mat<D>) -> f64 {
+    type Hyper = HyperDualSVec64<1, 1>;
+    let alpha = Hyper::new(0.0, Derivative::some(SVector::<f64, 1>::new(1.0)), Derivative::none(), Derivative::none());
+    let beta = Hyper::new(0.0, Derivative::none(), Derivative::some(SMatrix::<f64, 1, 1>::new(1.0)), Derivative::none());
+    let mut damped: GvrFunction<D, Hyper> = g.cast();
+    damped.a += SMatrix::from_fn(|i, j| alpha * m1[(i, j)] + beta * m2[(i, j)]);
+    let s = <EcgGvr as Family<D>>::overlap(&f.cast(), &damped, go);
+    s.eps1eps2.unwrap_generic(Const::<1>, Const::<1>)[(0, 0)]
+}
+
+/// `<2‖Q‖0>_IJ`, `v` the D columns of the symmetric `M` (module docs); `bra` of N = 0, `ket` the
+/// partner of N = 2's function.
+pub fn quadrupole<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
+    let (u, m) = (&ket.u, Mat::<D>::from_columns(v));
+    let uu = outer(u, u);
+    let contracted: f64 = (0..D).map(|i| second(bra, ket, go, &outer(u, &Vector::<D>::from_fn(|k, _| f64::from(k == i))), &outer(u, &m.column(i).into_owned()))).sum();
+    (1.5 * contracted - 0.5 * second(bra, ket, go, &uu, &m)) / second(ket, ket, go, &uu, &uu).sqrt()
 }
 
 /// The two forms as elements of a ket that carries directions (`path::between_gradient`).
@@ -249,10 +290,15 @@ mod tests {
         }
     }
 
+    /// `P_12`: the first two coordinates swapped.
+    fn swap<const D: usize>() -> Mat<D> {
+        Mat::<D>::from_fn(|i, j| f64::from(match i { 0 => j == 1, 1 => j == 0, _ => i == j }))
+    }
+
     /// Engines of `D` coordinates (no Coulomb pairs): the bra's of family `bra` and N = 0, the
-    /// ket's of ECG-GVR and N = 1 with two images, `(1 − P_12)/2`.
-    fn engines<const D: usize>(bra: Kind) -> (Engine, Engine) {
-        let swap = Mat::<D>::from_fn(|i, j| f64::from(match i { 0 => j == 1, 1 => j == 0, _ => i == j }));
+    /// ket's of ECG-GVR and N = `n` with two images, `(1 − P_12)/2`.
+    fn engines<const D: usize>(bra: Kind, n: u32) -> (Engine, Engine) {
+        let swap = swap::<D>();
         let rep = |sym: Vec<(Mat<D>, f64)>| Representation {
             n: D,
             lambda: (Mat::<D>::identity() * 0.5).as_slice().to_vec(),
@@ -263,7 +309,7 @@ mod tests {
             cm_mass: None,
         };
         let bra = Engine::new(bra, rep(vec![(Mat::<D>::identity(), 1.0)]), 0).unwrap();
-        let ket = Engine::new(Kind::EcgGvr, rep(vec![(Mat::<D>::identity(), 0.5), (swap, -0.5)]), 1).unwrap();
+        let ket = Engine::new(Kind::EcgGvr, rep(vec![(Mat::<D>::identity(), 0.5), (swap, -0.5)]), n).unwrap();
         (bra, ket)
     }
 
@@ -292,7 +338,7 @@ mod tests {
         let (a, uj) = (exponent::<D>(2.3) * 0.7, u(&mut rng));
         let da: Vec<Mat<D>> = (0..p).map(|_| Mat::<D>::from_fn(|_, _| rng.signed() * 0.3)).map(|m| m + m.transpose()).collect();
         let du: Vec<Vector<D>> = (0..p).map(|_| u(&mut rng)).collect();
-        let (bra_engine, ket_engine) = engines::<D>(bra_kind);
+        let (bra_engine, ket_engine) = engines::<D>(bra_kind, 1);
         let bra = columns(bra_kind, &bras);
         let w = Vector::<D>::from_fn(|i, _| [1.0, -2.0, 0.5][i % 3]);
         let flat = |m: &[Mat<D>]| m.iter().flat_map(|m| m.transpose().as_slice().to_vec()).collect::<Vec<_>>();
@@ -346,5 +392,100 @@ mod tests {
             let want = (8.0 * (at(1.0) - at(-1.0)) - (at(2.0) - at(-2.0))) / (12.0 * h);
             assert!((got - want).abs() <= 1e-7 * want.abs(), "{ks:?}: {got} vs {want}");
         }
+    }
+
+    /// `Σ_c r_c^T M r_c` and `r_z^T M r_z`.
+    fn trace_zz<const D: usize>(m: &Mat<D>, r: &[Vector<D>; 3]) -> (f64, f64) {
+        (r.iter().map(|rc| rc.dot(&(m * rc))).sum(), r[2].dot(&(m * r[2])))
+    }
+
+    impl<const D: usize> Pair<D> {
+        /// `√5 ∫ f_0 Q_0 φ_I / (‖f_0‖ ‖φ_I‖)` with the ket's M = 0 component `f_0 = |v|² C_20(v̂) p_J =
+        /// (3 v_z² − v²)/2 p_J` and `Q_0 = (3 T_zz − Tr T)/2`, `T = Σ_ij M_ij r_i r_j^T` (Edmonds).
+        fn quadrupole<const M: usize>(&self, m: &Mat<D>) -> f64 {
+            let ((ai, ui, ki), (aj, uj, kj)) = (self.bra, self.ket);
+            let f0 = |r: &[Vector<D>; 3]| {
+                let (v2, vz) = (power(&uj, 1, r), uj.dot(&r[2]));
+                (3.0 * vz * vz - v2) * 0.5 * power(&uj, kj, r)
+            };
+            let x = integrate::<D, M>(&(ai + aj), |r| {
+                let (tr, zz) = trace_zz(m, r);
+                f0(r) * (3.0 * zz - tr) * 0.5 * power(&ui, ki, r)
+            });
+            let nj = integrate::<D, M>(&(aj * 2.0), |r| f0(r).powi(2));
+            let ni = integrate::<D, M>(&(ai * 2.0), |r| power(&ui, ki, r).powi(2));
+            5f64.sqrt() * x / (nj * ni).sqrt()
+        }
+    }
+
+    /// A symmetric `M` of mixed signs (a quadrupole's `Σ_k q_k m_k m_k^T`).
+    fn quadrupole_matrix<const D: usize>() -> Mat<D> {
+        let m = Mat::<D>::from_fn(|i, j| [0.8, -1.3, 0.4, 2.1, -0.6, 1.7, -0.9, 0.3, 1.1][(3 * i + j) % 9]);
+        m + m.transpose()
+    }
+
+    #[test]
+    fn second_moments_match_quadrature() {
+        let pair = Pair::<3>::new((0.9, 2.4), (1, 1));
+        let (bra, ket, go) = pair.functions();
+        let ((ai, ui, ki), (aj, uj, kj)) = (pair.bra, pair.ket);
+        let (m1, m2) = (quadrupole_matrix::<3>(), outer(&uj, &Vector::<3>::new(0.3, -1.0, 0.7)));
+        let got = second(&bra, &ket, &go, &m1, &m2);
+        let moment = |b: &Mat<3>, g: &dyn Fn(&[Vector<3>; 3]) -> f64| integrate::<3, 5>(b, g);
+        let x = moment(&(ai + aj), &|r| power(&ui, ki, r) * power(&uj, kj, r) * trace_zz(&m1, r).0 * trace_zz(&m2, r).0);
+        let norms = moment(&(ai * 2.0), &|r| power(&ui, ki, r).powi(2)) * moment(&(aj * 2.0), &|r| power(&uj, kj, r).powi(2));
+        let want = x / norms.sqrt();
+        assert!((got - want).abs() <= 1e-11 * want.abs(), "{got} vs {want}");
+    }
+
+    fn quadrupole_pair<const D: usize>(seeds: (f64, f64), ks: (u32, u32)) {
+        let pair = Pair::<D>::new(seeds, ks);
+        let (bra, ket, go) = pair.functions();
+        let m = quadrupole_matrix::<D>();
+        let got = quadrupole(&bra, &ket, &go, &m.column_iter().map(|c| c.into_owned()).collect::<Vec<_>>());
+        let want = pair.quadrupole::<5>(&m);
+        assert!((got - want).abs() <= 1e-11 * want.abs(), "D={D} {ks:?}: {got} vs {want}");
+    }
+
+    #[test]
+    fn the_quadrupole_matches_quadrature_for_two_and_three_coordinates() {
+        for ks in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            quadrupole_pair::<2>((0.3, 1.7), ks);
+        }
+        for ks in [(0, 0), (1, 1)] {
+            quadrupole_pair::<3>((0.9, 2.4), ks);
+        }
+    }
+
+    /// `Engine::between`'s quadrupole, a bra of family `kind` and K_I = `ks.0`, two bra functions,
+    /// against the quadrature (`G` nodes) of each bra with the ket and its image under `P_12`,
+    /// `(1 − P_12)/2`.
+    fn symmetrised<const D: usize, const G: usize>(kind: Kind, ks: (u32, u32)) {
+        let pairs = [Pair::<D>::new((0.6, 1.9), ks), Pair::<D>::new((1.4, 1.9), ks)];
+        let (bra_engine, ket_engine) = engines::<D>(kind, 2);
+        let bra = columns(kind, &pairs.iter().map(|p| p.bra).collect::<Vec<_>>());
+        let ket = columns(Kind::EcgGvr, &[pairs[0].ket]);
+        let m = quadrupole_matrix::<D>();
+        let got = bra_engine.between(QUADRUPOLE, &bra, &ket_engine, &ket, m.as_slice()).unwrap();
+        let p = swap::<D>();
+        for (i, pair) in pairs.iter().enumerate() {
+            let (aj, uj, kj) = pair.ket;
+            let image = Pair { bra: pair.bra, ket: (p.transpose() * aj * p, p.transpose() * uj, kj) };
+            let want = 0.5 * (pair.quadrupole::<G>(&m) - image.quadrupole::<G>(&m));
+            assert!((got[i] - want).abs() <= 1e-11 * want.abs(), "D={D} {kind:?} {ks:?} bra {i}: {} vs {want}", got[i]);
+        }
+    }
+
+    #[test]
+    fn the_symmetrised_quadrupole_sums_the_kets_images() {
+        for kind in [Kind::Pecg, Kind::EcgGvr] {
+            symmetrised::<2, 5>(kind, (0, 1));
+            symmetrised::<3, 3>(kind, (0, 0));
+        }
+        symmetrised::<2, 5>(Kind::EcgGvr, (1, 1));
+        let (bra_engine, ket_engine) = engines::<2>(Kind::EcgGvr, 1);
+        let one = columns(Kind::EcgGvr, &[Pair::<2>::new((0.6, 1.9), (0, 0)).bra]);
+        let err = bra_engine.between(QUADRUPOLE, &one, &ket_engine, &one, &[0.0; 4]).unwrap_err().to_string();
+        assert!(err.contains("N = 0 and a ket of N = 1") && err.contains("N = 0 to N = 2"), "{err}");
     }
 }
