@@ -174,7 +174,8 @@ def test_a_response_input_runs_and_a_killed_run_resumes_to_the_same_basis(hydrog
                                        ('ground = "ground.json"\noperator = "quadrupole"', "operator"),
                                        ('ground = "ground.json"\nomega = "x"', "omega"),
                                        ('operator = "dipole"', "ground"),
-                                       ('ground = "ground.json"\n[state]\nN = 1\nparity = 1', "parity")])
+                                       ('ground = "ground.json"\n[state]\nN = 1\nparity = 1', "parity"),
+                                       ('ground = "ground.json"\n[state]\nN = 2\nparity = 1', "N = 2")])
 def test_bad_response_settings_get_one_line(hydrogen_ground, tmp_path, capsys, bad, what):
     hydrogen_ground.save(tmp_path / "ground.json")
     (tmp_path / "bad.toml").write_text(f"[response]\n{bad}\n[basis]\nsize = 4\n")

@@ -30,9 +30,8 @@ if sys.version_info >= (3, 11):
 else:  # Python 3.10: the same parser as a package
     import tomli as tomllib
 
-from ..basis import Basis, family
+from ..basis import family
 from ..errors import InputError, PreboError
-from ..level.transitions import forbidden, same_particles
 from ..optimise import Optimiser, coordinate_sets
 from ..system import State, System
 from ..optimise.defaults import resolved
@@ -100,7 +99,7 @@ def from_dict(d: dict, folder: Path = Path(".")) -> Job:
     if "K_max" in basis_t and not family(opts.kind).K_limit:
         raise InputError(f"[basis] K_max: {opts.kind} functions have no power K (K_max is a setting of ecg-gvr)")
     coordinate_sets(system, opts.channels)
-    response = None if ground is None else _source(ground, response_t, system, opts)
+    response = None if ground is None else _source(ground, response_t, system)
     return Job(title or system.label(), system, opts, response)
 
 
@@ -127,26 +126,20 @@ def _reached(ground: System) -> tuple[dict, dict]:
                                       "spin": ground.to_dict()["state"]["spin"]}
 
 
-def _source(ground: tuple, t: dict, system: System, opts: Optimiser) -> Source:
-    """The response.Source of a [response] table for a run of `system` with `opts`; InputError for
-    a ground basis of other particles or a symmetry its operator does not reach."""
+def _source(ground: tuple, t: dict, system: System) -> Source:
+    """The response.Source of a [response] table for a run of `system`; InputError for bad settings,
+    a ground basis of other particles or a symmetry its operator does not reach (Source.check)."""
     basis, threshold = ground
-    try:
-        same_particles(basis.system, system)
-    except InputError as exc:
-        raise InputError(f"[response] ground: {exc}") from exc
-    why = forbidden(basis, Basis.empty(system, opts.kind))
-    if why is not None:
-        raise InputError(f"[response]: the run's symmetry cannot hold the dipole's first-order function of the "
-                         f"ground level ({why})")
     settings = {k: t[k] for k in ("operator", "root", "omega") if k in t}
     if "root" in settings and (isinstance(settings["root"], bool) or not isinstance(settings["root"], int)
                                or settings["root"] < 0):
         raise InputError(f"[response] root = {settings['root']!r}: must be a level's index (0: the lowest)")
     try:
-        return Source.of(basis, threshold=threshold, **settings)
+        source = Source.of(basis, threshold=threshold, **settings)
+        source.check(system)
     except PreboError as exc:
-        raise InputError(f"[response]: {exc}") from exc
+        raise InputError(f"[response] {str(exc).removeprefix('response: ')}") from exc
+    return source
 
 
 def load(path) -> Job:

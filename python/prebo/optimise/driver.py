@@ -81,6 +81,8 @@ def optimise(system: System, opts: Optimiser, out: Path | None = None, progress:
         path_name(out, "optimise: out", "a folder (a str or path), or None")
     if response is not None and not isinstance(response, Source):
         raise InputError(f"optimise: response = {response!r}: must be a prebo.optimise.response.Source, or None")
+    if response is not None:
+        response.check(system)
     ranks = world()
     if not ranks.root:  # rank 0 alone writes (parallel.py); the others run the same steps
         out, progress = None, False

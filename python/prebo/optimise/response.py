@@ -88,6 +88,20 @@ class Source:
         return cls(ground, level["vectors"][:, 0], float(level["energy"]), operator, w, float(omega), root,
                    float(threshold))
 
+    def check(self, system) -> None:
+        """InputError unless `system` (a run's) is of the ground's particles and of the symmetry its
+        operator reaches from the level: N = 1 and the other parity for the dipole of N = 0."""
+        from ..level.transitions import forbidden, multipole, same_particles
+
+        same_particles(self.ground.system, system)
+        reached = Basis.empty(system, "ecg-gvr" if system.state.N else "pecg")
+        why = forbidden(self.ground, reached) or (
+            None if multipole(self.ground, reached) == "dipole" and system.state.N == 1 else
+            f"the dipole joins the ground's N = {self.ground.N} to N = 1 of the other parity")
+        if why is not None:
+            raise InputError(f"response: the run's symmetry (N = {system.state.N}, parity {system.state.parity:+d}) "
+                             f"cannot hold the dipole's first-order function of the ground level ({why})")
+
     def to_dict(self) -> dict:
         """The checkpoint's "response" block: the operator, frequency, root, threshold and ground
         basis (`of` rebuilds the source from it, the same bits)."""
