@@ -5,7 +5,7 @@
 use crate::cache::Cache;
 use crate::ecg::{Element, Mat, Operators, Vector, MAX_DIM};
 use crate::error::{CoreError, Result};
-use crate::gradient::KetElement;
+use crate::path::KetElement;
 use crate::families::fecg::Fecg;
 use crate::families::ecg_gvr::transition::Form;
 use crate::families::ecg_gvr::EcgGvr;

@@ -11,8 +11,7 @@ use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, DualSVec64};
 use rayon::prelude::*;
 
-use crate::ecg::{Element, Mat, Vector};
-use crate::families::Family;
+use crate::ecg::{Element, Mat};
 use crate::error::Result;
 use crate::matrices::Matrices;
 use crate::images::{Images, Transform};
@@ -37,18 +36,6 @@ pub fn seed_matrix<const R: usize, const C: usize, const W: usize>(
     dm: &[SMatrix<f64, R, C>],
 ) -> SMatrix<Dual<W>, R, C> {
     SMatrix::from_fn(|i, j| seed(m[(i, j)], dm.iter().map(|d| d[(i, j)])))
-}
-
-/// A two-basis element whose ket carries W directions (`path::between_gradient`):
-/// `<phi_I| O(v) |phi'_J>` of a constant bra and a seeded ket, with its derivatives.
-pub trait KetElement<const D: usize, F: Family<D>>: Sync {
-    fn element<const W: usize>(
-        &self,
-        bra: &F::Function<f64>,
-        ket: &F::Function<Dual<W>>,
-        ctx: &F::Context,
-        v: &[Vector<D>],
-    ) -> Dual<W>;
 }
 
 /// The value and derivatives of one element: `out[0]` the value, `out[1 + p]` its derivative along direction `p`.

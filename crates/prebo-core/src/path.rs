@@ -11,7 +11,7 @@ use crate::ecg::{Element, Mat, Vector};
 use crate::error::Result;
 use crate::families::Family;
 use crate::params::{check, Directions, Parameters, Symmetry};
-use crate::gradient::{self, Dual, KetElement, MAX_LANES};
+use crate::gradient::{self, Dual, MAX_LANES};
 use crate::images::Images;
 use crate::matrices::Matrices;
 use nalgebra::{Const, U1};
@@ -202,6 +202,18 @@ pub fn between<const D: usize, F: Family<D>>(
         }
     }
     Ok(out)
+}
+
+/// A two-basis element whose ket carries W directions (`path::between_gradient`):
+/// `<phi_I| O(v) |phi'_J>` of a constant bra and a seeded ket, with its derivatives.
+pub trait KetElement<const D: usize, F: Family<D>>: Sync {
+    fn element<const W: usize>(
+        &self,
+        bra: &F::Function<f64>,
+        ket: &F::Function<Dual<W>>,
+        ctx: &F::Context,
+        v: &[Vector<D>],
+    ) -> Dual<W>;
 }
 
 /// One chunk of at most W directions of `between_gradient`: per bra, per instance, the derivatives

@@ -59,7 +59,8 @@ use crate::error::{CoreError, Result};
 use super::element::{GvrFunction, GvrOps};
 use super::EcgGvr;
 use crate::families::Family;
-use crate::gradient::{seed, Dual, KetElement};
+use crate::gradient::{seed, Dual};
+use crate::path::KetElement;
 
 /// The length form, `v = [w]`.
 pub const DIPOLE: &str = "dipole";
