@@ -279,6 +279,15 @@ def lowest_with_block(E, C, h, s, H_ff, S_ff, min_norm: float = 1e-10, near: flo
     return roots_with_block(E, C, h, s, H_ff, S_ff, min_norm, [near])[0]
 
 
+def independent(D: np.ndarray, S_ff: np.ndarray, min_norm: float) -> bool:
+    """Whether k functions of overlap S_ff and overlaps D = s C with a basis's S-orthonormal
+    eigenvectors C are independent of it: the smallest eigenvalue of their orthogonal part
+    S_ff − D Dᵀ, scaled to unit diagonal, is at least `min_norm` (and finite)."""
+    scale = 1.0 / np.sqrt(np.diag(S_ff))
+    orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
+    return bool(np.all(np.isfinite(orthogonal)) and np.linalg.eigvalsh(orthogonal)[0] >= min_norm)
+
+
 class _Block:
     """k functions added to a basis of eigenvalues E and S-orthonormal eigenvectors C (module
     docstring, block update): D = s C, B = h C and the blocks H_ff, S_ff among them."""
@@ -291,9 +300,7 @@ class _Block:
         """The block of rows h, s; None when it is linearly dependent on the basis (the smallest
         eigenvalue of its orthogonal part S_ff - D D^T below `min_norm` of its diagonal)."""
         D, B = s @ C, h @ C
-        scale = 1.0 / np.sqrt(np.diag(S_ff))
-        orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
-        if not np.all(np.isfinite(orthogonal)) or np.linalg.eigvalsh(orthogonal)[0] < min_norm:
+        if not independent(D, S_ff, min_norm):
             return None
         return cls(E, D, B, H_ff, S_ff)
 

@@ -282,9 +282,7 @@ class Hylleraas(Objective):
             return np.inf, []
         yd, inv = rest
         D, P = (s @ C, (h - self.shift * s) @ C) if len(E) else (np.zeros((len(h), 0)),) * 2
-        scale = 1.0 / np.sqrt(np.diag(S_ff))
-        orthogonal = (S_ff - D @ D.T) * np.outer(scale, scale)
-        if not np.all(np.isfinite(orthogonal)) or np.linalg.eigvalsh(orthogonal)[0] < min_norm:
+        if not eigen.independent(D, S_ff, min_norm):
             return np.inf, []
         M = (H_ff - self.shift * S_ff) - (P * inv) @ P.T
         nu = np.asarray(b[1]) - P @ yd
