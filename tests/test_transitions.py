@@ -42,6 +42,7 @@ def test_hydrogen_1s_2p_matches_the_closed_forms_with_the_reduced_mass(lines):
     assert abs(line["Eh"] - de) < 1e-10
     assert abs(abs(line["length"]) - R) < 1e-9 * R
     assert abs(line["velocity"] - line["length"]) < 1e-9 * R
+    assert abs(line["acceleration"] - line["length"]) < 1e-9 * R  # 1.3e-10 R measured (5e-5 R with 20 exponents)
     assert abs(line["line_strength"] - R * R) < 2e-9 * R * R
     assert abs(line["oscillator_strength"] - 2 / 3 * de * R * R) < 2e-9
     want_A = 4 / 3 * ALPHA ** 3 * de ** 3 * R * R / 3 / AU_TIME
@@ -63,7 +64,7 @@ def test_the_thomas_reiche_kuhn_sum_over_pseudostates_is_one_over_mu():
 def test_laboratory_and_translationally_invariant_elements_agree():
     lower, upper = hydrogen(0, EXPONENTS[:6]), hydrogen(1, EXPONENTS[2:9])
     w, w_v = dipole_vectors(lower.system)
-    for name, v, momentum in [("dipole", w, False), ("velocity", w_v, True)]:
+    for name, v, momentum in [("dipole", w, False), ("velocity", w_v, True), ("acceleration", w_v, True)]:
         lab = laboratory(lower.system).between(name, lower, upper, v[None], momentum)[0]
         ti = translationally_invariant(lower.system).between(name, lower, upper, v[None], momentum)[0]
         assert np.max(np.abs(lab - ti)) < 1e-11 * np.max(np.abs(lab))
@@ -84,7 +85,7 @@ def test_a_plain_bra_equals_the_ecg_gvr_bra_at_k_0():
     upper = hydrogen(1, EXPONENTS[3:10])
     w, w_v = dipole_vectors(upper.system)
     rep = laboratory(upper.system)
-    for name, v, momentum in [("dipole", w, False), ("velocity", w_v, True)]:
+    for name, v, momentum in [("dipole", w, False), ("velocity", w_v, True), ("acceleration", w_v, True)]:
         plain = rep.between(name, hydrogen(0, EXPONENTS[:8]), upper, v[None], momentum)[0]
         gvr = rep.between(name, hydrogen(0, EXPONENTS[:8], kind="ecg-gvr"), upper, v[None], momentum)[0]
         assert np.array_equal(plain, gvr)

@@ -1,5 +1,6 @@
-"""The core's dipole elements in length and velocity form against [H, d], for single pairs of
-functions, from the floating-ECG engine's overlap and kinetic elements (no dipole kernel).
+"""The core's dipole elements in length and velocity form against [H, d], and in acceleration form
+against the Coulomb element's gradient under a translation, for single pairs of functions, from
+the floating-ECG engine's overlap, kinetic and Coulomb elements (no dipole kernel).
 
 With d_z = Σ_k w_k z_k, w = q − Q m/m_tot (`dipole_vectors`), and the laboratory-frame kinetic
 energy T = −Σ_k ∇_k²/(2 m_k), [d_z, T] = Σ_k (w_k/m_k) ∂/∂z_k = ∂_{w′,z}, w′ = q/m − Q/m_tot; the
@@ -48,6 +49,9 @@ from prebo.level.transitions import dipole_vectors
 STENCIL = ((1, 3 / 4), (-1, -3 / 4), (2, -3 / 20), (-2, 3 / 20), (3, 1 / 60), (-3, -1 / 60))
 #: the step in each parameter (α in bohr⁻², λ and μ in bohr⁻¹): below 5e-9 relative from 0.01 to 0.03
 STEP = 0.03
+#: the step of the translation h (bohr): the Coulomb elements' error falls as h⁶ (p μ e, K = 0: 9.7e-6
+#: at 0.06, 1.5e-7 at 0.03, 2.4e-9 at 0.015) until rounding (~2e-8 at 0.0075)
+SHIFT = 0.015
 
 SYSTEMS = {"p mu e": (["p", "mu", "e"], {}), "He singlet": (["alpha", "e", "e"], {"e": 0}),
            "He triplet": (["alpha", "e", "e"], {"e": 1})}
@@ -64,9 +68,11 @@ def norm(A: np.ndarray) -> float:
     return (math.pi ** len(A) / np.linalg.det(2 * A)) ** 0.75
 
 
-def partial(f, k: int) -> float:
-    """∂^k f(x_1, …, x_k)/∂x_1…∂x_k at 0 by the central difference `STENCIL` in each variable."""
-    return sum(math.prod(c / STEP for _, c in combo) * f(*(o * STEP for o, _ in combo))
+def partial(f, k: int, steps=None) -> float:
+    """∂^k f(x_1, …, x_k)/∂x_1…∂x_k at 0 by the central difference `STENCIL` in each variable, of
+    the steps `steps` (default: STEP each)."""
+    steps = steps or (STEP,) * k
+    return sum(math.prod(c / h for (_, c), h in zip(combo, steps)) * f(*(o * h for (o, _), h in zip(combo, steps)))
                for combo in itertools.product(STENCIL, repeat=k))
 
 
@@ -86,43 +92,83 @@ class Elements:
         return self.rep.matrices(basis)[name][0, 1] * scale
 
 
+class Pair:
+    """The case (system, the bra's K, the ket's global vector): the N = 0 system, the laboratory
+    exponents A_I, A_J and CM exponents c_I, c_J, the one-function bra (plain or ECG-GVR of K = 1)
+    and ECG-GVR ket (N = 1, K = 0) and their norms as un-normalised Gaussians' (module docstring)."""
+
+    def __init__(self, key: str, K: int, ket_u: str):
+        names, spin = SYSTEMS[key]
+        self.K, self.u_J = K, U_J[ket_u]
+        self.zero = prebo.System(names, N=0, parity=1, spin=spin)
+        one = prebo.System(names, N=1, parity=-1, spin=spin)
+        jac = jacobi(self.zero.masses)
+        (self.A_I, self.A_J), (self.c_I, self.c_J) = (jac.to_lab(a, c) for a, c in zip(A_INT, C_A)), C_A
+        self.ket = prebo.Basis(one, self.A_J[None], [self.c_J], kind="ecg-gvr", u=self.u_J[None], K=[0])
+        if K == 0:
+            self.bra = prebo.Basis(self.zero, self.A_I[None], [self.c_I])
+            norm_I = norm(self.A_I)
+        else:
+            self.bra = prebo.Basis(self.zero, self.A_I[None], [self.c_I], kind="ecg-gvr", u=U_I[None], K=[1])
+            norm_I = math.sqrt(15) * (U_I @ np.linalg.solve(self.A_I, U_I) / 4) * norm(self.A_I)
+        norm_J = math.sqrt(self.u_J @ np.linalg.solve(self.A_J, self.u_J) / 4) * norm(self.A_J)
+        cm = (2 * math.sqrt(self.c_I * self.c_J) / (self.c_I + self.c_J)) ** 1.5
+        #: √3 over the norms and the CM Gaussians' overlap, with the sign (−1)^K of the bra's −∂_α
+        self.scale = math.sqrt(3) / (norm_I * norm_J * cm) * (-1) ** K
+
+    def between(self, name: str, v: np.ndarray, momentum: bool = False) -> float:
+        """The core's element of the two-basis operator `name`."""
+        return laboratory(self.zero).between(name, self.bra, self.ket, v[None], momentum)[0, 0, 0]
+
+    def exponent_I(self, alpha: float) -> np.ndarray:
+        """A_I + α u_I u_Iᵀ (K = 1: the bra is −∂_α of its Gaussian)."""
+        return self.A_I + (alpha * np.outer(U_I, U_I) if self.K else 0.0)
+
+
 @pytest.mark.parametrize("key, K, ket_u", CASES, ids=[f"{s}-K={K}-{u}" for s, K, u in CASES])
 def test_length_and_velocity_elements_are_the_dipole_and_its_commutator_with_T(key, K, ket_u):
-    names, spin = SYSTEMS[key]
-    u_J = U_J[ket_u]
-    zero, one = prebo.System(names, N=0, parity=1, spin=spin), prebo.System(names, N=1, parity=-1, spin=spin)
-    w, w_v = dipole_vectors(zero)
-    jac = jacobi(zero.masses)
-    (A_I, A_J), (c_I, c_J) = (jac.to_lab(a, c) for a, c in zip(A_INT, C_A)), C_A
-    ket = prebo.Basis(one, A_J[None], [c_J], kind="ecg-gvr", u=u_J[None], K=[0])
-    if K == 0:
-        bra = prebo.Basis(zero, A_I[None], [c_I])
-        norm_I = norm(A_I)
-    else:
-        bra = prebo.Basis(zero, A_I[None], [c_I], kind="ecg-gvr", u=U_I[None], K=[1])
-        norm_I = math.sqrt(15) * (U_I @ np.linalg.solve(A_I, U_I) / 4) * norm(A_I)
-    norm_J = math.sqrt(u_J @ np.linalg.solve(A_J, u_J) / 4) * norm(A_J)
-    rep = laboratory(zero)
-    dipole = rep.between("dipole", bra, ket, w[None])[0, 0, 0]
-    velocity = rep.between("velocity", bra, ket, w_v[None], momentum=True)[0, 0, 0]
-
-    element = Elements(zero)
+    p = Pair(key, K, ket_u)
+    w, w_v = dipole_vectors(p.zero)
+    dipole, velocity = p.between("dipole", w), p.between("velocity", w_v, momentum=True)
+    element = Elements(p.zero)
 
     def bra_of(x):  # (α,) λ: e^{−λ wᵀr_z} exp(−rᵀ(A_I + α u_I u_Iᵀ)r)
-        return A_I + (x[0] * np.outer(U_I, U_I) if K else 0.0), c_I, x[-1] * w
+        return p.exponent_I(x[0]), p.c_I, x[-1] * w
 
     def overlap(*x):
-        return element(bra_of(x[:-1]), (A_J, c_J, x[-1] * u_J), "S")
+        return element(bra_of(x[:-1]), (p.A_J, p.c_J, x[-1] * p.u_J), "S")
 
     def commutator(*x, name):  # ⟨e^{−λw}f|T|e^{−μu}g⟩ − ⟨f|T|e^{−λw − μu}g⟩
-        return (element(bra_of(x[:-1]), (A_J, c_J, x[-1] * u_J), name)
-                - element(bra_of(x[:-2] + (0.0,)), (A_J, c_J, x[-2] * w + x[-1] * u_J), name))
+        return (element(bra_of(x[:-1]), (p.A_J, p.c_J, x[-1] * p.u_J), name)
+                - element(bra_of(x[:-2] + (0.0,)), (p.A_J, p.c_J, x[-2] * w + x[-1] * p.u_J), name))
 
-    sign = (-1) ** K  # each −∂ of the bra's α, λ and the ket's μ
-    cm = (2 * math.sqrt(c_I * c_J) / (c_I + c_J)) ** 1.5
-    scale = math.sqrt(3) / (norm_I * norm_J * cm)
-    want_dipole = scale * sign * partial(overlap, K + 2)
+    # each −∂ of the bra's α (in p.scale), λ and the ket's μ
+    want_dipole = p.scale * partial(overlap, K + 2)
     assert abs(dipole - want_dipole) < 1e-8 * abs(dipole)
     for name in ("T", "T_ti"):
-        want_velocity = -scale * sign * partial(lambda *x: commutator(*x, name=name), K + 2)
+        want_velocity = -p.scale * partial(lambda *x: commutator(*x, name=name), K + 2)
         assert abs(velocity - want_velocity) < 1e-8 * abs(velocity), name
+
+
+@pytest.mark.parametrize("key, K, ket_u", CASES, ids=[f"{s}-K={K}-{u}" for s, K, u in CASES])
+def test_the_acceleration_element_is_the_gradient_of_the_coulomb_element_under_a_shift(key, K, ket_u):
+    """acceleration = √3 ⟨χ̂|∂_{w′,z} V|φ̂⟩ with V the Coulomb potential: ⟨f|a·∇V|g⟩ = ∂_h ⟨f_h|V|g_h⟩,
+    f_h(r) = f(r − h a) with a = w′ on the z components, and a Gaussian shifted so is again one:
+    exp(−rᵀAr − bᵀr_z) at r_z − h w′ is exp(h bᵀw′ − h² w′ᵀAw′) exp(−rᵀAr − (b − 2h A w′)ᵀr_z). So
+    the element is the mixed derivative in ((α,) μ, h) of un-normalised FECG Coulomb elements."""
+    p = Pair(key, K, ket_u)
+    _, w_v = dipole_vectors(p.zero)
+    acceleration = p.between("acceleration", w_v, momentum=True)
+    element = Elements(p.zero)
+
+    def shifted(f, h):  # (the shifted Gaussian, its factor)
+        A, c, b = f
+        return (A, c, b - 2 * h * A @ w_v), math.exp(h * b @ w_v - h * h * w_v @ A @ w_v)
+
+    def coulomb(*x):  # ⟨f_h|V|g_h⟩, f = exp(−rᵀ(A_I + α u_I u_Iᵀ)r), g = e^{−μ u_Jᵀr_z} exp(−rᵀA_J r)
+        (f, a), (g, b) = (shifted(f, x[-1]) for f in ((p.exponent_I(x[0]), p.c_I, np.zeros(len(U_I))),
+                                                       (p.A_J, p.c_J, x[-2] * p.u_J)))
+        return a * b * element(f, g, "V")
+
+    want = -p.scale * partial(coulomb, K + 2, (STEP,) * (K + 1) + (SHIFT,))  # the ket's −∂_μ
+    assert abs(acceleration - want) < 1e-8 * abs(acceleration)

@@ -95,7 +95,9 @@ class Engine:
         of its vectors v (p, arity, n), given in this representation: "overlap" (no vectors;
         two bases of one N), and the electric dipole's reduced elements <1‖O‖0> between a bra of
         N = 0 (plain or ECG-GVR) and an ECG-GVR ket of N = 1: "dipole", O = Σ_k w_k r_k (w like
-        the Coulomb vectors), "velocity", O = Σ_k w'_k ∇_k (w' momentum-like);
+        the Coulomb vectors), "velocity", O = Σ_k w'_k ∇_k (w' momentum-like), "acceleration",
+        O = Σ_k w'_k ∇_k V (V the representation's Coulomb potential); and the quadrupole's
+        <2‖Q‖0> between N = 0 and N = 2 ("quadrupole", v the n columns of its matrix);
         crates/prebo-core/src/families/ecg_gvr/transition.rs."""
 
     def between_gradient(self, name: str, bra: Params, ket: Engine, ket_params: Params, dA: ArrayLike,

@@ -125,12 +125,13 @@ class Representation:
 
     def between(self, name: str, bra, ket, v: np.ndarray, momentum: bool = False) -> np.ndarray:
         """(p, nb_bra, nb_ket) matrices of the core's two-basis operator `name` ("dipole", "velocity",
-        "quadrupole", "overlap"; crates/prebo-core/src/registry.rs) between the normalised functions
+        "acceleration", "quadrupole", "overlap"; crates/prebo-core/src/registry.rs) between the normalised functions
         of the basis `bra` and those of the basis `ket`, symmetrised by this representation's
         operations (the kets' images), one per laboratory-frame vector v (p, n), position-like or,
         with `momentum`, momentum-like (`vectors`); for the quadrupole v is its symmetric (n, n)
         matrix M (level/transitions.py `quadrupole_matrix`), transformed on both sides (p = 1). The
-        dipole's forms join a bra of N = 0 to a ket of N = 1 and are reduced elements <1‖O‖0>, the
+        dipole's forms (O = d, ∇_w' and ∇_w' V, the last two with a momentum-like v) join a bra of
+        N = 0 to a ket of N = 1 and are reduced elements <1‖O‖0>, the
         quadrupole's a bra of N = 0 to a ket of N = 2, <2‖Q‖0> (level/transitions.py). Each element
         is that of the functions' internal parts (`centre_of_mass`)."""
         if name == "quadrupole":

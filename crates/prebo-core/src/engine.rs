@@ -220,7 +220,8 @@ fn between_d<const D: usize, F: Specialised<D>>(
     let (bra, ket_p) = (F::params(&bra_columns)?, F::params(&ket_columns)?);
     let (ops, _) = e.rep.operators::<D>();
     let (_, ket_sym) = ket.rep.operators::<D>();
-    let ctx = F::kinetic_only(&F::context(ops, e.n_ang, &[&bra, &ket_p])?);
+    let full = F::context(ops, e.n_ang, &[&bra, &ket_p])?;
+    let ctx = if registry::coulomb_between(name) { full } else { F::kinetic_only(&full) };
     path::between::<D, F>(&ctx, &ket_sym, &bra, &ket_p, |x, y, ctx, v| elements.of(x, y, ctx, v), arity, v)
 }
 

@@ -8,7 +8,7 @@
 //! a new one is its module in `operators`, its line here and, where a family has its own element,
 //! that family's `operators.rs`.
 use crate::error::{CoreError, Result};
-use crate::families::ecg_gvr::transition::{DIPOLE, QUADRUPOLE, VELOCITY};
+use crate::families::ecg_gvr::transition::{ACCELERATION, DIPOLE, QUADRUPOLE, VELOCITY};
 use crate::families::pecg::Pecg;
 use crate::families::Family;
 use crate::operators::drachmann::{self, coulomb, gradient};
@@ -46,14 +46,26 @@ fn generic<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<E
 /// (`None`: a family's own, `Specialised`). The quadrupole's D vectors are the columns of its
 /// D x D matrix (`transition`).
 fn two_bases<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<Elements<D, F>>)> {
-    vec![(overlap::NAME, 0, Some(Elements::Each(overlap::element::<D, F>))), (DIPOLE, 1, None), (VELOCITY, 1, None), (QUADRUPOLE, D, None)]
+    vec![
+        (overlap::NAME, 0, Some(Elements::Each(overlap::element::<D, F>))),
+        (DIPOLE, 1, None),
+        (VELOCITY, 1, None),
+        (ACCELERATION, 1, None),
+        (QUADRUPOLE, D, None),
+    ]
+}
+
+/// Whether the elements of the two-basis operator `name` need the Coulomb pairs (the acceleration
+/// form's `∇ V`); the others are read off overlaps, whose context goes without them.
+pub fn coulomb_between(name: &str) -> bool {
+    name == ACCELERATION
 }
 
 /// The rank of the two-basis operator `name`: its elements join a bra basis of N = 0 to a ket
 /// basis of N = rank (the dipole's, 1; the quadrupole's, 2), or, at rank 0, two bases of one N.
 pub fn rank(name: &str) -> u32 {
     match name {
-        DIPOLE | VELOCITY => 1,
+        DIPOLE | VELOCITY | ACCELERATION => 1,
         QUADRUPOLE => 2,
         _ => 0,
     }

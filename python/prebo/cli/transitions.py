@@ -30,7 +30,7 @@ def add(sub) -> None:
 
 def command(args) -> int:
     """`prebo transitions LOWER UPPER [--roots K [K]] [--coordinates lab|ti] [--threshold T] [--json]`:
-    for every pair of levels the reduced dipole moment in length and velocity form, the line and
+    for every pair of levels the reduced dipole moment in length, velocity and acceleration form, the line and
     oscillator strengths and the Einstein A coefficient, or the reduced quadrupole moment, its line
     strength and Einstein A coefficient; and each emitting level's lifetime (level/transitions.py)."""
     from ..level.transitions import transitions
@@ -76,18 +76,19 @@ def _print(r: dict) -> None:
 def _dipole(r: dict, label: dict) -> None:
     from rich.table import Table
 
-    lines = Table("lower → upper", "ν (cm⁻¹)", "<‖d‖> length (e a₀)", "velocity/length", "S (e² a₀²)", "f", "A (s⁻¹)",
+    lines = Table("lower → upper", "ν (cm⁻¹)", "<‖d‖> length (e a₀)", "velocity/length", "acceleration/length",
+                  "S (e² a₀²)", "f", "A (s⁻¹)",
                   title="electric-dipole lines",
                   caption="reduced moments <N'‖d‖N> (Edmonds), d about the centre of mass; f absorption from the "
                           "lower level; A emission from the upper")
     for line in r["lines"]:
         pair = f"{label[line['lower']]} → {label[line['upper']]}"
         if "forbidden" in line:
-            lines.add_row(pair, f"{line['cm-1']:.4f}", line["forbidden"], "", "", "", "")
+            lines.add_row(pair, f"{line['cm-1']:.4f}", line["forbidden"], "", "", "", "", "")
             continue
-        ratio = line["velocity/length"]
-        lines.add_row(pair, f"{line['cm-1']:.4f}", f"{line['length']:.9f}", "" if ratio is None else f"{ratio:.8f}",
-                      f"{line['line_strength']:.9e}", f"{line['oscillator_strength']:.9e}", f"{line['einstein_A']:.6e}")
+        ratios = ("" if x is None else f"{x:.8f}" for x in (line["velocity/length"], line["acceleration/length"]))
+        lines.add_row(pair, f"{line['cm-1']:.4f}", f"{line['length']:.9f}", *ratios, f"{line['line_strength']:.9e}",
+                      f"{line['oscillator_strength']:.9e}", f"{line['einstein_A']:.6e}")
     show(lines)
 
 

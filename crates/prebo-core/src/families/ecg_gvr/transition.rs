@@ -31,6 +31,19 @@
 //! For exact states `<f‖∇_w'‖i> = −(E_f − E_i) <f‖d‖i>` (`[H, d] = −∇_w'`); the ratio of the two
 //! forms is the usual convergence diagnostic.
 //!
+//! The acceleration form, `∇_w' V` with `V = Σ_{a<b} q_a q_b / r_ab` the context's Coulomb
+//! potential: for exact states `<f‖∇_w' V‖i> = (E_f − E_i)² <f‖d‖i>` (`[H, [H, d]] = −[V, ∇_w'] =
+//! ∇_w' V`). Integrated by parts (the force's singularities are integrable), with
+//! `∇_w'·v_J = 3 (w'·u_J)` and `v_J·∇_w' p_J = (2 K_J (w'·u_J) − 2 (u_J^T r)·((A_J w')^T r)) p_J`,
+//!
+//! ```text
+//!     <p_J| v_J·∇_w' V |φ_I> = −(3 + 2K_J)(w'·u_J) <p_J|V|φ_I> + 2 <p_J| (u_J^T r)·(((A_I + A_J) w')^T r) V |φ_I>
+//!                              − 2 K_I (w'·u_I) <p_J| (v_J·v_I) V |v_I|^{2K_I−2} e^{−r^T A_I r}>,
+//! ```
+//!
+//! each quadratic form with `V` inside again `−∂/∂α` at α = 0, now of the Coulomb element of the
+//! damped pair (`damped`), and the last with the velocity form's norm ratio.
+//!
 //! Derivatives along the ket's parameters (`Form`, `path::between_gradient`; docs/transitions.md):
 //! the ket of dual numbers carries them through its normalisation and `‖v_J p_J‖`, and each
 //! quadratic form, a derivative in α itself, through hyper-dual numbers (`Damping`).
@@ -68,6 +81,8 @@ pub const DIPOLE: &str = "dipole";
 pub const VELOCITY: &str = "velocity";
 /// The electric quadrupole, `v` the D columns of `M = Σ_k q_k m_k m_k^T`.
 pub const QUADRUPOLE: &str = "quadrupole";
+/// The acceleration form, `v = [w']`, with the Coulomb potential of the context.
+pub const ACCELERATION: &str = "acceleration";
 
 /// A scalar with one derivative more, along the damping α of `quadratic`'s overlap: `f64` →
 /// `Dual<1>`; `Dual<W>` (W parameter directions θ_p) → the hyper-dual `HyperDualSVec64<W, 1>`,
@@ -114,13 +129,20 @@ fn lift<const D: usize, T: Damping>(f: &GvrFunction<D, T>) -> GvrFunction<D, T::
     GvrFunction { a: f.a.map(T::lift), u: f.u.map(T::lift), k: f.k, c_a: f.c_a, c_u: T::lift(f.c_u), log_norm: T::lift(f.log_norm) }
 }
 
-/// `<f| r^T (M ⊗ I_3) r |g>` of normalised functions for a symmetric `M`: `−∂/∂α` of the overlap
-/// of `f` and `g exp(−α r^T (M ⊗ I_3) r)` at α = 0; for `T` of dual numbers with its derivatives.
-pub fn quadratic<const D: usize, T: Damping>(f: &GvrFunction<D, T>, g: &GvrFunction<D, T>, go: &GvrOps<D>, m: &SMatrix<T, D, D>) -> T {
+/// `(<f| q |g>, <f| q V |g>)` of normalised functions, `q = r^T (M ⊗ I_3) r` for a symmetric `M`
+/// and `V` the context's Coulomb potential (0 without pairs): `−∂/∂α` of the overlap and the
+/// Coulomb element of `f` and `g exp(−α q)` at α = 0; for `T` of dual numbers with its derivatives.
+fn damped<const D: usize, T: Damping>(f: &GvrFunction<D, T>, g: &GvrFunction<D, T>, go: &GvrOps<D>, m: &SMatrix<T, D, D>) -> (T, T) {
     let alpha = T::alpha();
     let mut damped = lift(g);
     damped.a += m.map(|x| alpha * T::lift(x));
-    -T::slope(&<EcgGvr as Family<D>>::overlap(&lift(f), &damped, go))
+    let e = <EcgGvr as Family<D>>::element(&lift(f), &damped, go);
+    (-T::slope(&e.s), -T::slope(&e.v))
+}
+
+/// `<f| r^T (M ⊗ I_3) r |g>` of normalised functions (`damped`).
+pub fn quadratic<const D: usize, T: Damping>(f: &GvrFunction<D, T>, g: &GvrFunction<D, T>, go: &GvrOps<D>, m: &SMatrix<T, D, D>) -> T {
+    damped(f, g, go, m).0
 }
 
 /// `(a b^T + b a^T)/2`: the quadratic form of `(a^T r)·(b^T r)`.
@@ -144,11 +166,31 @@ pub fn velocity<const D: usize, T: Damping>(bra: &GvrFunction<D>, ket: &GvrFunct
     let w = &v[0];
     let mut e = quadratic(&bra.cast(), ket, go, &outer(&ket.u, &(bra.a * w).map(re))) * -2.0;
     if bra.k > 0 {
-        let k = bra.k as f64;
-        let lower = GvrFunction::new(bra.a, bra.u, bra.k - 1, bra.c_a, go, 0).expect("K − 1 of a checked function");
-        let x = bra.u.dot(&bra.a.cholesky().expect("a checked exponent").solve(&bra.u)) * 0.25;
-        let ratio = 1.0 / (x * ((4.0 * k + 1.0) * (4.0 * k - 1.0)).sqrt());
-        e += quadratic(&lower.cast(), ket, go, &outer(&ket.u, &bra.u.map(re))) * (2.0 * k * w.dot(&bra.u) * ratio);
+        let (lower, ratio) = lowered(bra, go);
+        e += quadratic(&lower.cast(), ket, go, &outer(&ket.u, &bra.u.map(re))) * (2.0 * bra.k as f64 * w.dot(&bra.u) * ratio);
+    }
+    e / norm(ket, go)
+}
+
+/// The bra's function of power `K_I − 1` and the ratio of its norm to the bra's,
+/// `1/(x_I √((4K_I+1)(4K_I−1)))` (module docs); `bra.k > 0`.
+fn lowered<const D: usize>(bra: &GvrFunction<D>, go: &GvrOps<D>) -> (GvrFunction<D>, f64) {
+    let k = bra.k as f64;
+    let lower = GvrFunction::new(bra.a, bra.u, bra.k - 1, bra.c_a, go, 0).expect("K − 1 of a checked function");
+    let x = bra.u.dot(&bra.a.cholesky().expect("a checked exponent").solve(&bra.u)) * 0.25;
+    (lower, 1.0 / (x * ((4.0 * k + 1.0) * (4.0 * k - 1.0)).sqrt()))
+}
+
+/// `<1‖∇_w' V‖0>_IJ`, `v = [w']`, `V` the context's Coulomb potential (module docs); `bra` and
+/// `ket` as for `dipole`.
+pub fn acceleration<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
+    let (w, u) = (&v[0], &ket.u);
+    let plain = <EcgGvr as Family<D>>::element(bra, ket, go).v;
+    let (_, coupled) = damped(bra, ket, go, &outer(u, &((bra.a + ket.a) * w)));
+    let mut e = 2.0 * coupled - plain * ((3 + 2 * ket.k) as f64 * w.dot(u));
+    if bra.k > 0 {
+        let (lower, ratio) = lowered(bra, go);
+        e -= damped(&lower, ket, go, &outer(u, &bra.u)).1 * (2.0 * bra.k as f64 * w.dot(&bra.u) * ratio);
     }
     e / norm(ket, go)
 }
