@@ -19,8 +19,8 @@ Sum rules (closure over the levels of N = 1, exact eigenstates):
     A = Σ_n s_n = ⟨J'²⟩,
     D = ½⟨[J', [H, J']]⟩ = −2π Σ_{a<b} q_a q_b (w'_a − w'_b)² ⟨δ³(r_ab)⟩,
 
-the latter from [H, J'] = i Σ_i w'_i ∇_i V and ∇_i·∇_j(1/r_ab) = (δ_ia − δ_ib)(δ_ja − δ_jb) ∇²(1/r_ab),
-∇²(1/r) = −4πδ³(r): Σ_ij w'_i w'_j ∇_i·∇_j V = −4π Σ_{a<b} q_a q_b (w'_a − w'_b)² δ³(r_ab). Pairs
+the latter from [H, J'] = i Σ_i w'_i ∇_i V, ∇_i·∇_j(1/r_ab) = (δ_ia − δ_ib)(δ_ja − δ_jb) ∇²(1/r_ab)
+and ∇²(1/r) = −4πδ³(r): Σ_ij w'_i w'_j ∇_i·∇_j V = −4π Σ_{a<b} q_a q_b (w'_a − w'_b)² δ³(r_ab). Pairs
 of one charge-to-mass ratio (two electrons) drop out. Hydrogen (μ = m_p/(1 + m_p)):
 w'_e − w'_p = −1/μ, ⟨δ³⟩ = μ³/(πn³), so D = 2μ/n³; A = ⟨p²⟩/μ² = 1/n².
 
@@ -37,15 +37,15 @@ them, ln k₀ = Σ s_nΔE_n ln(|ΔE_n|/R)/Σ s_nΔE_n, is the basis's own value 
 of N = 1 at or below the level (ΔE_n ≤ 0: He 2¹P below 3¹S; hydrogen's 2p, degenerate with 2s) are
 counted with ln |ΔE_n|, their term zero at ΔE_n = 0.
 
-The integral representation (Schwartz 1961; Korobov 2012, eqs. for the velocity gauge). For
-ΔE > 0, ∫_0^∞ dk [1/(R + k) − 1/(ΔE + k)] = ln(ΔE/R), so
+The integral representation (the method of Schwartz 1961, carried to the velocity gauge and a
+general few-body system by Korobov 2012; of these papers only the abstracts and introductions were
+read here, and every formula below is derived here). For ΔE > 0, ∫_0^∞ dk [1/(R + k) − 1/(ΔE + k)] = ln(ΔE/R), so
 
     Σ_{ΔE_n>0} s_n ΔE_n ln(ΔE_n/R) = ∫_0^∞ dk [D₊/(R + k) − g(k)],
     g(k) = Σ_{ΔE_n>0} s_n ΔE_n/(ΔE_n + k) = A₊ − k f(k),   f(k) = ⟨J'(H − E₀ + k)⁻¹J'⟩₊,
 
 with D₊ = D − Σ_{ΔE_n≤0} s_nΔE_n and A₊ the sums over the levels above; the levels at or below
-are added as their terms, so no pole of f lies on the path (the principal value of Drake &
-Goldman's treatment is not needed). f(k) is minus the minimum of Hylleraas' functional
+are added as their terms, so no pole of f lies on the path of k. f(k) is minus the minimum of Hylleraas' functional
 ⟨ψ₁|H − E₀ + k|ψ₁⟩ + 2⟨ψ₁|J'⟩ over the N = 1 basis with the reduced elements r (response.py
 `FirstOrder.hylleraas(−k)`; −3 × the minimum with J'_z's elements r/√3): the dipole response at
 ω = −k. g is evaluated from the pseudostates as the sum above, not as A₊ − k f(k), which loses
@@ -59,30 +59,33 @@ The cusp's |r_ab| makes the distribution of p_ab fall as 8 μ_ab² (q_a q_b)² �
 Fourier transform of r is −8π/p⁴); with the free resolvent (k + p²/2μ_ab)⁻¹ the pseudostates'
 strength per unit ΔE falls as (C/π) ΔE^(−5/2) (C below, summed over the pairs), and the first
 Coulomb correction of the pair's high-energy continuum multiplies it by 1 + πμ_ab q_a q_b/p
-(the 1/p term of the exact hydrogen photoeffect cross section, σ ∝ p⁻⁷(1 − πZ/p), scaled to the
-pair's charges and reduced mass). D/k − g(k) = Σ_n s_n ΔE_n²/(k(ΔE_n + k)) then gives
+(the 1/p term of the exact hydrogen photoeffect cross section of Stobbe, σ ∝ p⁻⁷(1 − πZ/p),
+recalled, not read here, and scaled to the pair's charges and reduced mass; its consequence λ below
+is checked against hydrogen numerically). D/k − g(k) = Σ_n s_n ΔE_n²/(k(ΔE_n + k)) then gives
 
     g(k) = D₊/k − C k^(−3/2) + Σ_{a<b} λ_ab ln(k/μ_ab)/k² + b/k² + e k^(−5/2) + …,
     C = 4√2 π Σ_{a<b} √μ_ab (q_a q_b)² (w'_a − w'_b)² ⟨δ³(r_ab)⟩,
     λ_ab = −4π μ_ab (q_a q_b)³ (w'_a − w'_b)² ⟨δ³(r_ab)⟩,
 
-i.e. k f(k) = A − D/k + C k^(−3/2) − … . Hydrogen: C = 4√2 μ^(3/2)/n³, λ = 4μ²/n³; measured in
-even-tempered bases (tests/test_bethe.py) k^(3/2)(D/k − g) reaches C to 3e-3 at k = 1e6 Eh and the
-slope of k²[g − D/k + Ck^(−3/2)] against ln k reaches λ to 1e-2 at k = 1e5 Eh. C and λ are derived
-here pair by pair; three-body coalescences and the constant b are not. b and e (the next order)
+i.e. k f(k) = A − D/k + C k^(−3/2) − … . Hydrogen: C = 4√2 μ^(3/2)/n³, λ = 4μ²/n³; in
+even-tempered bases (tests/test_bethe.py) k^(3/2)(D/k − g) + λ ln(k/μ)/√k reaches C to 8e-4 at
+k = 1e6 Eh (the rest is b/√k) and the slope of k²[g − D/k + Ck^(−3/2)] against ln k reaches λ to
+7e-3 between 1e5 and 3e5 Eh (the rest is the k^(−5/2) term's). C and λ are derived pair by pair;
+what three-body coalescences add, and the constant b, are not derived. b and e (the next order)
 are fitted to the computed g on [K/`window`, K] ("fit"; hydrogen 1s: b ≈ −4.3).
 
 The integral is split at K: Gauss–Legendre panels in x = ln(1 + k/k₀) (k₀ the smaller of R and the
 lowest ΔE_n > 0; `PANEL` wide, `ORDER` points each, exact to ~1e-15 for each pseudostate's term,
 whose poles lie π off the real x axis) on [0, K], and on [K, ∞) the expansion in closed form,
 
-    ∫_K^∞ [D₊/(R + k) − g] dk = −D₊ ln(1 + R/K) + 2C/√K − Σ λ_ab (ln(K/μ_ab) + 1)/K − b/K − (2/3) e K^(−3/2).
+    ∫_K^∞ [D₊/(R + k) − g] dk = −D₊ ln(1 + R/K) + 2C/√K − Σ λ_ab (ln(K/μ_ab) + 1)/K
+                                − b/K − (2/3) e K^(−3/2).
 
 K must lie where the bases still resolve f (the ground basis's cusp and the N = 1 basis's
 functions at r ~ (2μk)^(−1/2)): by default 1e-5 of the smaller of the ground basis's largest
 diagonal kinetic energy and the N = 1 basis's largest ΔE_n (`SPLIT`). D is taken from ⟨δ³(r_ab)⟩,
 Drachmann's regularised value where `regularised` (drachmann.py; the direct one misses the cusp):
-its error enters ln k₀ as δD/D × (ln(K/R) − ln k₀), about 14 δD/D. With the basis's own D and A₊
+its error enters ln k₀ as (ln(K/R) − ln k₀) δD/D, 9 δD/D at K = 1e5 Eh in hydrogen. With the basis's own D and A₊
 (D_b = Σ s_nΔE_n) and K far above every ΔE_n, the integral is the pseudostate sum ("own": the
 check of the quadrature and of the treatment of the levels below). Not included: the
 relativistic and higher-order QED corrections to ln k₀, finite nuclear size, and the recoil
@@ -217,23 +220,23 @@ def panels(k0: float, K: float) -> tuple[np.ndarray, np.ndarray]:
     return k, (half * w).ravel() * (k0 + k)
 
 
-def integral(spectrum: Spectrum, pairs: Pairs | None, R: float, K: float, window: float) -> dict:
+def integral(sp: Spectrum, pairs: Pairs | None, R: float, K: float, window: float) -> dict:
     """Σ_{ΔE_n>0} s_nΔE_n ln(ΔE_n/R) by the integral representation split at K (module docstring):
     with `pairs` the level's D, C and λ and the fitted b, e on [K, ∞); without, the basis's own
     D₊ and no other term (K far above every ΔE_n). Returns {"numerator", "quadrature", "tail",
     "fit": {"b", "e", "share"}}, in Eh (the numerator of ln k₀)."""
-    s, de = spectrum.s, spectrum.de
-    up = spectrum.above
+    s, de = sp.s, sp.de
+    up = sp.above
     D_plus = (pairs.D if pairs else float(np.sum(s * de))) - float(np.sum(s[~up] * de[~up]))
     k0 = min(R, float(np.min(de[up])))
     k, w = panels(k0, K)
-    quadrature = float(w @ (D_plus / (R + k) - spectrum.g(k)))
+    quadrature = float(w @ (D_plus / (R + k) - sp.g(k)))
     tail = -D_plus * math.log1p(R / K)
     fit = {"b": 0.0, "e": 0.0, "share": 0.0}
     if pairs is not None:
         tail += 2 * pairs.C / math.sqrt(K) - float(np.sum(pairs.lam * (np.log(K / pairs.mu) + 1))) / K
         kk = np.geomspace(K / window, K, 24)
-        y = kk**2 * (spectrum.g(kk) - D_plus / kk + pairs.C * kk**-1.5) - pairs.log_term(kk)
+        y = kk**2 * (sp.g(kk) - D_plus / kk + pairs.C * kk**-1.5) - pairs.log_term(kk)
         (b, e), *_ = np.linalg.lstsq(np.c_[np.ones_like(kk), kk**-0.5], y, rcond=None)
         share = -(b / K + 2 / 3 * e * K**-1.5)
         fit = {"b": float(b), "e": float(e), "share": float(share)}
@@ -241,7 +244,7 @@ def integral(spectrum: Spectrum, pairs: Pairs | None, R: float, K: float, window
     return {"numerator": quadrature + tail, "quadrature": quadrature, "tail": tail, "fit": fit}
 
 
-def spectrum(ground: Basis, response: Basis, E0: float, c0: np.ndarray, threshold: float) -> Spectrum:
+def pseudostates(ground: Basis, response: Basis, E0: float, c0: np.ndarray, threshold: float) -> Spectrum:
     """The current's pseudostates of the level (E₀, its S-normalised vector c0 in `ground`) in the
     N = 1 basis `response` (laboratory frame, as response.py `first_order`)."""
     rep = laboratory(ground.system)
@@ -326,7 +329,7 @@ def bethe_logarithm(ground: Basis, response, root: int = 0, rydberg: float = R_I
     scale = float(np.max(np.diag(m["T_ti"]) / np.diag(m["S"])))
     rows = []
     for basis in responses:
-        sp = spectrum(ground, basis, E0, c0, threshold)
+        sp = pseudostates(ground, basis, E0, c0, threshold)
         split = K if K is not None else SPLIT * min(scale, float(np.max(sp.de)))
         lower = sp.lower(R)
         part = integral(sp, pairs, R, split, window)
