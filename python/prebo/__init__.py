@@ -10,7 +10,8 @@ The pipeline, one subpackage or module per stage (docs/architecture.md):
 - `prebo.level`: the results of a basis's levels: `evaluate`, their energies; `properties`, a
   level's energy, expectation values and their corrections; `densities`, the distance
   distributions of levels; `transitions`, the electric-dipole lines between two bases' levels; `polarisability`, a level's
-  dipole polarisability α(ω) from a basis of its first-order function;
+  dipole polarisability α(ω) from a basis of its first-order function; `bethe_logarithm`, its
+  Bethe logarithm ln k₀ from a basis of N = 1;
 - `prebo.system.thresholds`: the lowest dissociation threshold, below which a state is bound;
 - `prebo.io`: TOML inputs (`io.toml`) and ecgpack files (`io.ecgpack`);
 - `prebo.cli`, `prebo.plot`: the command line and convergence plots;
@@ -25,6 +26,7 @@ from .errors import PreboError
 from .optimise import Optimiser, optimise
 from .level.evaluate import evaluate
 from .level.properties import densities, properties
+from .level.bethe import bethe_logarithm
 from .level.response import polarisability
 from .level.transitions import transitions
 from .system import Particle, State, System, particle
@@ -36,6 +38,7 @@ __all__ = [
     "CoordinateSet", "jacobi", "heavy_particle_centred", "cm_centred", "all_sets",
     # basis, solving, results
     "Basis", "Optimiser", "optimise", "evaluate", "properties", "densities", "transitions", "polarisability",
+    "bethe_logarithm",
     "PreboError",
 ]
 from .provenance import VERSION as __version__  # noqa: E402 (the package metadata's)
