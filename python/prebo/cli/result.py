@@ -64,8 +64,10 @@ def print_result(r: dict) -> None:
         x = r["response"]
         t.add_row("Hylleraas functional J", f"{x['objective']:.12f} a.u. ({x['operator']} on root {x['root']}, "
                   f"E₀ = {x['energy']:.12f} Eh)")
-        t.add_row(f"polarisability α(ω = {x['omega'][0]:g} Eh)", f"{x['alpha'][0]:.12f} a₀³ (sum over states "
-                  f"{x['sum_over_states'][0]:.12f}; first pole {x['pole']:.6f} Eh)")
+        name, value, unit = (f"polarisability α(ω = {x['omega'][0]:g} Eh)", x["alpha"][0], "a₀³") if "alpha" in x \
+            else (f"⟨J'(H − E₀ − ω)⁻¹J'⟩ at ω = {x['omega'][0]:g} Eh", x["f"][0], "a.u.")
+        t.add_row(name, f"{value:.12f} {unit} (sum over states {x['sum_over_states'][0]:.12f}; first pole "
+                  f"{x['pole']:.6f} Eh)")
     if r.get("convergence"):
         c = r["convergence"]
         t.add_row("stopped", f"{STOPPED[c['stopped']]} after {c['seconds']:.1f} s")

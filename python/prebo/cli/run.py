@@ -155,11 +155,12 @@ def checkpoint_source(path: Path):
 
 def response(basis, source) -> dict:
     """result.json's `response`: the operator, the ground level (`root`, `energy`), the functional's
-    minimum the run reached (`objective`, Eh) and the dipole polarisability α(ω) (a₀³) at the
-    source's frequency that the run's basis gives (level/response.FirstOrder.at: the Hylleraas
-    value, the sum over its pseudostates and the first pole)."""
+    minimum the run reached (`objective`, Eh) and what the run's basis gives at the source's
+    frequency (level/response.FirstOrder, the Hylleraas value with the sum over its pseudostates
+    and the first pole): the dipole polarisability α(ω) (a₀³, `at`), or for the current
+    f(ω) = ⟨J'(H − E₀ − ω)⁻¹J'⟩ (`resolvent`)."""
     from ..level.response import first_order
 
-    order = first_order(source.ground, basis, source.root, source.threshold)
-    return {"operator": source.operator, "root": source.root, "objective": basis.convergence["objective"]} \
-        | order.at(source.omega)
+    order = first_order(source.ground, basis, source.root, source.threshold, source.operator)
+    value = order.at(source.omega) if source.operator == "dipole" else order.resolvent(source.omega)
+    return {"operator": source.operator, "root": source.root, "objective": basis.convergence["objective"]} | value

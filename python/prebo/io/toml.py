@@ -10,7 +10,8 @@
 
 With [response] the run optimises the first-order function of the level `root` of the stored
 basis `ground` (a basis.json, a run folder or an ecgpack file; relative to the input's folder) on
-Hylleraas' functional (optimise/response.py): [system] and [state] may be left out, and are then
+Hylleraas' functional (optimise/response.py) for the dipole, or for the current ("velocity", the
+Bethe logarithm's at omega = −k): [system] and [state] may be left out, and are then
 the ground basis's particles and the symmetry its dipole reaches (N + 1, the other parity, the
 same spins).
 

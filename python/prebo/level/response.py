@@ -44,6 +44,7 @@ class FirstOrder:
     S: np.ndarray
     C: np.ndarray
     de: np.ndarray
+    operator: str = "dipole"
 
     @property
     def pole(self) -> float:
@@ -58,23 +59,40 @@ class FirstOrder:
     def at(self, omega) -> dict:
         """α(ω) at the frequencies `omega` (Eh; a number or a list, each below the first pole), as
         `polarisability` returns it; InputError for ω not finite or at or above the pole."""
-        omegas = np.atleast_1d(np.asarray(omega, dtype=float))
-        if omegas.ndim != 1 or not np.all(np.isfinite(omegas)):
-            raise InputError(f"polarisability: omega = {omega!r}: must be finite frequencies (E_h)")
-        above = np.abs(omegas) >= self.pole
-        if np.any(above):
-            raise InputError(f"polarisability: omega = {omegas[above][0]:.6g} Eh is at or above the first pole "
-                             f"{self.pole:.6g} Eh (the response basis's lowest level of N = 1)")
+        omegas = self._frequencies(omega, np.abs)
         strengths = (self.C.T @ self.r) ** 2
         alpha = [-(self.hylleraas(x) + self.hylleraas(-x)) / 3 for x in omegas]
         sos = [float(np.sum(strengths * (1 / (self.de - x) + 1 / (self.de + x)))) / 3 for x in omegas]
         return {"alpha": alpha, "sum_over_states": sos, "omega": omegas.tolist(), "pole": self.pole,
                 "energy": self.E0, "hylleraas": self.hylleraas(0.0) / 3}
 
+    def resolvent(self, omega) -> dict:
+        """f(ω) = ⟨O(H − E₀ − ω)⁻¹O⟩ summed over the three components, −3 J at its minimum (for the
+        current, f at ω = −k is the Bethe logarithm's; level/bethe.py), at the frequencies `omega`
+        (Eh, each below the first pole), with the sum over states Σ_n S_n/(ΔE_n − ω) as a check."""
+        omegas = self._frequencies(omega, lambda x: x)
+        strengths = (self.C.T @ self.r) ** 2
+        return {"f": [-self.hylleraas(x) for x in omegas],
+                "sum_over_states": [float(np.sum(strengths / (self.de - x))) for x in omegas],
+                "omega": omegas.tolist(), "pole": self.pole, "energy": self.E0}
 
-def first_order(ground: Basis, response: Basis, root: int = 0, threshold: float = eigen.THRESHOLD) -> FirstOrder:
+    def _frequencies(self, omega, reach) -> np.ndarray:
+        """`omega` as a 1-d array; InputError unless each is finite and `reach(ω)` below the pole."""
+        omegas = np.atleast_1d(np.asarray(omega, dtype=float))
+        if omegas.ndim != 1 or not np.all(np.isfinite(omegas)):
+            raise InputError(f"{self.operator} response: omega = {omega!r}: must be finite frequencies (E_h)")
+        above = reach(omegas) >= self.pole
+        if np.any(above):
+            raise InputError(f"{self.operator} response: omega = {omegas[above][0]:.6g} Eh is at or above the first "
+                             f"pole {self.pole:.6g} Eh (the response basis's lowest level of N = 1)")
+        return omegas
+
+
+def first_order(ground: Basis, response: Basis, root: int = 0, threshold: float = eigen.THRESHOLD,
+                operator: str = "dipole") -> FirstOrder:
     """The `FirstOrder` problem of the level `root` of the N = 0 basis `ground` in the N = 1 basis
-    `response`. InputError for bases of different particles or spin states, a ground basis not of
+    `response`, for the dipole or its velocity form ∇_w' (`operator`; r their reduced elements).
+    InputError for bases of different particles or spin states, a ground basis not of
     N = 0, a response basis not of N = 1 and opposite parity, or one with a level below the ground
     level."""
     for b, what in ((ground, "ground"), (response, "response")):
@@ -92,8 +110,9 @@ def first_order(ground: Basis, response: Basis, root: int = 0, threshold: float 
     r0 = evaluate(ground, threshold=threshold, roots=root + 1, targets=[root])
     E0, c0 = float(r0["energy"]), r0["vectors"][:, 0]
     rep = laboratory(ground.system)
-    w, _ = dipole_vectors(ground.system)
-    r = rep.between("dipole", ground, response, w[None])[0].T @ c0
+    momentum = operator == "velocity"
+    w = dipole_vectors(ground.system)[momentum]
+    r = rep.between(operator, ground, response, w[None], momentum)[0].T @ c0
     m = rep.matrices(response)
     rep.require_resolved(m)
     H, S = m["T_ti"] + m["V"], m["S"]
@@ -101,7 +120,7 @@ def first_order(ground: Basis, response: Basis, root: int = 0, threshold: float 
     if states.energies[0] <= E0:
         raise InputError(f"polarisability: the response basis has a level {E0 - states.energies[0]:.6g} Eh below "
                          "the ground level")
-    return FirstOrder(E0, r, H, S, states.vectors, states.energies - E0)
+    return FirstOrder(E0, r, H, S, states.vectors, states.energies - E0, operator)
 
 
 def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,

@@ -42,10 +42,12 @@ from ..integrals import Representation
 from ..matrices import Matrices
 from .objective import BlockLevel, Level, Objective
 
-#: the operators a response objective can be driven by, and the factor of the reduced element
-#: that gives the source of the field's component along z: ⟨φ_J M=0|d_z|ψ₀⟩ = ⟨φ_J‖d‖ψ₀⟩/√3 for ψ₀
-#: of N = 0 (Edmonds; level/transitions.py)
-OPERATORS = {"dipole": 1.0 / np.sqrt(3.0)}
+#: the operators a response objective can be driven by: whether their vector is momentum-like, and
+#: the factor of the reduced element that gives the source of the component along z,
+#: ⟨φ_J M=0|O_z|ψ₀⟩ = ⟨φ_J‖O‖ψ₀⟩/√3 for ψ₀ of N = 0 (Edmonds; level/transitions.py): the dipole d
+#: (polarisabilities) and its velocity form ∇_w' (the current J' = −i∇_w' of the Bethe logarithm,
+#: whose f(k) = ⟨J'(H − E₀ + k)⁻¹J'⟩ is −3 J at ω = −k; level/bethe.py)
+OPERATORS = {"dipole": (False, 1.0 / np.sqrt(3.0)), "velocity": (True, 1.0 / np.sqrt(3.0))}
 
 
 @dataclass(frozen=True)
@@ -84,7 +86,7 @@ class Source:
         if isinstance(omega, bool) or not isinstance(omega, (int, float)) or not np.isfinite(omega):
             raise InputError(f"response: omega = {omega!r}: must be a finite frequency (Eh)")
         level = evaluate(ground, threshold=threshold, roots=root + 1, targets=[root])
-        w, _ = dipole_vectors(ground.system)
+        w = dipole_vectors(ground.system)[OPERATORS[operator][0]]
         return cls(ground, level["vectors"][:, 0], float(level["energy"]), operator, w, float(omega), root,
                    float(threshold))
 
@@ -121,14 +123,15 @@ class Source:
 
     def terms(self, rep: Representation, f: Basis) -> np.ndarray:
         """b_j = ⟨φ_j|V|ψ₀⟩ of the functions of `f` (normalised, symmetrised as `rep`'s)."""
-        r = rep.between(self.operator, self.ground, f, self.w[None])[0].T @ self.c0
-        return r * OPERATORS[self.operator]
+        momentum, factor = OPERATORS[self.operator]
+        return rep.between(self.operator, self.ground, f, self.w[None], momentum)[0].T @ self.c0 * factor
 
     def gradient(self, rep: Representation, f: Basis, dA: np.ndarray, dv: np.ndarray | None) -> np.ndarray:
         """b of the one-function basis `f` and its derivatives along the directions (dA, dv) of
         its parameters (Representation.row_gradient's): (1 + P,)."""
-        g = rep.between_gradient(self.operator, self.ground, f, dA, dv, self.w[None])[0]  # (1 + P, n0)
-        return (g @ self.c0) * OPERATORS[self.operator]
+        momentum, factor = OPERATORS[self.operator]
+        g = rep.between_gradient(self.operator, self.ground, f, dA, dv, self.w[None], momentum)[0]  # (1 + P, n0)
+        return (g @ self.c0) * factor
 
 
 @dataclass(frozen=True)
