@@ -264,14 +264,19 @@ mod tests {
 
     #[test]
     fn the_floating_term_matches_a_panelled_rule() {
-        // E(λ) = ∫_0^1 2τ² e^{−λτ²} (1 − e^{−λ(1 − τ²)})/(1 − τ²) dτ, 400 panels of 20 nodes
+        // E(λ) = ∫_0^1 2τ² e^{−λτ²} (1 − e^{−λ(1 − τ²)})/(1 − τ²) dτ, 400 panels of 20 nodes, whose
+        // rounding is the deviation measured here (up to 7.9e-15, at λ = 30): the series themselves
+        // were within 2.4e-16 of a 40-digit quadrature (mpmath) at λ = 5, 30, 49.9, 50.1, 120
+        let mut worst: f64 = 0.0;
         for lambda in [1e-6, 0.3, 5.0, 30.0, 49.9, 50.1, 120.0, 1e4] {
             let want = panels(&[0.0, 1.0], 1.0 / 400.0, |t| t.iter().map(|&t| {
                 let v = 1.0 - t * t;
                 2.0 * t * t * (-lambda * t * t).exp() * if v > 0.0 { -(-lambda * v).exp_m1() / v } else { lambda }
             }).collect());
             let got = floating(lambda);
+            worst = worst.max((got / want - 1.0).abs());
             assert!((got - want).abs() < 1e-14 * want, "λ = {lambda}: {got} vs {want} ({:.1e})", (got / want - 1.0).abs());
         }
+        println!("E(λ): largest relative deviation from the rule {worst:.1e}");
     }
 }
