@@ -85,8 +85,8 @@ class Engine:
         between normalised functions, one per instance of its vectors w (p, arity, n; (p, n) for
         arity 1), given in this representation like the Coulomb vectors ("r2": r_w² =
         |Σ_k w_k r_k|² in a_0², with w = e_i − e_j in the laboratory frame the squared distance
-        r_ij²). Symmetrised like S, which is exact for
-        operators that commute with the symmetry operations."""
+        r_ij²; "araki_sucher": the Araki–Sucher distribution P(1/r_w³) in a_0⁻³). Symmetrised
+        like S, which is exact for operators that commute with the symmetry operations."""
 
     def between(self, name: str, bra: Params, ket: Engine, ket_params: Params, v: ArrayLike) -> NDArray[np.float64]:
         """(p, nb_bra, nb_ket) matrices of the registered two-basis operator `name` between the

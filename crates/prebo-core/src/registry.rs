@@ -12,7 +12,7 @@ use crate::families::ecg_gvr::transition::{ACCELERATION, DIPOLE, QUADRUPOLE, VEL
 use crate::families::pecg::Pecg;
 use crate::families::Family;
 use crate::operators::drachmann::{self, coulomb, gradient};
-use crate::operators::{angular, delta, distance, inverse, inverse_square, momentum, orbit, overlap, r2, ElementFn, Elements, Specialised};
+use crate::operators::{angular, araki_sucher, delta, distance, inverse, inverse_square, momentum, orbit, overlap, r2, ElementFn, Elements, Specialised};
 
 /// An operator's element of one vector, as `Elements::Each` of arity 1.
 macro_rules! one_vector {
@@ -32,6 +32,7 @@ fn generic<const D: usize, F: Family<D>>() -> Vec<(&'static str, usize, Option<E
         (inverse::NAME, 1, Some(one_vector!(inverse::element::<D, F>))),
         (inverse_square::NAME, 1, Some(one_vector!(inverse_square::element::<D, F>))),
         (delta::NAME, 1, Some(one_vector!(delta::element::<D, F>))),
+        (araki_sucher::NAME, 1, Some(one_vector!(araki_sucher::element::<D, F>))),
         (momentum::P2, 1, Some(one_vector!(momentum::p2::<D, F>))),
         (momentum::P4, 1, Some(one_vector!(momentum::p4::<D, F>))),
         (momentum::P2P2, 2, Some(Each(momentum::p2p2::<D, F>))),

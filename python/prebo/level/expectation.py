@@ -138,6 +138,9 @@ OPERATORS: dict[str, Operator] = {
     "delta": Operator("delta", "bohr⁻³", "⟨δ³(r_ij)⟩, the density of particles i and j at one point "
                                          "(direct: converges slowly in Gaussians, which lack the cusp)",
                       contact=True),
+    "araki_sucher": Operator("araki_sucher", "bohr⁻³", "⟨P(1/r_ij³)⟩, the Araki–Sucher distribution "
+                                                     "lim_{a→0}[θ(r_ij − a)/r_ij³ + 4π(γ + ln a)δ³(r_ij)] of the α³ QED "
+                                                     "term (direct: Gaussians lack the cusp, like δ)"),
     "p2": Operator("p2", "ħ²/bohr²", "⟨p_i²⟩, particle i's mean square momentum in the centre-of-mass frame",
                    ("p_i",)),
     "p4": Operator("p4", "ħ⁴/bohr⁴", "⟨p_i⁴⟩, the mass–velocity term's −Σ⟨p_i⁴⟩/(8m_i³c²) per particle i",

@@ -2,8 +2,8 @@
 
 - `properties`: one level's energy, uncertainty, virial coefficient and whether it is bound, with
   the expectation value of every registered pair operator (`expectation.OPERATORS`: ⟨r_ij⟩,
-  ⟨r_ij²⟩, ⟨1/r_ij⟩, ⟨1/r_ij²⟩, ⟨δ³(r_ij)⟩) per class of equivalent pairs — what `prebo properties
-  BASIS --root k` prints and `prebo.properties(basis, root=k)` returns. ⟨δ³(r_ij)⟩ is the direct
+  ⟨r_ij²⟩, ⟨1/r_ij⟩, ⟨1/r_ij²⟩, ⟨δ³(r_ij)⟩, the Araki–Sucher ⟨P(1/r_ij³)⟩, ...) per class of
+  equivalent pairs — what `prebo properties BASIS --root k` prints and `prebo.properties(basis, root=k)` returns. ⟨δ³(r_ij)⟩ is the direct
   expectation value, which Gaussians, lacking the cusp, reach slowly (hydrogen 1s in 80
   even-tempered Gaussians: 1.8e-4 low, against 2e-11 for ⟨r⟩). With them, the level's
   Breit–Pauli correction (relativistic.py).

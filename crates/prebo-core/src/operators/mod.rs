@@ -15,6 +15,7 @@ use crate::ecg::Vector;
 use crate::families::Family;
 
 pub mod angular;
+pub mod araki_sucher;
 pub mod delta;
 pub mod density;
 pub mod distance;
