@@ -95,7 +95,7 @@ def test_left_out_and_bad_input():
 def test_of_level_gathers_bethe():
     # hydrogen 1s in test_bethe's even-tempered bases: ln k₀ there is Drake & Swainson's within 1e-7
     ground, response = hydrogen(0, GROUND), hydrogen(1, RESPONSE)
-    out = of_level(ground, response, {}, K=1e5)
+    out = of_level(ground, response, K=1e5)
     log = out["bethe"]
     assert log["rydberg"] == 0.5
     assert out["Eh"] == terms(ground.system, log["delta"], {}, log["ln_k0"])["Eh"]

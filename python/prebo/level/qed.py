@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import math
 
+from .. import eigen
 from ..errors import InputError
 from .bethe import R_INFINITY, bethe_logarithm
 from .evaluate import HARTREE_CM
@@ -119,12 +120,16 @@ def terms(system, delta: dict, araki_sucher: dict, ln_k0: float, rydberg: float 
             "ln_k0": ln_k0_inf, "alpha": alpha}
 
 
-def of_level(ground, response, araki_sucher: dict, root: int = 0, **bethe) -> dict:
+def of_level(ground, response, root: int = 0, **bethe) -> dict:
     """E⁽³⁾ of the level `root` of the N = 0 basis `ground`: ln k₀ and the ⟨δ³(r_ab)⟩ it used
     (Drachmann's regularised values where bethe.py takes them) from `bethe_logarithm(ground,
-    response, root, **bethe)` in R_∞, and ⟨P(1/r_ab³)⟩ per pair class given (`araki_sucher`: the
-    core's operator of that name is not yet on main). Returns `terms`' result with "bethe", the
-    Bethe logarithm's result."""
+    response, root, **bethe)` in R_∞, and ⟨P(1/r_ab³)⟩ per pair class from the core's operator
+    "araki_sucher" on the level (evaluate). Returns `terms`' result with "bethe", the Bethe
+    logarithm's result."""
+    from .evaluate import evaluate
+
     log = bethe_logarithm(ground, response, root=root, **({"rydberg": R_INFINITY} | bethe))
-    out = terms(ground.system, log["delta"], araki_sucher, log["ln_k0"], log["rydberg"])
+    level = evaluate(ground, threshold=bethe.get("threshold", eigen.THRESHOLD), roots=root + 1, targets=[root],
+                     operators=("araki_sucher",))
+    out = terms(ground.system, log["delta"], dict(level["expectation"]["araki_sucher"]), log["ln_k0"], log["rydberg"])
     return out | {"bethe": log}
