@@ -93,11 +93,12 @@ class Engine:
         normalised functions of the basis `bra` (this engine's family and N) and those of
         `ket_params` (`ket`'s family and N, symmetrised by `ket`'s operations), one per instance
         of its vectors v (p, arity, n), given in this representation: "overlap" (no vectors;
-        two bases of one N), and the electric dipole's reduced elements <1‖O‖0> between a bra of
-        N = 0 (plain or ECG-GVR) and an ECG-GVR ket of N = 1: "dipole", O = Σ_k w_k r_k (w like
-        the Coulomb vectors), "velocity", O = Σ_k w'_k ∇_k (w' momentum-like), "acceleration",
-        O = Σ_k w'_k ∇_k V (V the representation's Coulomb potential); and the quadrupole's
-        <2‖Q‖0> between N = 0 and N = 2 ("quadrupole", v the n columns of its matrix);
+        two bases of one N), and the electric dipole's reduced elements <L+1‖O‖L> between a bra
+        of N = L (plain or ECG-GVR) and an ECG-GVR ket of N = L + 1: "dipole", O = Σ_k w_k r_k
+        (w like the Coulomb vectors), "velocity", O = Σ_k w'_k ∇_k (w' momentum-like), every L,
+        and "acceleration", O = Σ_k w'_k ∇_k V (V the representation's Coulomb potential), L = 0;
+        and the quadrupole's <2‖Q‖0> between N = 0 and N = 2 ("quadrupole", v the n columns of
+        its matrix);
         crates/prebo-core/src/families/ecg_gvr/transition.rs."""
 
     def between_gradient(self, name: str, bra: Params, ket: Engine, ket_params: Params, dA: ArrayLike,
@@ -106,7 +107,7 @@ class Engine:
         along P directions of its parameters, dA (P, n, n) of A and du (P, n) of u, as
         `row_gradient`'s: (p, 1 + P, nb_bra), row 0 of each instance `between`'s column (its
         bits), row 1 + k the derivative along direction k. "dipole" and "velocity" between a plain
-        or ECG-GVR bra of N = 0 and the ket of N = 1; exact (dual numbers,
+        or ECG-GVR bra of N = L and the ket of N = L + 1; exact (dual numbers,
         crates/prebo-core/src/path.rs `between_gradient`). Laboratory frame."""
 
     def density(self, params: Params, w: ArrayLike, C: ArrayLike, r: ArrayLike) -> NDArray[np.float64]:

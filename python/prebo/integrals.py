@@ -131,8 +131,9 @@ class Representation:
         with `momentum`, momentum-like (`vectors`); for the quadrupole v is its symmetric (n, n)
         matrix M (level/transitions.py `quadrupole_matrix`), transformed on both sides (p = 1). The
         dipole's forms (O = d, ∇_w' and ∇_w' V, the last two with a momentum-like v) join a bra of
-        N = 0 to a ket of N = 1 and are reduced elements <1‖O‖0>, the
-        quadrupole's a bra of N = 0 to a ket of N = 2, <2‖Q‖0> (level/transitions.py). Each element
+        N = L to a ket of N = L + 1 (the acceleration form N = 0 to 1) and are reduced elements
+        <L+1‖O‖L>, the quadrupole's a bra of N = 0 to a ket of N = 2, <2‖Q‖0>
+        (level/transitions.py). Each element
         is that of the functions' internal parts (`centre_of_mass`)."""
         if name == "quadrupole":
             v = self.vectors(self.vectors(v).T)

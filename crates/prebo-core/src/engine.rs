@@ -206,7 +206,7 @@ fn operator_d<const D: usize, F: Specialised<D>>(e: &Engine, name: &str, basis: 
 }
 
 /// `between` for the family `F` of both bases (a contained family's columns as `F`'s,
-/// `as_family`), the context at the bra's N.
+/// `as_family`), the context at the N `registry::context_n` names.
 fn between_d<const D: usize, F: Specialised<D>>(
     e: &Engine,
     name: &str,
@@ -220,12 +220,13 @@ fn between_d<const D: usize, F: Specialised<D>>(
     let (bra, ket_p) = (F::params(&bra_columns)?, F::params(&ket_columns)?);
     let (ops, _) = e.rep.operators::<D>();
     let (_, ket_sym) = ket.rep.operators::<D>();
-    let full = F::context(ops, e.n_ang, &[&bra, &ket_p])?;
+    let n = registry::context_n(name, e.n_ang, ket.n_ang);
+    let full = F::context(ops, n, &[&bra, &ket_p])?;
     let ctx = if registry::coulomb_between(name) { full } else { F::kinetic_only(&full) };
     path::between::<D, F>(&ctx, &ket_sym, &bra, &ket_p, |x, y, ctx, v| elements.of(x, y, ctx, v), arity, v)
 }
 
-/// `between_gradient` for the family `F` of both bases (`as_family`), the context at the bra's N.
+/// `between_gradient` for the family `F` of both bases (`as_family`), the context as for `between_d`.
 fn between_gradient_d<const D: usize, F: Specialised<D>>(
     e: &Engine,
     name: &str,
@@ -243,7 +244,8 @@ where
     let (bra, ket_p) = (F::params(&bra_columns)?, F::params(&ket_columns)?);
     let (ops, _) = e.rep.operators::<D>();
     let (_, ket_sym) = ket.rep.operators::<D>();
-    let ctx = F::kinetic_only(&F::context(ops, e.n_ang, &[&bra, &ket_p])?);
+    let n = registry::context_n(name, e.n_ang, ket.n_ang);
+    let ctx = F::kinetic_only(&F::context(ops, n, &[&bra, &ket_p])?);
     let elements = |x: &F::Function<f64>, y: &F::Function<f64>, ctx: &F::Context, v: &[Vec<Vector<D>>]| elements.of(x, y, ctx, v);
     path::between_gradient::<D, F>(&ctx, &ket_sym, &bra, &ket_p, dir, elements, &Form::of(name)?, arity, v)
 }
@@ -327,9 +329,9 @@ impl Engine {
     /// The `p x nb_bra x nb_ket` matrices (row-major) of the registered two-basis operator `name`
     /// (`registry::lookup_between`) between the basis `bra` of this engine and the basis
     /// `ket_params` of `ket` (its family, N and symmetry: the kets are symmetrised by `ket`'s
-    /// operations), one per instance of its `arity` vectors `v` (`p x arity x n`). An operator of
-    /// rank k > 0 (`registry::rank`) joins a bra of N = 0 to a ket of N = k; the overlap two
-    /// bases of one N. The bra's operators (its representation) serve both.
+    /// operations), one per instance of its `arity` vectors `v` (`p x arity x n`), for the N it
+    /// joins (`registry::joins`: the dipole's forms N = L to N = L + 1, the quadrupole N = 0 to
+    /// N = 2, the overlap two bases of one N). The bra's operators (its representation) serve both.
     pub fn between(&self, name: &str, bra: &[Column], ket: &Engine, ket_params: &[Column], v: &[f64]) -> Result<Vec<f64>> {
         self.joins(name, ket)?;
         match (self.kind, ket.kind) {
@@ -364,20 +366,12 @@ impl Engine {
     }
 
     /// Whether this engine's bases meet those of `ket` under the two-basis operator `name`: the
-    /// same coordinates, and the N of each its rank joins (`registry::rank`).
+    /// same coordinates, and the N its elements join (`registry::joins`).
     fn joins(&self, name: &str, ket: &Engine) -> Result<()> {
         if ket.rep.n != self.rep.n {
             return Err(CoreError::ShapeMismatch(format!("a bra of {} coordinates and a ket of {}", self.rep.n, ket.rep.n)));
         }
-        let rank = registry::rank(name);
-        let wanted = if rank == 0 { (ket.n_ang, ket.n_ang) } else { (0, rank) };
-        if (self.n_ang, ket.n_ang) != wanted {
-            return Err(CoreError::Unsupported(format!(
-                "operator {name:?} between a bra of N = {} and a ket of N = {} (its elements join N = {} to N = {})",
-                self.n_ang, ket.n_ang, wanted.0, wanted.1
-            )));
-        }
-        Ok(())
+        registry::joins(name, self.n_ang, ket.n_ang)
     }
 
     /// The spherically averaged densities `<Ψ| ρ̄_w(r) |Ψ>` (operators/density.rs) of the states

@@ -62,13 +62,31 @@ pub fn coulomb_between(name: &str) -> bool {
     name == ACCELERATION
 }
 
-/// The rank of the two-basis operator `name`: its elements join a bra basis of N = 0 to a ket
-/// basis of N = rank (the dipole's, 1; the quadrupole's, 2), or, at rank 0, two bases of one N.
-pub fn rank(name: &str) -> u32 {
+/// Whether the two-basis operator `name` joins a bra basis of N = `bra` to a ket basis of
+/// N = `ket`: the overlap two bases of one N, the dipole's length and velocity forms N = L to
+/// N = L + 1 for every L, its acceleration form N = 0 to N = 1 and the quadrupole N = 0 to N = 2
+/// (derived there alone); else a line saying which N its elements join.
+pub fn joins(name: &str, bra: u32, ket: u32) -> Result<()> {
+    let (joined, reach) = match name {
+        DIPOLE | VELOCITY => (ket == bra + 1, "N = L to N = L + 1".to_string()),
+        ACCELERATION => ((bra, ket) == (0, 1), "N = 0 to N = 1; derived there alone".to_string()),
+        QUADRUPOLE => ((bra, ket) == (0, 2), "N = 0 to N = 2".to_string()),
+        _ => (bra == ket, format!("N = {ket} to N = {ket}")),
+    };
+    if joined {
+        return Ok(());
+    }
+    Err(CoreError::Unsupported(format!("operator {name:?} between a bra of N = {bra} and a ket of N = {ket} (its elements join {reach})")))
+}
+
+/// The N of the context the elements of the two-basis operator `name` read both bases' functions
+/// at (`path::between`): the ket's for the dipole's length and velocity forms (the bra raised to it,
+/// `transition`), else the bra's (the acceleration form's and the quadrupole's ket as its partner
+/// of N = 0).
+pub fn context_n(name: &str, bra: u32, ket: u32) -> u32 {
     match name {
-        DIPOLE | VELOCITY | ACCELERATION => 1,
-        QUADRUPOLE => 2,
-        _ => 0,
+        DIPOLE | VELOCITY => ket,
+        _ => bra,
     }
 }
 

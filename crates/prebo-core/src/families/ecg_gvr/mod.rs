@@ -12,9 +12,9 @@
 //!   function (eqs. 26–26c);
 //! - `drachmann`: `V/|r_w|` (eq. 38) from the Coulomb elements of damped functions as
 //!   rank-one updates of one factorisation;
-//! - `transition`: the dipole's reduced elements between bases of N = 0 and N = 1 (length and
-//!   velocity forms) from quadratic forms of N = 0 functions, the quadrupole's between N = 0 and
-//!   N = 2 from their second moments;
+//! - `transition`: the dipole's reduced elements between bases of N = L and N = L + 1 (length and
+//!   velocity forms) from overlaps of functions of N = L + 1, the quadrupole's between N = 0 and
+//!   N = 2 from second moments of N = 0 functions;
 //! - `operators`: the family's own operator elements (`momentum`, `drachmann`) for the registry;
 //! - `coulomb` (tests only): the closed form of the Coulomb τ-integral.
 use nalgebra::SMatrix;

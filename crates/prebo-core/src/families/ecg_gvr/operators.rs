@@ -1,7 +1,8 @@
 //! ECG-GVR's own operator elements (`operators::Specialised`): the momentum operators and the
 //! orbit–orbit operator from the overlap's generating function (eqs. 26–26c, `momentum`; `p_g²`
 //! the kinetic element with `Λ = g g^T`), and Drachmann's two elements with every damped element
-//! read off one factorisation (`drachmann`), and the dipole's three forms between bases of N = 0 and N = 1 and
+//! read off one factorisation (`drachmann`), and the dipole's three forms (length and velocity
+//! between bases of N = L and N = L + 1, acceleration between N = 0 and N = 1) and
 //! the quadrupole between N = 0 and N = 2 (`transition`, no generic element), where the generic elements assume a Gaussian's
 //! gradients or integrate over damped functions one by one.
 use super::element::{element, GvrFunction, GvrOps};

@@ -1,55 +1,78 @@
-//! Vector operators between a basis of N = 0 and one of N = 1: the electric dipole in length
-//! form, `d = Σ_k w_k r_k` with `w_k = q_k − Q m_k/m_tot` (the charges' dipole about the centre of
-//! mass; `Q`, `m_tot` the total charge and mass), and in velocity form, `Σ_k w'_k ∇_k` with
-//! `w'_k = q_k/m_k − Q/m_tot`; both vectors in the representation's coordinates (`w` like the
-//! Coulomb vectors, `w'` like a momentum). Their elements are reduced ones (Wigner–Eckart,
-//! Edmonds' convention `<N' M'|O_q|N M> = (−1)^{N'−M'} (N' 1 N; −M' q M) <N'‖O‖N>`), one per pair
-//! of a function of N = 0 (bra) and one of N = 1 (ket), each normalised:
+//! Vector operators between a basis of N = L and one of N = L + 1, for every L ≥ 0: the electric
+//! dipole in length form, `d = Σ_k w_k r_k` with `w_k = q_k − Q m_k/m_tot` (the charges' dipole
+//! about the centre of mass; `Q`, `m_tot` the total charge and mass), and in velocity form,
+//! `Σ_k w'_k ∇_k` with `w'_k = q_k/m_k − Q/m_tot`; both vectors in the representation's coordinates
+//! (`w` like the Coulomb vectors, `w'` like a momentum). Their elements are reduced ones
+//! (Wigner–Eckart, Edmonds' convention `<N' M'|O_q|N M> = (−1)^{N'−M'} (N' 1 N; −M' q M) <N'‖O‖N>`),
+//! one per pair of a function of N = L (bra, `φ_I`) and one of N = L + 1 (ket, `φ'_J`), each
+//! normalised. With `e = (1, i, 0)`, `v_+ = e·v` and `O_{+1} = −e·O/√2`, the stretched element
+//! (M = N on both sides) and `(L+1 1 L; −L−1 1 L) = (2L+3)^{−1/2}` give
 //!
 //! ```text
-//!     <1‖O‖0>_IJ = <p̂_J| v_J·O |φ̂_I> / <p̂_J| v_J² |p̂_J>^{1/2},
+//!     <L+1‖O‖L>_IJ = ((2L+3)/2)^{1/2} <φ̂'_J| e·O |φ̂_I>,
 //! ```
 //!
-//! where `p_J = |v|^{2K} exp(−r^T A r)`, `v_J = u^T r`, is the N = 0 partner of the ket
-//! `φ'_J = v_+ p_J` (ECG-GVR, M = N; a plain ECG is K = N = 0). Derivation (docs/transitions.md):
-//! `p_J φ_I` is invariant under rotations and reflections, so `∫ (v_J)_a O_b p_J φ_I =
-//! δ_ab ∫ v_J·O p_J φ_I / 3`; hence `<1 1|O_{+1}|0 0> = −(√2/3) <p_J|v_J·O|φ_I> / ‖φ'_J‖` with
-//! `‖φ'_J‖² = (2/3) <p_J|v_J²|p_J>`, and `<1‖O‖0> = √3 <1 1|O_{+1}|0 0>`; the overall sign,
-//! like an eigenvector's, is a convention (dropped here). For the length form `v_J·d` is the
-//! quadratic form `r^T (u_J w^T ⊗ I_3) r`; for the velocity form, with
-//! `φ_I = |v_I|^{2K_I} exp(−r^T A_I r)`,
+//! the overall sign, like an eigenvector's, a convention (dropped). Both functions are read as
+//! functions of N = L + 1 (the context is the ket's, `registry::context_n`). For the bra
+//! `φ_I = |v_I|^{2K} v_{I+}^L exp(−r^T A_I r)`, `v_I = u_I^T r`, and `d_+ = e·d = (w^T r)_+`,
 //!
 //! ```text
-//!     v_J·∇_w' φ_I = −2 (u_J^T r)·((A_I w')^T r) φ_I + 2 K_I (w'·u_I) (v_J·v_I) |v_I|^{2K_I−2} e^{−r^T A_I r},
+//!     v_{I+}^L d_+ = ∂_t (v_I + t d)_+^{L+1} / (L+1),   v_I + t d = (u_I + t w)^T r,
+//!     |v_I|^{2K} = |v_I + t d|^{2K} − 2K t |v_I|^{2K−2} (v_I·d) + O(t²),
 //! ```
 //!
-//! the second term a quadratic form against the function of power `K_I − 1`, whose norm is
-//! `x_I √((4K_I+1)(4K_I−1))` times smaller (`x_I = u_I^T A_I^{-1} u_I / 4`, the variance of each
-//! component of `v_I` under `|φ_I|²`'s Gaussian; `E|v|^{2p} = (2x)^p Γ(p+3/2)/Γ(3/2)`). Every
-//! quadratic form `<f| r^T (M ⊗ I_3) r |g>` is `−∂/∂α <f| g exp(−α r^T M r)>` at α = 0 (as `r2`).
+//! so `(L+1) d_+ φ_I = ∂_t χ_t − 2K (v_I·d) ψ_I` at t = 0, `χ_t` the function of N = L + 1, power K
+//! and global vector `u_I + t w` (a dual number in t), `ψ_I` that of power K − 1 and `u_I`: the
+//! t-derivative of an overlap, and a quadratic form `r^T (sym(u_I w^T) ⊗ I_3) r`, `−∂/∂α` of the
+//! overlap of `ψ_I exp(−α r^T (sym(u_I w^T) ⊗ I_3) r)` at α = 0 (`quadratic`). Their norms relative
+//! to `φ_I`'s are moments of the Gaussian vector `v_I` of component variance `x_I = u_I^T A_I^{-1} u_I / 4`
+//! (`E|v|^{2p} = (2x)^p Γ(p+3/2)/Γ(3/2)`, and `sin^{2q}θ` averages to `2^q q!/(2q+1)!!`):
+//!
+//! ```text
+//!     ‖χ_0‖²/‖φ_I‖² = 4 x_I (2K + L + 3/2)(L + 1)/(2L + 3),   ‖ψ_I‖²/‖φ_I‖² = (L + 1)/((2L + 3) x_I (2K + L + 1/2)).
+//! ```
+//!
+//! A bra of N = 0 and K = 0 (every plain ECG) has no `v_I`: `d_+ φ_I` is itself the function of
+//! N = 1 and global vector `w`, of norm `(2 x_w)^{1/2} ‖φ_I‖` (no derivative, nothing read of the
+//! bra's `u`). For the velocity form `e·∇_k v_{I+}^L = L u_{Ik} (e·e) v_{I+}^{L−1} = 0`, so only the
+//! gradients of the Gaussian and of `|v_I|^{2K}` remain:
+//!
+//! ```text
+//!     e·∇_w' φ_I = −2 ((A_I w')^T r)_+ φ_I + 2K (w'·u_I) ψ_I,
+//! ```
+//!
+//! the length form's with `w → A_I w'`, and an overlap.
 //!
 //! For exact states `<f‖∇_w'‖i> = −(E_f − E_i) <f‖d‖i>` (`[H, d] = −∇_w'`); the ratio of the two
 //! forms is the usual convergence diagnostic.
 //!
 //! The acceleration form, `∇_w' V` with `V = Σ_{a<b} q_a q_b / r_ab` the context's Coulomb
-//! potential: for exact states `<f‖∇_w' V‖i> = (E_f − E_i)² <f‖d‖i>` (`[H, [H, d]] = −[V, ∇_w'] =
-//! ∇_w' V`). Integrated by parts (the force's singularities are integrable), with
-//! `∇_w'·v_J = 3 (w'·u_J)` and `v_J·∇_w' p_J = (2 K_J (w'·u_J) − 2 (u_J^T r)·((A_J w')^T r)) p_J`,
+//! potential, between a basis of N = 0 and one of N = 1 alone: for exact states
+//! `<f‖∇_w' V‖i> = (E_f − E_i)² <f‖d‖i>` (`[H, [H, d]] = −[V, ∇_w'] = ∇_w' V`). It is read at the
+//! bra's N = 0, the ket `φ'_J = v_{J+} p_J` as its partner `p_J = |v_J|^{2K_J} exp(−r^T A_J r)`,
+//! `v_J = u_J^T r`: `p_J φ_I` is invariant under rotations and reflections, so
+//! `∫ (v_J)_a O_b p_J φ_I = δ_ab ∫ v_J·O p_J φ_I / 3`, and with `‖φ'_J‖² = (2/3) <p_J|v_J²|p_J>`
+//! the element above is `<1‖O‖0>_IJ = <p̂_J| v_J·O |φ̂_I> / <p̂_J| v_J² |p̂_J>^{1/2}`. Integrated by
+//! parts (the force's singularities are integrable), with `∇_w'·v_J = 3 (w'·u_J)` and
+//! `v_J·∇_w' p_J = (2 K_J (w'·u_J) − 2 (u_J^T r)·((A_J w')^T r)) p_J`,
 //!
 //! ```text
 //!     <p_J| v_J·∇_w' V |φ_I> = −(3 + 2K_J)(w'·u_J) <p_J|V|φ_I> + 2 <p_J| (u_J^T r)·(((A_I + A_J) w')^T r) V |φ_I>
 //!                              − 2 K_I (w'·u_I) <p_J| (v_J·v_I) V |v_I|^{2K_I−2} e^{−r^T A_I r}>,
 //! ```
 //!
-//! each quadratic form with `V` inside again `−∂/∂α` at α = 0, now of the Coulomb element of the
-//! damped pair (`damped`), and the last with the velocity form's norm ratio.
+//! each quadratic form with `V` inside `−∂/∂α` at α = 0 of the Coulomb element of the damped pair
+//! (`damped`), the last against the bra's function of power `K_I − 1` and N = 0, whose norm is
+//! `x_I √((4K_I+1)(4K_I−1))` times smaller.
 //!
 //! Derivatives along the ket's parameters (`Form`, `path::between_gradient`; docs/transitions.md):
-//! the ket of dual numbers carries them through its normalisation and `‖v_J p_J‖`, and each
-//! quadratic form, a derivative in α itself, through hyper-dual numbers (`Damping`).
+//! the ket of dual numbers carries them through its normalisation, and each t-derivative and
+//! quadratic form, a derivative itself, through hyper-dual numbers (`Damping`).
 //!
-//! The electric quadrupole about the centre of mass between a basis of N = 0 and one of N = 2,
-//! `Q_2q = Σ_k q_k |ρ_k|² C_2q(ρ̂_k)`, `ρ_k = r_k − R_CM = m_k^T r` (`m_k = e_k − m/m_tot`): its
+//! The electric quadrupole about the centre of mass, `Q_2q = Σ_k q_k |ρ_k|² C_2q(ρ̂_k)`,
+//! `ρ_k = r_k − R_CM = m_k^T r` (`m_k = e_k − m/m_tot`), between a basis of N = 0 and one of N = 2,
+//! read at the bra's N = 0: the ket `φ'_J = v_+² p_J` as its partner of N = 0,
+//! `p_J = |v|^{2K} exp(−r^T A_J r)`, `v = u_J^T r` (a plain ECG is K = N = 0). Its
 //! Cartesian tensor is `T = Σ_ij M_ij r_i r_j^T` with `M = Σ_k q_k m_k m_k^T` (`v`: the D columns
 //! of `M`, in the representation's coordinates on both sides, like the Coulomb vectors), and
 //!
@@ -84,7 +107,8 @@ pub const QUADRUPOLE: &str = "quadrupole";
 /// The acceleration form, `v = [w']`, with the Coulomb potential of the context.
 pub const ACCELERATION: &str = "acceleration";
 
-/// A scalar with one derivative more, along the damping α of `quadratic`'s overlap: `f64` →
+/// A scalar with one derivative more, along the damping α of `quadratic`'s overlap or the shift t
+/// of `raised`'s global vector: `f64` →
 /// `Dual<1>`; `Dual<W>` (W parameter directions θ_p) → the hyper-dual `HyperDualSVec64<W, 1>`,
 /// whose `ε_1 ε_2` part is `∂²/∂θ_p ∂α` (exact through `ecg::inverse_log_det`'s second order).
 pub trait Damping: Real {
@@ -124,7 +148,7 @@ impl<const W: usize> Damping for Dual<W> {
     }
 }
 
-/// `f` over the scalar of one derivative more (`Damping`), none of it along α.
+/// `f` over the scalar of one derivative more (`Damping`), none of it along α (or t).
 fn lift<const D: usize, T: Damping>(f: &GvrFunction<D, T>) -> GvrFunction<D, T::Damped> {
     GvrFunction { a: f.a.map(T::lift), u: f.u.map(T::lift), k: f.k, c_a: f.c_a, c_u: T::lift(f.c_u), log_norm: T::lift(f.log_norm) }
 }
@@ -150,46 +174,87 @@ fn outer<const D: usize, T: Real>(a: &SVector<T, D>, b: &SVector<T, D>) -> SMatr
     SMatrix::from_fn(|i, j| (a[i] * b[j] + a[j] * b[i]) * 0.5)
 }
 
-/// `<p̂_J| v_J² |p̂_J>^{1/2}` of the ket's partner.
-fn norm<const D: usize, T: Damping>(ket: &GvrFunction<D, T>, go: &GvrOps<D>) -> T {
+/// `u^T A^{-1} u / 4`: the variance of each Cartesian component of `u^T r` under `exp(−2 r^T A r)`.
+fn variance<const D: usize>(a: &Mat<D>, u: &Vector<D>) -> f64 {
+    u.dot(&a.cholesky().expect("a checked exponent").solve(u)) * 0.25
+}
+
+/// `ψ_I`, the bra's function of power K − 1 at the context's N = L + 1, and `‖ψ_I‖/‖φ_I‖` (module
+/// docs) for the bra's variance `x`; `bra.k > 0`.
+fn lowered<const D: usize>(bra: &GvrFunction<D>, go: &GvrOps<D>, x: f64) -> (GvrFunction<D>, f64) {
+    let (n, k) = (go.n_ang as f64, bra.k as f64);
+    let lower = GvrFunction::new(bra.a, bra.u, bra.k - 1, bra.c_a, go, 0).expect("K − 1 of a checked function");
+    (lower, (n / ((2.0 * n + 1.0) * x * (2.0 * k + n - 0.5))).sqrt())
+}
+
+/// `(L+1) <φ̂'_J| (w^T r)_+ φ_I> / ‖φ_I‖` of the bra `φ_I` of N = L (of variance `x`) and the ket of
+/// N = L + 1, the context's: `∂_t` of the overlap with `χ_t` less `2K` times the quadratic form
+/// against `ψ_I`, each with its norm relative to `φ_I`'s (module docs); for a bra of N = K = 0
+/// the overlap with the function of global vector `w`.
+fn raised<const D: usize, T: Damping>(bra: &GvrFunction<D>, ket: &GvrFunction<D, T>, go: &GvrOps<D>, w: &Vector<D>, x: f64) -> T {
+    let (n, k) = (go.n_ang as f64, bra.k as f64);
+    if bra.k == 0 && go.n_ang == 1 {
+        let x_w = variance(&bra.a, w);
+        if x_w == 0.0 {
+            return T::zero(); // w = 0 (a system of no dipole)
+        }
+        let g = GvrFunction::new(bra.a, *w, 0, bra.c_a, go, 0).expect("a checked exponent and w ≠ 0");
+        return <EcgGvr as Family<D>>::overlap(&g.cast(), ket, go) * (2.0 * x_w).sqrt();
+    }
+    let t = T::alpha();
+    let mut moved = lift(&bra.cast::<T>());
+    moved.u += w.map(|c| t * c);
+    moved.c_u = moved.u.sum();
+    let ratio = (4.0 * x * (2.0 * k + n + 0.5) * n / (2.0 * n + 1.0)).sqrt();
+    let mut e = T::slope(&<EcgGvr as Family<D>>::overlap(&moved, &lift(ket), go)) * ratio;
+    if bra.k > 0 {
+        let (lower, ratio) = lowered(bra, go, x);
+        e -= quadratic(&lower.cast(), ket, go, &outer(&bra.u, w).map(re)) * (2.0 * k * ratio);
+    }
+    e
+}
+
+/// `<L+1‖d‖L>_IJ`, `v = [w]` (module docs); `bra` of N = L, `ket` of N = L + 1, the context's N
+/// (of dual numbers for the derivatives along its parameters, `between_gradient`).
+pub fn dipole<const D: usize, T: Damping>(bra: &GvrFunction<D>, ket: &GvrFunction<D, T>, go: &GvrOps<D>, v: &[Vector<D>]) -> T {
+    let n = go.n_ang as f64;
+    raised(bra, ket, go, &v[0], variance(&bra.a, &bra.u)) * (((2.0 * n + 1.0) / 2.0).sqrt() / n)
+}
+
+/// `<L+1‖∇_w'‖L>_IJ`, `v = [w']` (module docs); `bra` and `ket` as for `dipole`.
+pub fn velocity<const D: usize, T: Damping>(bra: &GvrFunction<D>, ket: &GvrFunction<D, T>, go: &GvrOps<D>, v: &[Vector<D>]) -> T {
+    let (w, n, x) = (&v[0], go.n_ang as f64, variance(&bra.a, &bra.u));
+    let mut e = raised(bra, ket, go, &(bra.a * w), x) * (-2.0 / n);
+    if bra.k > 0 {
+        let (lower, ratio) = lowered(bra, go, x);
+        e += <EcgGvr as Family<D>>::overlap(&lower.cast(), ket, go) * (2.0 * bra.k as f64 * w.dot(&bra.u) * ratio);
+    }
+    e * ((2.0 * n + 1.0) / 2.0).sqrt()
+}
+
+/// `<p̂_J| v_J² |p̂_J>^{1/2}` of the ket's partner of N = 0.
+fn norm<const D: usize>(ket: &GvrFunction<D>, go: &GvrOps<D>) -> f64 {
     quadratic(ket, ket, go, &outer(&ket.u, &ket.u)).sqrt()
 }
 
-/// `<1‖d‖0>_IJ`, `v = [w]` (module docs); `bra` of N = 0, `ket` the partner of N = 1's function
-/// (of dual numbers for the derivatives along its parameters, `between_gradient`).
-pub fn dipole<const D: usize, T: Damping>(bra: &GvrFunction<D>, ket: &GvrFunction<D, T>, go: &GvrOps<D>, v: &[Vector<D>]) -> T {
-    quadratic(&bra.cast(), ket, go, &outer(&ket.u, &v[0].map(re))) / norm(ket, go)
-}
-
-/// `<1‖∇_w'‖0>_IJ`, `v = [w']` (module docs); `bra` and `ket` as for `dipole`.
-pub fn velocity<const D: usize, T: Damping>(bra: &GvrFunction<D>, ket: &GvrFunction<D, T>, go: &GvrOps<D>, v: &[Vector<D>]) -> T {
-    let w = &v[0];
-    let mut e = quadratic(&bra.cast(), ket, go, &outer(&ket.u, &(bra.a * w).map(re))) * -2.0;
-    if bra.k > 0 {
-        let (lower, ratio) = lowered(bra, go);
-        e += quadratic(&lower.cast(), ket, go, &outer(&ket.u, &bra.u.map(re))) * (2.0 * bra.k as f64 * w.dot(&bra.u) * ratio);
-    }
-    e / norm(ket, go)
-}
-
-/// The bra's function of power `K_I − 1` and the ratio of its norm to the bra's,
+/// The bra's function of power `K_I − 1` and the ratio of its norm to the bra's, both of N = 0,
 /// `1/(x_I √((4K_I+1)(4K_I−1)))` (module docs); `bra.k > 0`.
-fn lowered<const D: usize>(bra: &GvrFunction<D>, go: &GvrOps<D>) -> (GvrFunction<D>, f64) {
+fn lowered_partner<const D: usize>(bra: &GvrFunction<D>, go: &GvrOps<D>) -> (GvrFunction<D>, f64) {
     let k = bra.k as f64;
     let lower = GvrFunction::new(bra.a, bra.u, bra.k - 1, bra.c_a, go, 0).expect("K − 1 of a checked function");
-    let x = bra.u.dot(&bra.a.cholesky().expect("a checked exponent").solve(&bra.u)) * 0.25;
+    let x = variance(&bra.a, &bra.u);
     (lower, 1.0 / (x * ((4.0 * k + 1.0) * (4.0 * k - 1.0)).sqrt()))
 }
 
-/// `<1‖∇_w' V‖0>_IJ`, `v = [w']`, `V` the context's Coulomb potential (module docs); `bra` and
-/// `ket` as for `dipole`.
+/// `<1‖∇_w' V‖0>_IJ`, `v = [w']`, `V` the context's Coulomb potential (module docs); `bra` of
+/// N = 0, `ket` the partner of N = 1's function.
 pub fn acceleration<const D: usize>(bra: &GvrFunction<D>, ket: &GvrFunction<D>, go: &GvrOps<D>, v: &[Vector<D>]) -> f64 {
     let (w, u) = (&v[0], &ket.u);
     let plain = <EcgGvr as Family<D>>::element(bra, ket, go).v;
     let (_, coupled) = damped(bra, ket, go, &outer(u, &((bra.a + ket.a) * w)));
     let mut e = 2.0 * coupled - plain * ((3 + 2 * ket.k) as f64 * w.dot(u));
     if bra.k > 0 {
-        let (lower, ratio) = lowered(bra, go);
+        let (lower, ratio) = lowered_partner(bra, go);
         e -= damped(&lower, ket, go, &outer(u, &bra.u)).1 * (2.0 * bra.k as f64 * w.dot(&bra.u) * ratio);
     }
     e / norm(ket, go)
@@ -246,10 +311,14 @@ impl<const D: usize> KetElement<D, EcgGvr> for Form {
 
 #[cfg(test)]
 mod tests {
-    //! Against Gauss–Hermite quadrature of the Cartesian elements with the ket's M = 0 component
-    //! `v_z p_J` (`<1‖O‖0> = √3 <1 0|O_z|0 0>`, Edmonds), for two and three coordinates and K up
-    //! to 1: the length form exactly (a polynomial under the Gaussian weight), the velocity form
-    //! by a central difference of the bra along `w'` inside the quadrature.
+    //! Against Gauss–Hermite quadrature of the Cartesian elements of `O_z` with the ket's M = L
+    //! component `v_z v_+^L |v|^{2K} exp(−r^T A_J r)`, not the stretched one the elements are
+    //! derived from (`<L+1‖O‖L> = ((2L+3)(L+1))^{1/2} <L+1 L|O_z|L L>`, Edmonds), for two and three
+    //! coordinates, L up to 2 and K up to 1: the length form exactly (a polynomial under the
+    //! Gaussian weight), the velocity form by a central difference of the bra along `w'` inside the
+    //! quadrature.
+    use nalgebra::Complex;
+
     use super::*;
     use crate::ecg::{Mat, Operators};
     use crate::engine::{Engine, Kind, Representation};
@@ -263,19 +332,22 @@ mod tests {
         let rule = gauss_hermite::<M>();
         let l = b.cholesky().unwrap().l();
         let (back, det) = (l.transpose().try_inverse().unwrap(), l.diagonal().product().powi(2));
-        let mut index = vec![0; 3 * D];
+        // the M^D nodes of one component with their weights, shared by the three
+        let nodes: Vec<(Vector<D>, f64)> = (0..M.pow(D as u32))
+            .map(|i| {
+                let index: [usize; D] = std::array::from_fn(|d| i / M.pow(d as u32) % M);
+                (back * Vector::<D>::from_fn(|d, _| rule[index[d]].0), index.iter().map(|&k| rule[k].1).product())
+            })
+            .collect();
         let mut total = 0.0;
-        loop {
-            let r: [Vector<D>; 3] = std::array::from_fn(|c| back * Vector::<D>::from_fn(|i, _| rule[index[c * D + i]].0));
-            total += index.iter().map(|&k| rule[k].1).product::<f64>() * g(&r);
-            match index.iter().position(|&k| k + 1 < M) {
-                Some(d) => {
-                    index[d] += 1;
-                    index[..d].fill(0);
+        for (x, wx) in &nodes {
+            for (y, wy) in &nodes {
+                for (z, wz) in &nodes {
+                    total += wx * wy * wz * g(&[*x, *y, *z]);
                 }
-                None => return total * det.powf(-1.5),
             }
         }
+        total * det.powf(-1.5)
     }
 
     /// `|u^T r|^{2K}`.
@@ -294,43 +366,71 @@ mod tests {
             Self { bra: (exponent::<D>(seeds.0), u(seeds.0), ks.0), ket: (exponent::<D>(seeds.1), u(seeds.1 + 0.4), ks.1) }
         }
 
-        fn functions(&self) -> (GvrFunction<D>, GvrFunction<D>, GvrOps<D>) {
-            let go = GvrOps::new(Operators { lambda: Mat::<D>::identity() * 0.5, pairs: vec![], cm_mass: None }, 0, 2).unwrap();
+        /// The bra and the ket read at N = `n` (the dipole's, the ket's N; the quadrupole's, 0).
+        fn functions(&self, n: u32) -> (GvrFunction<D>, GvrFunction<D>, GvrOps<D>) {
+            let go = GvrOps::new(Operators { lambda: Mat::<D>::identity() * 0.5, pairs: vec![], cm_mass: None }, n, 2).unwrap();
             let f = |(a, u, k): (Mat<D>, Vector<D>, u32), i| GvrFunction::new(a, u, k, 1.0, &go, i).unwrap();
             (f(self.bra, 0), f(self.ket, 1), go)
         }
 
-        /// `√3 ∫ (v_z p_J)(r) φ_I(r + s) dr / (‖v_z p_J‖ ‖φ_I‖)`, `s = h w' ẑ` and `O_z` = `o(r)`.
-        fn cartesian<const M: usize>(&self, o: impl Fn(&[Vector<D>; 3]) -> f64, h: f64, w: &Vector<D>) -> f64 {
-            let ((ai, ui, ki), (aj, uj, kj)) = (self.bra, self.ket);
-            let shift = |r: &[Vector<D>; 3]| [r[0], r[1], r[2] + w * h];
-            let x = integrate::<D, M>(&(ai + aj), |r| {
+        /// The bra `φ_I = |v_I|^{2K_I} v_{I+}^L exp(−r^T A_I r)` of N = L without its Gaussian.
+        fn phi(&self, l: u32) -> impl Fn(&[Vector<D>; 3]) -> Complex<f64> {
+            let (_, u, k) = self.bra;
+            move |r: &[Vector<D>; 3]| Complex::new(u.dot(&r[0]), u.dot(&r[1])).powu(l) * power(&u, k, r)
+        }
+
+        /// The ket's M = L component `f = v_{Jz} v_{J+}^L |v_J|^{2K_J} exp(−r^T A_J r)` without its
+        /// Gaussian (`−f̂` is `L_−` of the stretched ket, normalised).
+        fn f(&self, l: u32) -> impl Fn(&[Vector<D>; 3]) -> Complex<f64> {
+            let (_, u, k) = self.ket;
+            move |r: &[Vector<D>; 3]| Complex::new(u.dot(&r[0]), u.dot(&r[1])).powu(l) * (u.dot(&r[2]) * power(&u, k, r))
+        }
+
+        /// `∫ f^* O_z φ_I(r + s) dr` (`f`, `phi`), `O_z` = `o(r)`, `s = h w' ẑ`.
+        fn moment<const M: usize>(&self, l: u32, o: impl Fn(&[Vector<D>; 3]) -> f64, h: f64, w: &Vector<D>) -> f64 {
+            let ((ai, ..), (aj, ..)) = (self.bra, self.ket);
+            let (phi, f) = (self.phi(l), self.f(l));
+            integrate::<D, M>(&(ai + aj), |r| {
                 let decay = (-2.0 * h * (ai * w).dot(&r[2]) - h * h * w.dot(&(ai * w))).exp();
-                uj.dot(&r[2]) * power(&uj, kj, r) * o(r) * power(&ui, ki, &shift(r)) * decay
-            });
-            let nj = integrate::<D, M>(&(aj * 2.0), |r| (uj.dot(&r[2]) * power(&uj, kj, r)).powi(2));
-            let ni = integrate::<D, M>(&(ai * 2.0), |r| power(&ui, ki, r).powi(2));
-            3f64.sqrt() * x / (nj * ni).sqrt()
+                (f(r).conj() * phi(&[r[0], r[1], r[2] + w * h])).re * o(r) * decay
+            })
+        }
+
+        /// `‖f‖ ‖φ_I‖ / ((2L+3)(L+1))^{1/2}`: `<L+1‖O‖L> = moment / scale`, Edmonds' theorem with
+        /// `(L+1 1 L; −L 0 L) = −((2L+3)(L+1))^{−1/2}`.
+        fn scale<const M: usize>(&self, l: u32) -> f64 {
+            let ((ai, ..), (aj, ..)) = (self.bra, self.ket);
+            let (phi, f) = (self.phi(l), self.f(l));
+            let norms = integrate::<D, M>(&(aj * 2.0), |r| f(r).norm_sqr()) * integrate::<D, M>(&(ai * 2.0), |r| phi(r).norm_sqr());
+            (norms / ((2 * l + 3) * (l + 1)) as f64).sqrt()
+        }
+
+        /// The length form's `<L+1‖O‖L>` of `O_z` = `o(r)`.
+        fn cartesian<const M: usize>(&self, l: u32, o: impl Fn(&[Vector<D>; 3]) -> f64, w: &Vector<D>) -> f64 {
+            self.moment::<M>(l, o, 0.0, w) / self.scale::<M>(l)
         }
     }
 
-    fn length<const D: usize>(seeds: (f64, f64), ks: (u32, u32)) {
+    /// `<L+1‖d‖L>` of a pair against `cartesian` with `M` nodes (exact for degree < 2M).
+    fn length<const D: usize, const M: usize>(l: u32, seeds: (f64, f64), ks: (u32, u32)) {
         let pair = Pair::<D>::new(seeds, ks);
-        let (bra, ket, go) = pair.functions();
+        let (bra, ket, go) = pair.functions(l + 1);
         let w = Vector::<D>::from_fn(|i, _| [1.0, -2.0, 0.5][i % 3]);
         let got = dipole(&bra, &ket, &go, &[w]);
-        let want = pair.cartesian::<4>(|r| w.dot(&r[2]), 0.0, &w);
-        assert!((got - want).abs() <= 1e-11 * want.abs(), "{ks:?}: {got} vs {want}");
+        let want = pair.cartesian::<M>(l, |r| w.dot(&r[2]), &w);
+        assert!((got - want).abs() <= 1e-11 * want.abs(), "D={D} L={l} K={ks:?}: {got} vs {want}");
     }
 
     #[test]
     fn the_length_form_matches_quadrature_for_two_and_three_coordinates() {
         for ks in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-            length::<2>((0.3, 1.7), ks);
+            length::<2, 4>(0, (0.3, 1.7), ks);
+            length::<2, 5>(1, (0.3, 1.7), ks);
+            length::<2, 6>(2, (0.3, 1.7), ks);
         }
-        for ks in [(0, 0), (1, 1)] {
-            length::<3>((0.9, 2.4), ks);
-        }
+        length::<3, 4>(0, (0.9, 2.4), (1, 1));
+        length::<3, 4>(1, (0.9, 2.4), (1, 0));
+        length::<3, 4>(2, (0.9, 2.4), (0, 0));
     }
 
     /// `P_12`: the first two coordinates swapped.
@@ -338,9 +438,9 @@ mod tests {
         Mat::<D>::from_fn(|i, j| f64::from(match i { 0 => j == 1, 1 => j == 0, _ => i == j }))
     }
 
-    /// Engines of `D` coordinates (no Coulomb pairs): the bra's of family `bra` and N = 0, the
-    /// ket's of ECG-GVR and N = `n` with two images, `(1 − P_12)/2`.
-    fn engines<const D: usize>(bra: Kind, n: u32) -> (Engine, Engine) {
+    /// Engines of `D` coordinates (no Coulomb pairs): the bra's of family `bra` and N = `ns.0`, the
+    /// ket's of ECG-GVR and N = `ns.1` with two images, `(1 − P_12)/2`.
+    fn engines<const D: usize>(bra: Kind, ns: (u32, u32)) -> (Engine, Engine) {
         let swap = swap::<D>();
         let rep = |sym: Vec<(Mat<D>, f64)>| Representation {
             n: D,
@@ -351,8 +451,8 @@ mod tests {
             sym_c: sym.iter().map(|(_, c)| *c).collect(),
             cm_mass: None,
         };
-        let bra = Engine::new(bra, rep(vec![(Mat::<D>::identity(), 1.0)]), 0).unwrap();
-        let ket = Engine::new(Kind::EcgGvr, rep(vec![(Mat::<D>::identity(), 0.5), (swap, -0.5)]), n).unwrap();
+        let bra = Engine::new(bra, rep(vec![(Mat::<D>::identity(), 1.0)]), ns.0).unwrap();
+        let ket = Engine::new(Kind::EcgGvr, rep(vec![(Mat::<D>::identity(), 0.5), (swap, -0.5)]), ns.1).unwrap();
         (bra, ket)
     }
 
@@ -371,17 +471,18 @@ mod tests {
         }
     }
 
-    /// `between_gradient` of a one-function ket against a bra basis of three functions (K_I = `ks.0`,
-    /// the ket's K_J = `ks.1`) along `p` random directions: row 0 has `between`'s bits, rows 1.. its
-    /// derivatives by a fourth-order central difference of `between` (step 1e-3).
-    fn derivatives<const D: usize>(bra_kind: Kind, ks: (u32, u32), p: usize, seed: u64) {
+    /// `between_gradient` of a one-function ket of N = L + 1 against a bra basis of three functions
+    /// of N = L (K_I = `ks.0`, the ket's K_J = `ks.1`) along `p` random directions: row 0 has
+    /// `between`'s bits, rows 1.. its derivatives by a fourth-order central difference of
+    /// `between` (step 1e-3).
+    fn derivatives<const D: usize>(bra_kind: Kind, l: u32, ks: (u32, u32), p: usize, seed: u64) {
         let mut rng = Rng(seed);
         let u = |rng: &mut Rng| Vector::<D>::from_fn(|_, _| rng.signed());
         let bras: Vec<_> = (0..3).map(|i| (exponent::<D>(0.4 + 0.9 * i as f64), u(&mut rng), ks.0)).collect();
         let (a, uj) = (exponent::<D>(2.3) * 0.7, u(&mut rng));
         let da: Vec<Mat<D>> = (0..p).map(|_| Mat::<D>::from_fn(|_, _| rng.signed() * 0.3)).map(|m| m + m.transpose()).collect();
         let du: Vec<Vector<D>> = (0..p).map(|_| u(&mut rng)).collect();
-        let (bra_engine, ket_engine) = engines::<D>(bra_kind, 1);
+        let (bra_engine, ket_engine) = engines::<D>(bra_kind, (l, l + 1));
         let bra = columns(bra_kind, &bras);
         let w = Vector::<D>::from_fn(|i, _| [1.0, -2.0, 0.5][i % 3]);
         let flat = |m: &[Mat<D>]| m.iter().flat_map(|m| m.transpose().as_slice().to_vec()).collect::<Vec<_>>();
@@ -405,7 +506,7 @@ mod tests {
                 for i in 0..3 {
                     let want = (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h);
                     let d = got[(1 + k) * 3 + i];
-                    assert!((d - want).abs() <= 1e-8 * want.abs().max(1e-2), "{name} D={D} K={ks:?} direction {k}, bra {i}: {d} vs {want}");
+                    assert!((d - want).abs() <= 1e-8 * want.abs().max(1e-2), "{name} D={D} L={l} K={ks:?} direction {k}, bra {i}: {d} vs {want}");
                 }
             }
         }
@@ -416,25 +517,64 @@ mod tests {
         for bra in [Kind::Pecg, Kind::EcgGvr] {
             for kj in [0, 1] {
                 let ki = if bra == Kind::Pecg { 0 } else { 1 };
-                derivatives::<2>(bra, (ki, kj), 4, 7 + kj as u64);
-                derivatives::<3>(bra, (ki, kj), 5, 11 + kj as u64);
+                derivatives::<2>(bra, 0, (ki, kj), 4, 7 + kj as u64);
+                derivatives::<3>(bra, 0, (ki, kj), 5, 11 + kj as u64);
             }
         }
-        derivatives::<3>(Kind::EcgGvr, (0, 1), 18, 5); // two chunks of directions
+        derivatives::<3>(Kind::EcgGvr, 0, (0, 1), 18, 5); // two chunks of directions
+        derivatives::<2>(Kind::EcgGvr, 1, (0, 1), 4, 13);
+        derivatives::<3>(Kind::EcgGvr, 1, (1, 0), 5, 17);
+        derivatives::<2>(Kind::EcgGvr, 2, (1, 1), 4, 19);
     }
 
     #[test]
     fn the_velocity_form_matches_a_central_difference_of_the_bra() {
-        for ks in [(0, 0), (1, 0), (2, 1)] {
+        for (l, ks) in [(0, (0, 0)), (0, (1, 0)), (0, (2, 1)), (1, (0, 1)), (1, (1, 0)), (2, (1, 1))] {
             let pair = Pair::<2>::new((0.6, 1.9), ks);
-            let (bra, ket, go) = pair.functions();
+            let (bra, ket, go) = pair.functions(l + 1);
             let w = Vector::<2>::new(0.7, -1.1);
             let got = velocity(&bra, &ket, &go, &[w]);
             let h = 1e-2;
-            let at = |s: f64| pair.cartesian::<7>(|_| 1.0, s * h, &w);
-            let want = (8.0 * (at(1.0) - at(-1.0)) - (at(2.0) - at(-2.0))) / (12.0 * h);
-            assert!((got - want).abs() <= 1e-7 * want.abs(), "{ks:?}: {got} vs {want}");
+            let at = |s: f64| pair.moment::<7>(l, |_| 1.0, s * h, &w);
+            let want = (8.0 * (at(1.0) - at(-1.0)) - (at(2.0) - at(-2.0))) / (12.0 * h) / pair.scale::<7>(l);
+            assert!((got - want).abs() <= 1e-7 * want.abs(), "L={l} K={ks:?}: {got} vs {want}");
         }
+    }
+
+    /// `Engine::between`'s dipole between a bra basis of N = L (family `kind`, K_I = `ks.0`, two
+    /// functions) and a ket of N = L + 1, against the quadrature (`G` nodes) of each bra with the
+    /// ket and its image under `P_12`, `(1 − P_12)/2`.
+    fn symmetrised_dipole<const D: usize, const G: usize>(kind: Kind, l: u32, ks: (u32, u32)) {
+        let pairs = [Pair::<D>::new((0.6, 1.9), ks), Pair::<D>::new((1.4, 1.9), ks)];
+        let (bra_engine, ket_engine) = engines::<D>(kind, (l, l + 1));
+        let bra = columns(kind, &pairs.iter().map(|p| p.bra).collect::<Vec<_>>());
+        let ket = columns(Kind::EcgGvr, &[pairs[0].ket]);
+        let w = Vector::<D>::from_fn(|i, _| [0.8, -1.5, 0.3][i % 3]);
+        let got = bra_engine.between(DIPOLE, &bra, &ket_engine, &ket, w.as_slice()).unwrap();
+        let p = swap::<D>();
+        for (i, pair) in pairs.iter().enumerate() {
+            let (aj, uj, kj) = pair.ket;
+            let image = Pair { bra: pair.bra, ket: (p.transpose() * aj * p, p.transpose() * uj, kj) };
+            let z = |r: &[Vector<D>; 3]| w.dot(&r[2]);
+            let want = 0.5 * (pair.cartesian::<G>(l, z, &w) - image.cartesian::<G>(l, z, &w));
+            assert!((got[i] - want).abs() <= 1e-11 * want.abs(), "D={D} {kind:?} L={l} {ks:?} bra {i}: {} vs {want}", got[i]);
+        }
+    }
+
+    #[test]
+    fn the_symmetrised_dipole_joins_n_to_n_plus_one() {
+        symmetrised_dipole::<2, 4>(Kind::Pecg, 0, (0, 1));
+        symmetrised_dipole::<2, 4>(Kind::EcgGvr, 1, (1, 0));
+        symmetrised_dipole::<3, 3>(Kind::EcgGvr, 1, (0, 0));
+        let one = columns(Kind::EcgGvr, &[Pair::<2>::new((0.6, 1.9), (0, 0)).bra]);
+        for (ns, name) in [((1, 1), DIPOLE), ((0, 2), VELOCITY), ((2, 1), DIPOLE)] {
+            let (bra, ket) = engines::<2>(Kind::EcgGvr, ns);
+            let err = bra.between(name, &one, &ket, &one, &[0.0; 2]).unwrap_err().to_string();
+            assert!(err.contains(&format!("N = {} and a ket of N = {}", ns.0, ns.1)) && err.contains("join N = L to N = L + 1"), "{err}");
+        }
+        let (bra, ket) = engines::<2>(Kind::EcgGvr, (1, 2));
+        let err = bra.between(ACCELERATION, &one, &ket, &one, &[0.0; 2]).unwrap_err().to_string();
+        assert!(err.contains("N = 1 and a ket of N = 2") && err.contains("join N = 0 to N = 1; derived there alone"), "{err}");
     }
 
     /// `Σ_c r_c^T M r_c` and `r_z^T M r_z`.
@@ -470,7 +610,7 @@ mod tests {
     #[test]
     fn second_moments_match_quadrature() {
         let pair = Pair::<3>::new((0.9, 2.4), (1, 1));
-        let (bra, ket, go) = pair.functions();
+        let (bra, ket, go) = pair.functions(0);
         let ((ai, ui, ki), (aj, uj, kj)) = (pair.bra, pair.ket);
         let (m1, m2) = (quadrupole_matrix::<3>(), outer(&uj, &Vector::<3>::new(0.3, -1.0, 0.7)));
         let got = second(&bra, &ket, &go, &m1, &m2);
@@ -483,7 +623,7 @@ mod tests {
 
     fn quadrupole_pair<const D: usize>(seeds: (f64, f64), ks: (u32, u32)) {
         let pair = Pair::<D>::new(seeds, ks);
-        let (bra, ket, go) = pair.functions();
+        let (bra, ket, go) = pair.functions(0);
         let m = quadrupole_matrix::<D>();
         let got = quadrupole(&bra, &ket, &go, &m.column_iter().map(|c| c.into_owned()).collect::<Vec<_>>());
         let want = pair.quadrupole::<5>(&m);
@@ -505,7 +645,7 @@ mod tests {
     /// `(1 − P_12)/2`.
     fn symmetrised<const D: usize, const G: usize>(kind: Kind, ks: (u32, u32)) {
         let pairs = [Pair::<D>::new((0.6, 1.9), ks), Pair::<D>::new((1.4, 1.9), ks)];
-        let (bra_engine, ket_engine) = engines::<D>(kind, 2);
+        let (bra_engine, ket_engine) = engines::<D>(kind, (0, 2));
         let bra = columns(kind, &pairs.iter().map(|p| p.bra).collect::<Vec<_>>());
         let ket = columns(Kind::EcgGvr, &[pairs[0].ket]);
         let m = quadrupole_matrix::<D>();
@@ -526,7 +666,7 @@ mod tests {
             symmetrised::<3, 3>(kind, (0, 0));
         }
         symmetrised::<2, 5>(Kind::EcgGvr, (1, 1));
-        let (bra_engine, ket_engine) = engines::<2>(Kind::EcgGvr, 1);
+        let (bra_engine, ket_engine) = engines::<2>(Kind::EcgGvr, (0, 1));
         let one = columns(Kind::EcgGvr, &[Pair::<2>::new((0.6, 1.9), (0, 0)).bra]);
         let err = bra_engine.between(QUADRUPOLE, &one, &ket_engine, &one, &[0.0; 4]).unwrap_err().to_string();
         assert!(err.contains("N = 0 and a ket of N = 1") && err.contains("N = 0 to N = 2"), "{err}");
