@@ -8,13 +8,14 @@ Conventions (hartree atomic units; constants CODATA 2018, E. Tiesinga et al., Re
   every particle's charge counted (for a charged system the dipole about the CM, which moves with
   the system and does not depend on the origin);
 - the reduced moment <N'‖d‖N> of Edmonds' Wigner–Eckart theorem,
-  <N' M'|d_q|N M> = (−1)^{N'−M'} (N' 1 N; −M' q M) <N'‖d‖N>, in e a_0, from the level of N = 1 to
-  the level of N = 0 (its sign, like an eigenvector's, is arbitrary); in velocity form
-  −<1‖∇_w'‖0>/(E_1 − E_0) with w' = q/m − Q/m_tot, equal to the length form for exact levels
+  <N' M'|d_q|N M> = (−1)^{N'−M'} (N' 1 N; −M' q M) <N'‖d‖N>, in e a_0, from the level of N = L + 1
+  to the level of N = L (its sign, like an eigenvector's, is arbitrary); in velocity form
+  −<L+1‖∇_w'‖L>/(E_{L+1} − E_L) with w' = q/m − Q/m_tot, equal to the length form for exact levels
   ([H, d] = −Σ_k (q_k/m_k) ∇_k, the CM part dropping out), so their ratio measures convergence;
   in acceleration form <1‖∇_w' V‖0>/(E_1 − E_0)² ([H, [H, d]] = ∇_w' V, V the Coulomb potential),
-  which weighs the particles' coalescences, where Gaussians are weakest;
-- the line strength S = |<1‖d‖0>|² (e² a_0², summed over both levels' M);
+  which weighs the particles' coalescences, where Gaussians are weakest (derived for N = 0 ↔ 1;
+  None for the lines of higher N);
+- the line strength S = |<L+1‖d‖L>|² (e² a_0², summed over both levels' M);
 - the absorption oscillator strength f = (2/3) ΔE S / (2N_l + 1), N_l the lower level's;
 - the Einstein coefficient A = (4/3) α³ ΔE³ S / (2N_u + 1) (E_h/ħ), given in s⁻¹;
 - the quadrupole about the centre of mass, Q_2q = Σ_k q_k |ρ_k|² C_2q(ρ̂_k), ρ_k = r_k − R_CM, and
@@ -28,7 +29,8 @@ Conventions (hartree atomic units; constants CODATA 2018, E. Tiesinga et al., Re
 The two bases are of the same particles and one spin state; an electric-dipole line joins levels
 of N and N ± 1 of opposite parity (not 0 and 0), an electric-quadrupole line levels of N and
 N' ≤ N + 2 of the same parity with N + N' ≥ 2. The elements (crates/prebo-core, registry
-"dipole", "velocity", "acceleration" and "quadrupole") are derived for N = 0 ↔ 1 and N = 0 ↔ 2.
+"dipole", "velocity", "acceleration" and "quadrupole") are derived for N = L ↔ L + 1 (every L;
+the acceleration form N = 0 ↔ 1) and N = 0 ↔ 2.
 """
 from __future__ import annotations
 
@@ -106,14 +108,14 @@ def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: f
     conventions of the module docstring; `roots`, how many levels of each (K, or (K_lower, K_upper)).
 
     Returns {"levels": [{basis (0: lower, 1: upper), root, N, parity, energy}], "lines": [{lower,
-    upper (indices into levels, by energy), Eh, cm-1, length, velocity, acceleration,
-    velocity/length, acceleration/length, line_strength, oscillator_strength, einstein_A (s⁻¹)}
-    for a dipole line, {lower, upper, Eh,
-    cm-1, quadrupole, line_strength, einstein_A} for a quadrupole line, or, for a forbidden pair,
-    {lower, upper, Eh, cm-1, forbidden: why}], "lifetimes": [{level, lifetime (s), lines}]}.
+    upper (indices into levels, by energy), Eh, cm-1, length, velocity, acceleration (None but for
+    N = 0 ↔ 1), velocity/length, acceleration/length, line_strength, oscillator_strength,
+    einstein_A (s⁻¹)} for a dipole line, {lower, upper, Eh, cm-1, quadrupole, line_strength,
+    einstein_A} for a quadrupole line, or, for a forbidden pair, {lower, upper, Eh, cm-1,
+    forbidden: why}], "lifetimes": [{level, lifetime (s), lines}]}.
     InputError for bases of different particles, of one symmetry, or of floating ECGs (no definite
-    N); UnsupportedError for an allowed pair the elements are not derived for (dipole lines but
-    N = 0 ↔ 1, quadrupole lines but N = 0 ↔ 2)."""
+    N); UnsupportedError for an allowed pair the elements are not derived for (dipole lines of one N,
+    quadrupole lines but N = 0 ↔ 2)."""
     bases = (lower, upper)
     for b in bases:
         if not isinstance(b, Basis) or len(b) == 0:
@@ -155,11 +157,11 @@ def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: f
                     "einstein_A": ALPHA ** 5 * de ** 5 * q * q / 15 / (2 * levels[hi]["N"] + 1) / AU_TIME,
                 })
                 continue
-            d_l, d_v, d_a = (x[a["root"], b["root"]] for x in (length, velocity, acceleration))
+            d_l, d_v, d_a = (None if x is None else x[a["root"], b["root"]] for x in (length, velocity, acceleration))
             S = d_l * d_l
             lines.append(line | {
-                "length": d_l, "velocity": d_v, "acceleration": d_a,
-                "velocity/length": d_v / d_l if d_l else None, "acceleration/length": d_a / d_l if d_l else None,
+                "length": d_l, "velocity": d_v, "acceleration": d_a, "velocity/length": d_v / d_l if d_l else None,
+                "acceleration/length": d_a / d_l if d_l and d_a is not None else None,
                 "line_strength": S,
                 "oscillator_strength": 2 / 3 * de * S / (2 * levels[lo]["N"] + 1),
                 "einstein_A": 4 / 3 * ALPHA ** 3 * de ** 3 * S / (2 * levels[hi]["N"] + 1) / AU_TIME,
@@ -167,26 +169,29 @@ def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: f
     return {"levels": levels, "lines": lines, "lifetimes": _lifetimes(lines)}
 
 
-def _reduced(bases, vectors, energies, coordinates: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """<1‖d‖0> between every level of the N = 0 basis (rows) and of the N = 1 one (columns), in
-    length, velocity and acceleration form, rows and columns in the order of `bases`' levels."""
-    flip = bases[0].N != 0
-    zero, one = (1, 0) if flip else (0, 1)
-    if {bases[zero].N, bases[one].N} != {0, 1}:
-        raise UnsupportedError(f"dipole elements between N = {bases[zero].N} and N = {bases[one].N}: derived for "
-                               "N = 0 ↔ 1 only")
-    system = bases[zero].system
+def _reduced(bases, vectors, energies, coordinates: str) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """<L+1‖d‖L> between every level of the basis of N = L and of the one of N = L + 1, in length,
+    velocity and (for L = 0) acceleration form (None for L ≥ 1), rows the levels of `bases[0]`,
+    columns those of `bases[1]`, in their order."""
+    flip = bases[0].N > bases[1].N
+    low, high = (1, 0) if flip else (0, 1)
+    if bases[high].N != bases[low].N + 1:
+        raise UnsupportedError(f"dipole elements between two bases of N = {bases[low].N} (opposite parities): derived "
+                               "for N = L ↔ L + 1 only")
+    system = bases[low].system
     rep = laboratory(system) if coordinates == "lab" else translationally_invariant(system)
     w, w_v = dipole_vectors(system)
-    L = rep.between("dipole", bases[zero], bases[one], w[None])[0]
-    V, F = (rep.between(name, bases[zero], bases[one], w_v[None], momentum=True)[0] for name in ("velocity", "acceleration"))
-    c0, c1 = vectors[zero], vectors[one]
+    L = rep.between("dipole", bases[low], bases[high], w[None])[0]
+    V = rep.between("velocity", bases[low], bases[high], w_v[None], momentum=True)[0]
+    F = rep.between("acceleration", bases[low], bases[high], w_v[None], momentum=True)[0] if bases[low].N == 0 else None
+    c0, c1 = vectors[low], vectors[high]
     length = c0.T @ L @ c1
-    de = np.subtract.outer(energies[one], energies[zero]).T  # E_1 − E_0, rows the N = 0 levels
+    de = np.subtract.outer(energies[high], energies[low]).T  # E_{L+1} − E_L, rows the levels of N = L
     with np.errstate(divide="ignore", invalid="ignore"):
-        velocity, acceleration = -(c0.T @ V @ c1) / de, (c0.T @ F @ c1) / de ** 2
+        velocity = -(c0.T @ V @ c1) / de
+        acceleration = None if F is None else (c0.T @ F @ c1) / de ** 2
     forms = (length, velocity, acceleration)
-    return tuple(x.T for x in forms) if flip else forms
+    return tuple(None if x is None else x.T for x in forms) if flip else forms
 
 
 def _quadrupole(bases, vectors, coordinates: str) -> np.ndarray:
