@@ -51,6 +51,30 @@ def test_hydrogen_1s_2p_matches_the_closed_forms_with_the_reduced_mass(lines):
     assert [lv["N"] for lv in lines["levels"]] == [0, 1]
 
 
+def test_hydrogen_2p_3d_matches_the_closed_forms_with_the_reduced_mass():
+    # ⟨R_32|r|R_21⟩ = ∫ R_32 R_21 r³ dr = 2¹¹ 3⁴ / 5^{13/2} a_0 at infinite mass (R_21 = r e^{−r/2}/(2√6),
+    # R_32 = 4 r² e^{−r/3}/(81√30), ∫ r⁶ e^{−5r/6} dr = 6! (6/5)⁷), ⟨2‖C_1‖1⟩ = √2 (Edmonds: (−1)^l'
+    # ((2l'+1)(2l+1))^{1/2} (l' 1 l; 0 0 0)); lengths scale as 1/μ, energies as μ; d = −(r_e − r_p)
+    # 60 even-tempered Gaussians from 5e-4 (EXPONENTS leave 3d 6e-11 Eh high and the moment 1.9e-9 off)
+    fine = 5e-4 * 1.4 ** np.arange(60)
+    mu = prebo.System(["p", "e"]).masses.prod() / prebo.System(["p", "e"]).m_total
+    R = 2 ** 0.5 * 2 ** 11 * 3 ** 4 / 5 ** 6.5 / mu
+    de = 5 * mu / 72
+    r = transitions(hydrogen(1, fine), hydrogen(2, fine), roots=1)
+    (line,) = r["lines"]
+    assert abs(line["Eh"] - de) < 1e-13
+    assert abs(abs(line["length"]) - R) < 1e-12 * R
+    assert abs(line["velocity"] - line["length"]) < 1e-12 * R
+    assert abs(line["line_strength"] - R * R) < 2e-12 * R * R
+    assert abs(line["oscillator_strength"] - 2 / 3 * de * R * R / 3) < 1e-11
+    want_A = 4 / 3 * ALPHA ** 3 * de ** 3 * R * R / 5 / AU_TIME
+    assert abs(line["einstein_A"] - want_A) < 1e-11 * want_A
+    assert line["acceleration"] is None and line["acceleration/length"] is None
+    assert [lv["N"] for lv in r["levels"]] == [1, 2]
+    (flipped,) = transitions(hydrogen(2, fine), hydrogen(1, fine), roots=1)["lines"]
+    assert flipped["length"] == line["length"] and flipped["velocity"] == line["velocity"]
+
+
 def test_the_thomas_reiche_kuhn_sum_over_pseudostates_is_one_over_mu():
     # Σ_n f_0n = Σ_k q_k²/m_k − Q²/m_tot = 1/m_e + 1/m_p: the N = 1 basis holds d ψ_0 exactly
     lower, upper = hydrogen(0), hydrogen(1)
@@ -68,6 +92,35 @@ def test_laboratory_and_translationally_invariant_elements_agree():
         lab = laboratory(lower.system).between(name, lower, upper, v[None], momentum)[0]
         ti = translationally_invariant(lower.system).between(name, lower, upper, v[None], momentum)[0]
         assert np.max(np.abs(lab - ti)) < 1e-11 * np.max(np.abs(lab))
+
+
+def test_laboratory_and_translationally_invariant_elements_agree_between_n_1_and_2():
+    # hydrogen p–d, and p p e: random ECG-GVR functions (K ∈ {0, 1}) of N = 1 and N = 2 at one c_A and
+    # c_U = 0, the kets symmetrised over the protons' images
+    from test_operators import family_basis
+
+    rng = np.random.default_rng(7)
+    ppe = prebo.System(["p", "p", "e"], N=1, parity=-1)
+    pairs = [(hydrogen(1, EXPONENTS[:6]), hydrogen(2, EXPONENTS[2:9])),
+             (family_basis("ecg-gvr", ppe, rng, nb=4, shared_c_A=0.9, cm_free=True),
+              family_basis("ecg-gvr", prebo.System(["p", "p", "e"], N=2, parity=1), rng, nb=3, shared_c_A=0.9,
+                           cm_free=True))]
+    for lower, upper in pairs:
+        w, w_v = dipole_vectors(lower.system)
+        for name, v, momentum in [("dipole", w, False), ("velocity", w_v, True)]:
+            lab = laboratory(lower.system).between(name, lower, upper, v[None], momentum)[0]
+            ti = translationally_invariant(lower.system).between(name, lower, upper, v[None], momentum)[0]
+            assert np.max(np.abs(lab - ti)) < 1e-11 * np.max(np.abs(lab)) and np.min(np.abs(lab)) > 0, name
+
+
+def test_the_core_refuses_the_pairs_of_n_it_has_not_derived():
+    p, d = hydrogen(1, EXPONENTS[::8]), hydrogen(2, EXPONENTS[::8])
+    w, w_v = dipole_vectors(p.system)
+    rep = laboratory(p.system)
+    with pytest.raises(UnsupportedError, match=r"between a bra of N = 1 and a ket of N = 1 .*join N = L to N = L \+ 1"):
+        rep.between("dipole", p, p, w[None])
+    with pytest.raises(UnsupportedError, match=r"join N = 0 to N = 1; derived there alone"):
+        rep.between("acceleration", p, d, w_v[None], momentum=True)
 
 
 def test_bases_of_different_cm_exponents_give_the_internal_elements():
@@ -172,11 +225,12 @@ def test_ecgpack_he_samples_give_the_elements_its_readme_prints():
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
-    """basis.json files of hydrogen 1s and 2p (8 functions), H 2p with a deuteron, and a floating ECG basis."""
+    """basis.json files of hydrogen 1s, 2p and 3d (8 functions), H 2p with a deuteron, and a floating ECG basis."""
     d = tmp_path_factory.mktemp("lines")
     few = EXPONENTS[::5]
     hydrogen(0, few).save(d / "s.json")
     hydrogen(1, few).save(d / "p.json")
+    hydrogen(2, few).save(d / "d.json")
     hydrogen(1, few, nucleus="d").save(d / "dp.json")
     s = hydrogen(0, few)
     prebo.Basis(s.system, s.A, s.c_A, kind="fecg", s=np.zeros((len(s), 2, 3))).save(d / "f.json")
@@ -195,6 +249,18 @@ def test_the_command_prints_every_line_and_its_json(files, capsys):
     assert main(["transitions", str(files / "s.json"), str(files / "p.json"), "--roots", "2", "3"]) == 0
     out = capsys.readouterr().out
     assert out.count("(N=0+) →") + out.count("(N=1−) →") == 6 and "radiative lifetimes" in out
+
+
+def test_the_command_prints_the_lines_between_n_1_and_2(files, capsys):
+    from prebo.cli import main
+
+    assert main(["transitions", str(files / "d.json"), str(files / "p.json"), "--json"]) == 0
+    r = __import__("json").loads(capsys.readouterr().out)
+    assert r == transitions(prebo.Basis.load(files / "d.json"), prebo.Basis.load(files / "p.json"))
+    assert [lv["N"] for lv in r["levels"]] == [2, 1] and r["lines"][0]["acceleration"] is None
+    assert main(["transitions", str(files / "p.json"), str(files / "d.json"), "--roots", "2", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "electric-dipole lines" in out and out.count("(N=1−) →") + out.count("(N=2+) →") == 4
 
 
 @pytest.mark.parametrize("args, words", [

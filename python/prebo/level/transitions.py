@@ -172,12 +172,9 @@ def transitions(lower: Basis, upper: Basis, roots: int | tuple = 1, threshold: f
 def _reduced(bases, vectors, energies, coordinates: str) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """<L+1‖d‖L> between every level of the basis of N = L and of the one of N = L + 1, in length,
     velocity and (for L = 0) acceleration form (None for L ≥ 1), rows the levels of `bases[0]`,
-    columns those of `bases[1]`, in their order."""
+    columns those of `bases[1]`, in their order; the core refuses bases of one N (UnsupportedError)."""
     flip = bases[0].N > bases[1].N
     low, high = (1, 0) if flip else (0, 1)
-    if bases[high].N != bases[low].N + 1:
-        raise UnsupportedError(f"dipole elements between two bases of N = {bases[low].N} (opposite parities): derived "
-                               "for N = L ↔ L + 1 only")
     system = bases[low].system
     rep = laboratory(system) if coordinates == "lab" else translationally_invariant(system)
     w, w_v = dipole_vectors(system)
