@@ -86,7 +86,7 @@
 //! `(3/2) Σ_k q_k (v·ρ_k)² − (1/2) v² Σ_k q_k ρ_k²`; the norm `‖|v|² C_2M(v̂) p_J‖² =
 //! <p_J|v⁴|p_J>/5` likewise. Each product of two quadratic forms is `∂²/∂α∂β` of the overlap of
 //! `φ_I` and `p_J exp(−α r^T M_1 r − β r^T M_2 r)` at 0, exact with a hyper-dual number (`second`),
-//! `D + 2` overlaps per pair. Length form only (`quadrupole`, registered of rank 2).
+//! `D + 2` overlaps per pair. Length form only (`quadrupole`, joining N = 0 to N = 2, `registry::joins`).
 use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, HyperDualSVec64};
 
