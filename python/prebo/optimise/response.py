@@ -50,6 +50,13 @@ from .objective import BlockLevel, Level, Objective
 OPERATORS = {"dipole": (False, 1.0 / np.sqrt(3.0)), "velocity": (True, 1.0 / np.sqrt(3.0))}
 
 
+def contract(M: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """M c, each row summed alone along its contiguous copy: the same bits for a row whatever rows
+    come with it (BLAS's M @ c blocks by the shape, so a trial's source term would depend on its
+    batch, and a resumed run would leave the whole run's trajectory)."""
+    return (np.ascontiguousarray(M) * c).sum(axis=1)
+
+
 @dataclass(frozen=True)
 class Source:
     """The level a perturbation acts on: the basis `ground` of its symmetry, its S-normalised
@@ -124,14 +131,14 @@ class Source:
     def terms(self, rep: Representation, f: Basis) -> np.ndarray:
         """b_j = ⟨φ_j|V|ψ₀⟩ of the functions of `f` (normalised, symmetrised as `rep`'s)."""
         momentum, factor = OPERATORS[self.operator]
-        return rep.between(self.operator, self.ground, f, self.w[None], momentum)[0].T @ self.c0 * factor
+        return contract(rep.between(self.operator, self.ground, f, self.w[None], momentum)[0].T, self.c0) * factor
 
     def gradient(self, rep: Representation, f: Basis, dA: np.ndarray, dv: np.ndarray | None) -> np.ndarray:
         """b of the one-function basis `f` and its derivatives along the directions (dA, dv) of
         its parameters (Representation.row_gradient's): (1 + P,)."""
         momentum, factor = OPERATORS[self.operator]
         g = rep.between_gradient(self.operator, self.ground, f, dA, dv, self.w[None], momentum)[0]  # (1 + P, n0)
-        return (g @ self.c0) * factor
+        return contract(g, self.c0) * factor
 
 
 @dataclass(frozen=True)
