@@ -187,9 +187,12 @@ def h_input(**optimiser) -> dict:
 
 
 def cli_error(capsys, *argv) -> str:
-    """Run `prebo ARGV` in-process; assert exit 2 and exactly one `prebo: error:` line on stderr;
-    return that line."""
-    rc = main([str(a) for a in argv])
+    """Run `prebo ARGV` in-process; assert exit 2 (returned, or argparse's SystemExit) and exactly one
+    `prebo: error:` line on stderr; return that line."""
+    try:
+        rc = main([str(a) for a in argv])
+    except SystemExit as exc:  # argparse's refusals
+        rc = exc.code
     out, err = capsys.readouterr()
     assert rc == 2, (rc, out, err)
     assert err.startswith("prebo: error: ") and err.count("\n") == 1 and "Traceback" not in err, err

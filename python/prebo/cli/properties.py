@@ -9,6 +9,7 @@ from ..errors import NonFiniteError, PreboError
 from ..level.expectation import OPERATORS
 from .arguments import fraction, natural
 from ..io.load import load_basis
+from .qed import add_arguments, check, print_qed, qed
 from .result import bound
 from .tables import show
 
@@ -25,20 +26,25 @@ def add(sub) -> None:
     p.add_argument("--regularised", action="store_true",
                    help="the regularised δ and p⁴ (and the Breit–Pauli correction from them) also where they are "
                         "slower (floating ECGs, ECG-GVR: H2 with 500 ECG-GVR functions 55 s against 26 s); plain ECGs always have them")
+    add_arguments(p)
     p.add_argument("--json", action="store_true", help="print the properties as JSON")
     p.set_defaults(func=command)
 
 
 def command(args) -> int:
-    """`prebo properties BASIS [--root K] [--coordinates lab|ti] [--threshold T] [--regularised] [--json]`: the
-    energy of level K of a stored basis, the expectation value of every registered operator per
-    class of equivalent pairs (properties.py) and the level's Breit–Pauli correction (relativistic.py);
-    a level not bound in the basis gets a warning line on stderr."""
+    """`prebo properties BASIS [--root K] [--coordinates lab|ti] [--threshold T] [--regularised] [--qed
+    [RESPONSE...]] [--json]`: the energy of level K of a stored basis, the expectation value of every
+    registered operator per class of equivalent pairs (properties.py), the level's Breit–Pauli
+    correction (relativistic.py) and with --qed its E⁽³⁾ (qed.py); a level not bound in the basis
+    gets a warning line on stderr."""
     from ..level.properties import properties
 
+    check(args)
     basis, stored = load_basis(args.basis)
     try:
         p = properties(basis, args.root, args.coordinates, args.threshold or stored, args.regularised or None)
+        if args.qed is not None:
+            p["qed"] = qed(basis, args, args.threshold or stored, args.root)
     except PreboError as exc:
         raise type(exc)(f"{args.basis}: {exc}") from exc
     values = [v for per in p["expectation"].values() for v in per.values()]
@@ -98,6 +104,9 @@ def print_properties(p: dict, basis) -> None:
             for c, v in bp["classes"].get(term, {}).items():
                 table.add_row(f"  {c}", f"{v:.6e}", f"{v * HARTREE_CM:.6f}")
         show(table)
+    if "qed" in p:  # qed.py: each term, per class and summed, and ln k₀'s convergence
+        print_qed(p["qed"])
     if p["not_derived"]:
         print(f"not derived for {basis.family.name} functions: {', '.join(p['not_derived'])}"
                         + ("" if "breit_pauli" in p else " (so neither is the Breit–Pauli correction)"))
+

@@ -100,14 +100,14 @@ import numpy as np
 
 from .. import eigen
 from ..basis import Basis
-from ..errors import InputError, UnsupportedError
+from ..errors import InputError
 from ..integrals import laboratory
 from ..system import reduced_mass
 from . import drachmann
 from .evaluate import evaluate
 from .expectation import members
-from .response import FirstOrder
-from .transitions import dipole_vectors, forbidden, same_particles
+from .response import FirstOrder, problem, require
+from .transitions import dipole_vectors
 
 #: the Rydberg at infinite mass in Eh, R_∞ = α²m_ec²/2h = ½ E_h: the default unit of ln k₀
 R_INFINITY = 0.5
@@ -244,38 +244,11 @@ def integral(sp: Spectrum, pairs: Pairs | None, R: float, K: float, window: floa
     return {"numerator": quadrature + tail, "quadrature": quadrature, "tail": tail, "fit": fit}
 
 
-def pseudostates(ground: Basis, response: Basis, E0: float, c0: np.ndarray, threshold: float) -> Spectrum:
-    """The current's pseudostates of the level (E₀, its S-normalised vector c0 in `ground`) in the
-    N = 1 basis `response` (laboratory frame, as response.py `first_order`)."""
-    rep = laboratory(ground.system)
-    _, wv = dipole_vectors(ground.system)
-    r = rep.between("velocity", ground, response, wv[None], momentum=True)[0].T @ c0
-    m = rep.matrices(response)
-    rep.require_resolved(m)
-    H, S = m["T_ti"] + m["V"], m["S"]
-    states = eigen.solve(H, S, threshold, 1)
-    return Spectrum.of(FirstOrder(E0, r, H, S, states.vectors, states.energies - E0))
-
-
 def check(ground, responses, R, K, k, window) -> None:
     """InputError (UnsupportedError for a ground basis of N > 0) for bases the Bethe logarithm is
-    not derived for, or a unit, split point, window or k-grid that is not a finite positive number."""
-    for b, what in [(ground, "ground")] + [(r, "response") for r in responses]:
-        if not isinstance(b, Basis) or len(b) == 0:
-            raise InputError(f"bethe_logarithm: {what} = {b!r}: must be a non-empty prebo.Basis")
-        if not b.family.conserves_L:
-            raise InputError(f"bethe_logarithm: the {what} basis is of {b.family.name} functions, which have no "
-                             "definite N; it needs bases of definite N (pecg, ecg-gvr)")
-    if ground.N != 0:
-        raise UnsupportedError(f"the Bethe logarithm of a level of N = {ground.N}: derived for N = 0 only")
-    for r in responses:
-        if r.N != 1:
-            raise InputError(f"bethe_logarithm: a response basis is of N = {r.N}; the current J mixes a level of "
-                             "N = 0 with those of N = 1")
-        why = forbidden(ground, r)
-        if why is not None:
-            raise InputError(f"bethe_logarithm: the response basis cannot hold J ψ₀ ({why})")
-        same_particles(ground.system, r.system)
+    not derived for (response.py `require`), or a unit, split point, window or k-grid that is not a
+    finite positive number."""
+    require(ground, responses, "bethe_logarithm", "J ψ₀")
     for name, x in (("rydberg", R), ("K", K), ("window", window)):
         if x is not None and not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
             raise InputError(f"bethe_logarithm: {name} = {x!r}: must be a finite positive number")
@@ -285,6 +258,13 @@ def check(ground, responses, R, K, k, window) -> None:
         grid = np.atleast_1d(np.asarray(k, dtype=float)) if np.ndim(k) <= 1 else None
         if grid is None or grid.size == 0 or not np.all(np.isfinite(grid)) or np.any(grid <= 0):
             raise InputError(f"bethe_logarithm: k = {k!r}: must be a non-empty list of finite photon energies > 0 (Eh)")
+
+
+def kinetic_scale(basis: Basis) -> float:
+    """The largest diagonal kinetic energy ⟨φ_I|T|φ_I⟩/⟨φ_I|φ_I⟩ of `basis` (Eh): the shortest distance
+    it resolves; SPLIT of it is where the ground basis's f(k) stops being trusted."""
+    m = laboratory(basis.system).matrices(basis)
+    return float(np.max(np.diag(m["T_ti"]) / np.diag(m["S"])))
 
 
 def bethe_logarithm(ground: Basis, response, root: int = 0, rydberg: float = R_INFINITY, K: float | None = None,
@@ -325,11 +305,10 @@ def bethe_logarithm(ground: Basis, response, root: int = 0, rydberg: float = R_I
     rep = laboratory(ground.system)
     _, wv = dipole_vectors(ground.system)
     J2 = float(c0 @ rep.operator("p2", ground, wv[None], (True,))[0] @ c0)
-    m = rep.matrices(ground)
-    scale = float(np.max(np.diag(m["T_ti"]) / np.diag(m["S"])))
+    scale = kinetic_scale(ground)
     rows = []
     for basis in responses:
-        sp = pseudostates(ground, basis, E0, c0, threshold)
+        sp = Spectrum.of(problem(ground, basis, E0, c0, threshold, "velocity"))
         split = K if K is not None else SPLIT * min(scale, float(np.max(sp.de)))
         lower = sp.lower(R)
         part = integral(sp, pairs, R, split, window)

@@ -125,11 +125,25 @@ def of_level(ground, response, root: int = 0, **bethe) -> dict:
     (Drachmann's regularised values where bethe.py takes them) from `bethe_logarithm(ground,
     response, root, **bethe)` in R_∞, and ⟨P(1/r_ab³)⟩ per pair class from the core's operator
     "araki_sucher" on the level (evaluate). Returns `terms`' result with "bethe", the Bethe
-    logarithm's result."""
+    logarithm's result, and "araki_sucher", the values used."""
     from .evaluate import evaluate
 
     log = bethe_logarithm(ground, response, root=root, **({"rydberg": R_INFINITY} | bethe))
     level = evaluate(ground, threshold=bethe.get("threshold", eigen.THRESHOLD), roots=root + 1, targets=[root],
                      operators=("araki_sucher",))
-    out = terms(ground.system, log["delta"], dict(level["expectation"]["araki_sucher"]), log["ln_k0"], log["rydberg"])
-    return out | {"bethe": log}
+    araki_sucher = dict(level["expectation"]["araki_sucher"])
+    out = terms(ground.system, log["delta"], araki_sucher, log["ln_k0"], log["rydberg"])
+    return out | {"bethe": log, "araki_sucher": araki_sucher}
+
+
+def uncertainty(system, direct: dict, out: dict) -> float:
+    """The numerical uncertainty (Eh) of `of_level`'s E⁽³⁾ `out`: ln k₀'s — the change of its
+    convergence table's last row from the row before, else the integral's distance from the
+    pseudostate sum — times |∂E⁽³⁾/∂ln k₀|, and in quadrature the change of E⁽³⁾ when the direct
+    ⟨δ³⟩ (`direct`, per pair class) replace those used."""
+    log = out["bethe"]
+    rows = log["convergence"]
+    d_ln = abs(rows[-1]["ln_k0"] - rows[-2]["ln_k0"]) if len(rows) > 1 else abs(log["ln_k0"] - log["pseudostate"])
+    slope = math.fsum(out["classes"]["electron_nucleus"].values()) / (19 / 30 - 2 * math.log(out["alpha"]) - out["ln_k0"])
+    d_delta = terms(system, direct, out["araki_sucher"], out["ln_k0"], alpha=out["alpha"])["Eh"]["total"] - out["Eh"]["total"]
+    return math.hypot(slope * d_ln, d_delta)

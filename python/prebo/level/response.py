@@ -88,39 +88,59 @@ class FirstOrder:
         return omegas
 
 
-def first_order(ground: Basis, response: Basis, root: int = 0, threshold: float = eigen.THRESHOLD,
-                operator: str = "dipole") -> FirstOrder:
-    """The `FirstOrder` problem of the level `root` of the N = 0 basis `ground` in the N = 1 basis
-    `response`, for the dipole or its velocity form ∇_w' (`operator`; r their reduced elements).
-    InputError for bases of different particles or spin states, a ground basis not of
-    N = 0, a response basis not of N = 1 and opposite parity, or one with a level below the ground
-    level."""
-    for b, what in ((ground, "ground"), (response, "response")):
+#: the operators whose first-order function a basis of N = 1 holds for a level of N = 0, and whether
+#: their laboratory-frame vector is momentum-like (transitions.py `dipole_vectors`): the dipole d
+#: (polarisabilities) and its velocity form ∇_w' (the current J' = −i∇_w' of the Bethe logarithm, bethe.py)
+MOMENTUM = {"dipole": False, "velocity": True}
+
+
+def require(ground, responses, who: str, holds: str) -> None:
+    """InputError unless `ground` and each of `responses` are non-empty bases of definite N, the
+    ground's of N = 0 (UnsupportedError for N > 0) and each response's of N = 1 and the other parity,
+    of the same particles and spin state, able to hold `holds`; every message begins with `who`."""
+    for b, what in [(ground, "ground")] + [(r, "response") for r in responses]:
         if not isinstance(b, Basis) or len(b) == 0:
-            raise InputError(f"polarisability: {what} = {b!r}: must be a non-empty prebo.Basis")
+            raise InputError(f"{who}: {what} = {b!r}: must be a non-empty prebo.Basis")
+        if not b.family.conserves_L:
+            raise InputError(f"{who}: the {what} basis is of {b.family.name} functions, which have no definite N; "
+                             "it needs bases of definite N (pecg, ecg-gvr)")
     if ground.N != 0:
-        raise UnsupportedError(f"polarisability of a level of N = {ground.N}: derived for N = 0 only")
-    if response.N != 1:
-        raise InputError(f"polarisability: the response basis is of N = {response.N}; a dipole field "
-                         "mixes a level of N = 0 with those of N = 1")
-    why = forbidden(ground, response)
-    if why is not None:
-        raise InputError(f"polarisability: the response basis cannot hold the dipole's first-order function ({why})")
-    same_particles(ground.system, response.system)
-    r0 = evaluate(ground, threshold=threshold, roots=root + 1, targets=[root])
-    E0, c0 = float(r0["energy"]), r0["vectors"][:, 0]
+        raise UnsupportedError(f"{who}: a level of N = {ground.N}: derived for N = 0 only")
+    for r in responses:
+        if r.N != 1:
+            raise InputError(f"{who}: the response basis is of N = {r.N}; {holds} of a level of N = 0 is of N = 1")
+        why = forbidden(ground, r)
+        if why is not None:
+            raise InputError(f"{who}: the response basis cannot hold {holds} ({why})")
+        same_particles(ground.system, r.system)
+
+
+def problem(ground: Basis, response: Basis, E0: float, c0: np.ndarray, threshold: float,
+            operator: str = "dipole") -> FirstOrder:
+    """The `FirstOrder` problem of the level (energy E0, S-normalised coefficients c0 in `ground`) in
+    the N = 1 basis `response` (laboratory frame), its pseudostates as they fall, below E0 or not."""
     rep = laboratory(ground.system)
-    momentum = operator == "velocity"
+    momentum = MOMENTUM[operator]
     w = dipole_vectors(ground.system)[momentum]
     r = rep.between(operator, ground, response, w[None], momentum)[0].T @ c0
     m = rep.matrices(response)
     rep.require_resolved(m)
     H, S = m["T_ti"] + m["V"], m["S"]
     states = eigen.solve(H, S, threshold, 1)
-    if states.energies[0] <= E0:
-        raise InputError(f"polarisability: the response basis has a level {E0 - states.energies[0]:.6g} Eh below "
-                         "the ground level")
     return FirstOrder(E0, r, H, S, states.vectors, states.energies - E0, operator)
+
+
+def first_order(ground: Basis, response: Basis, root: int = 0, threshold: float = eigen.THRESHOLD,
+                operator: str = "dipole") -> FirstOrder:
+    """The `FirstOrder` problem of the level `root` of the N = 0 basis `ground` in the N = 1 basis
+    `response`, for the dipole or its velocity form ∇_w' (`operator`; r their reduced elements).
+    InputError as `require` raises it, or for a response basis with a level below the ground level."""
+    require(ground, [response], "polarisability", "the first-order function")
+    r0 = evaluate(ground, threshold=threshold, roots=root + 1, targets=[root])
+    order = problem(ground, response, float(r0["energy"]), r0["vectors"][:, 0], threshold, operator)
+    if order.de[0] <= 0:
+        raise InputError(f"polarisability: the response basis has a level {-order.de[0]:.6g} Eh below the ground level")
+    return order
 
 
 def polarisability(ground: Basis, response: Basis, omega=0.0, root: int = 0,

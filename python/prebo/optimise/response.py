@@ -39,15 +39,16 @@ from .. import eigen
 from ..basis import Basis
 from ..errors import BasisFileError, InputError, UnsupportedError
 from ..integrals import Representation
+from ..level.response import MOMENTUM
 from ..matrices import Matrices
 from .objective import BlockLevel, Level, Objective
 
-#: the operators a response objective can be driven by: whether their vector is momentum-like, and
+#: the operators a response objective can be driven by (level/response.py `MOMENTUM`: the dipole d and
+#: its velocity form ∇_w', the current J' = −i∇_w' of the Bethe logarithm, whose f(k) =
+#: ⟨J'(H − E₀ + k)⁻¹J'⟩ is −3 J at ω = −k; level/bethe.py): whether their vector is momentum-like, and
 #: the factor of the reduced element that gives the source of the component along z,
-#: ⟨φ_J M=0|O_z|ψ₀⟩ = ⟨φ_J‖O‖ψ₀⟩/√3 for ψ₀ of N = 0 (Edmonds; level/transitions.py): the dipole d
-#: (polarisabilities) and its velocity form ∇_w' (the current J' = −i∇_w' of the Bethe logarithm,
-#: whose f(k) = ⟨J'(H − E₀ + k)⁻¹J'⟩ is −3 J at ω = −k; level/bethe.py)
-OPERATORS = {"dipole": (False, 1.0 / np.sqrt(3.0)), "velocity": (True, 1.0 / np.sqrt(3.0))}
+#: ⟨φ_J M=0|O_z|ψ₀⟩ = ⟨φ_J‖O‖ψ₀⟩/√3 for ψ₀ of N = 0 (Edmonds; level/transitions.py)
+OPERATORS = {name: (momentum, 1.0 / np.sqrt(3.0)) for name, momentum in MOMENTUM.items()}
 
 
 def contract(M: np.ndarray, c: np.ndarray) -> np.ndarray:
