@@ -126,3 +126,25 @@ def test_energy_gives_each_level_and_line_by_order_in_alpha(tmp_path, capsys):
     assert main(["energy", str(g), "--roots", "2", "--corrections"]) == 0
     text = capsys.readouterr().out
     assert "energy by order in α" in text and "lines from the lowest level" in text and "α³" not in text
+
+
+def test_transitions_give_each_line_by_order_in_alpha(tmp_path, capsys):
+    # hydrogen 1s, 2s → 2p, 3p: each line's α⁰ its frequency, its α² the difference of its levels'
+    # Breit–Pauli corrections as `prebo properties` gives them, uncertainties in quadrature
+    g = saved(tmp_path, hydrogen(0, GROUND), "g.json")
+    r = saved(tmp_path, hydrogen(1, RESPONSE), "r.json")
+    assert main(["transitions", str(g), str(r), "--roots", "2", "--corrections", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    bp = {(v["basis"], v["root"]): properties(capsys, (g, r)[v["basis"]], "--root", v["root"])["breit_pauli"]
+          for v in out["levels"]}
+    for line in out["lines"]:
+        lower, upper = (out["levels"][line[k]] for k in ("lower", "upper"))
+        b = line["budget"]
+        assert b["alpha0"]["Eh"] == pytest.approx(line["Eh"], abs=1e-14)
+        a2 = bp[upper["basis"], upper["root"]]["Eh"]["total"] - bp[lower["basis"], lower["root"]]["Eh"]["total"]
+        assert b["alpha2"]["Eh"] == pytest.approx(a2, rel=1e-10, abs=1e-16)
+        assert b["alpha2"]["uncertainty"] == pytest.approx(math.hypot(lower["budget"]["alpha2"]["uncertainty"],
+                                                                      upper["budget"]["alpha2"]["uncertainty"]))
+        assert "alpha3" not in b
+    assert main(["transitions", str(g), str(r), "--roots", "2", "--corrections"]) == 0
+    assert "line frequencies by order in α" in capsys.readouterr().out

@@ -24,6 +24,10 @@ def add(sub) -> None:
     p.add_argument("--threshold", type=fraction, metavar="T",
                    help="relative overlap eigenvalue below which directions are dropped (default: each "
                         "basis's run's, else 4 x 2^-53)")
+    p.add_argument("--corrections", action="store_true",
+                   help="each level and line by order in α with its numerical uncertainty: α⁰ and α² (Breit–Pauli; "
+                        "level/budget.py); α³ needs the Bethe logarithm, derived for levels of N = 0 only "
+                        "(prebo energy --qed)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=command)
 
@@ -42,6 +46,8 @@ def command(args) -> int:
     try:
         roots = tuple(args.roots) if len(args.roots) == 2 else args.roots[0]
         r = transitions(lower, upper, roots, threshold, args.coordinates)
+        if args.corrections:
+            budget(r, (lower, upper), threshold, args.coordinates)
     except PreboError as exc:
         raise type(exc)(f"{args.lower}, {args.upper}: {exc}") from exc
     if args.json:
@@ -49,6 +55,26 @@ def command(args) -> int:
     else:
         _print(r)
     return 0
+
+
+def budget(r: dict, bases: tuple, threshold: float, coordinates: str) -> None:
+    """Each level's parts by order in α (α⁰, α²) into its "budget", and each line's into its own
+    (level/budget.py), the levels re-evaluated with the operators the α² part needs."""
+    from ..level import budget as parts
+    from ..level.evaluate import evaluate
+    from ..level.properties import reported
+
+    solved = {}
+    for k, basis in enumerate(bases):
+        roots = 1 + max(v["root"] for v in r["levels"] if v["basis"] == k)
+        e = evaluate(basis, coordinates=coordinates, threshold=threshold, roots=roots,
+                     operators=reported(basis.family, True))
+        solved[k] = (basis, e.get("levels", [e]))
+    for v in r["levels"]:
+        basis, levels = solved[v["basis"]]
+        v["budget"] = parts.of_level(basis, levels[v["root"]])
+    for line in r["lines"]:
+        line["budget"] = parts.line(r["levels"][line["lower"]]["budget"], r["levels"][line["upper"]]["budget"])
 
 
 def _print(r: dict) -> None:
@@ -61,6 +87,8 @@ def _print(r: dict) -> None:
     for k, v in enumerate(r["levels"]):
         levels.add_row(label[k], f"{v['energy']:.12f}")
     show(levels)
+    if "budget" in r["levels"][0]:
+        _budget(r, label)
     if any("quadrupole" in line for line in r["lines"]):
         _quadrupole(r, label)
     else:
@@ -71,6 +99,22 @@ def _print(r: dict) -> None:
         for v in r["lifetimes"]:
             life.add_row(label[v["level"]], f"{v['lifetime']:.6e}", str(v["lines"]))
         show(life)
+
+
+def _budget(r: dict, label: dict) -> None:
+    """The lines' frequencies by order in α (`budget`), in cm⁻¹ ± their numerical uncertainty."""
+    from rich.table import Table
+
+    def cell(x):
+        return f"{x['cm-1']:.6f} ± {x['uncertainty_cm-1']:.1e}"
+
+    t = Table("lower → upper", "α⁰ (cm⁻¹)", "α² (cm⁻¹)", "total (cm⁻¹)", title="line frequencies by order in α",
+              caption="± the numerical uncertainty (level/budget.py)")
+    for line in r["lines"]:
+        b = line["budget"]
+        t.add_row(f"{label[line['lower']]} → {label[line['upper']]}", cell(b["alpha0"]),
+                  cell(b["alpha2"]) if "alpha2" in b else "", cell(b["total"]))
+    show(t)
 
 
 def _dipole(r: dict, label: dict) -> None:
