@@ -12,10 +12,11 @@ from prebo.cli import main
 from prebo.errors import InputError
 from prebo.level.qed import of_level
 from prebo.level.relativistic import ALPHA
-from prebo.optimise.current import current_bases, folder_of, grid
+from prebo.optimise.current import current_bases, folder_of, grid, scale
 
 from conftest import cli_error, edited
 from test_bethe import DRAKE_SWAINSON, GROUND, RESPONSE, even
+from test_qed import clamped
 from test_transitions import hydrogen
 
 MU = float(np.prod(prebo.System(["p", "e"]).masses) / prebo.System(["p", "e"]).m_total)
@@ -70,6 +71,8 @@ def test_the_default_grid_reaches_the_split_point():
     ks = grid(ground)
     assert ks[0] == pytest.approx(0.1 * MU) and ks == sorted(ks) and len(ks) >= 7
     assert np.allclose(np.diff(np.log10(ks)), np.diff(np.log10(ks))[0])
+    # the unit of the lowest k: (Z μ)² of the attracting pairs, the infinite mass's limit μ = m_e included
+    assert scale(clamped("alpha", 2)) == 4.0 and scale(prebo.System(["e+", "e", "e"])) == 0.5
     with pytest.raises(InputError, match="non-empty list of finite photon energies"):
         grid(ground, [])
     with pytest.raises(InputError, match="non-empty list of finite photon energies"):

@@ -26,7 +26,7 @@ from .. import eigen
 from ..basis import Basis
 from ..errors import InputError
 from ..level.bethe import SPLIT, kinetic_scale
-from ..system import State, System
+from ..system import State, System, reduced_mass
 from .checkpoint import CHECKPOINT
 from .driver import optimise, resume_from
 from .response import Source
@@ -52,7 +52,7 @@ def scale(system: System) -> float:
     """The binding scale max (q_a q_b)² μ_ab over `system`'s attracting pairs (Eh; 1 for hydrogen at
     infinite mass, twice its binding energy; every charged pair if none attract): the unit of LOWEST."""
     q, m = system.charges, system.masses
-    pairs = [(q[a] * q[b], m[a] * m[b] / (m[a] + m[b])) for a in range(system.n) for b in range(a) if q[a] * q[b]]
+    pairs = [(q[a] * q[b], reduced_mass(m[a], m[b])) for a in range(system.n) for b in range(a) if q[a] * q[b]]
     attract = [(qq, mu) for qq, mu in pairs if qq < 0] or pairs
     return max(qq**2 * mu for qq, mu in attract)
 
