@@ -100,6 +100,10 @@ def test_bad_input_gets_one_line(tmp_path, capsys):
     assert "only with --qed and no RESPONSE" in cli_error(capsys, "properties", g, "--qed", r, "--qed-size", "4")
     assert "only with --qed and no RESPONSE" in cli_error(capsys, "properties", g, "--qed-k", "1")
     assert "the response basis is of N = 0" in cli_error(capsys, "properties", g, "--qed", g)
+    # the bases' folder where a file stands
+    (tmp_path / "file").write_text("")
+    assert "cannot make the folder" in cli_error(capsys, "properties", g, "--qed", "--qed-k", "1",
+                                                 "--qed-out", tmp_path / "file")
 
 
 def test_energy_gives_each_level_and_line_by_order_in_alpha(tmp_path, capsys):

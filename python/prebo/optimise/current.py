@@ -24,7 +24,7 @@ import numpy as np
 
 from .. import eigen
 from ..basis import Basis
-from ..errors import InputError
+from ..errors import InputError, OutputError
 from ..level.bethe import SPLIT, kinetic_scale
 from ..system import State, System, reduced_mass
 from .checkpoint import CHECKPOINT
@@ -84,7 +84,8 @@ def current_bases(ground: Basis, root: int = 0, k=None, size: int = SIZE, out: P
     per photon energy of `grid(ground, k)` (ascending), each of `size` functions optimised by the
     driver on Hylleraas' functional at ω = −k (`opts` its other settings), its run in
     `folder_of(out, k)`: read back if it is there (resumed to its end), else run. InputError as
-    `grid` and response.Source raise it."""
+    `grid` and response.Source raise it, or for a folder holding another run (`require_same`);
+    OutputError for a folder that cannot be made."""
     ks = grid(ground, k)
     system = reached(ground.system)
     settings = replace(opts or Optimiser(), size=size)
@@ -98,7 +99,10 @@ def current_bases(ground: Basis, root: int = 0, k=None, size: int = SIZE, out: P
             basis, _ = resume_from(where, progress=progress)
         else:
             if where is not None:
-                where.mkdir(parents=True, exist_ok=True)
+                try:
+                    where.mkdir(parents=True, exist_ok=True)
+                except OSError as exc:
+                    raise OutputError(f"{where}: cannot make the folder of the run ({exc.strerror})") from exc
             basis = optimise(system, settings, out=where, progress=progress, response=source)
         bases.append(basis)
     return bases
