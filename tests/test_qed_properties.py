@@ -12,7 +12,8 @@ from prebo.cli import main
 from prebo.errors import InputError
 from prebo.level.qed import of_level
 from prebo.level.relativistic import ALPHA
-from prebo.optimise.current import current_bases, folder_of, grid, scale
+from prebo.integrals import laboratory
+from prebo.optimise.current import current_bases, folder_of, grid, scale, union
 
 from conftest import cli_error, edited
 from test_bethe import DRAKE_SWAINSON, GROUND, RESPONSE, even
@@ -155,3 +156,20 @@ def test_transitions_give_each_line_by_order_in_alpha(tmp_path, capsys):
         assert "alpha3" not in b
     assert main(["transitions", str(g), str(r), "--roots", "2", "--corrections"]) == 0
     assert "line frequencies by order in α" in capsys.readouterr().out
+
+
+def test_the_union_drops_what_its_overlap_cannot_resolve():
+    # a basis joined with itself, and with its functions moved by 1e-9 relative, is itself; a
+    # function 1e-3 off its neighbour's exponent stays; in hydrogen's driver-optimised k-bases the
+    # union's scaled overlap had eigenvalues at −1e-12, and the Bethe logarithm failed on it
+    b = hydrogen(1, even(0.01, 1e4, 3.0))
+    moved = prebo.Basis(b.system, b.A * (1 + 1e-9), b.c_A, kind=b.kind, u=b.u, K=b.K)
+    for other in (b, moved):
+        u = union([b, other])
+        assert len(u) == len(b) and not len(u.differs(b))
+    apart = prebo.Basis(b.system, b.A[:1] * 1.001, b.c_A[:1], kind=b.kind, u=b.u[:1], K=b.K[:1])
+    assert len(union([b, apart])) == len(b) + 1
+    u = union([b, moved, apart], min_norm=1e-5)
+    S = laboratory(u.system).matrices(u)["S"]
+    d = 1 / np.sqrt(np.diag(S))
+    assert np.linalg.eigvalsh(S * np.outer(d, d))[0] > 1e-12

@@ -40,20 +40,20 @@ def check(args) -> None:
 def qed(basis, args, threshold: float, root: int) -> dict:
     """E⁽³⁾ of level `root` of `basis` (level/qed.py `of_level`) with its Bethe logarithm from the --qed
     bases (split at bethe.py's default K), or from those optimise/current.py builds and keeps in
-    --qed-out/rootK, or qed/rootK beside BASIS (their unions as they join, k ascending, each a row of the
+    --qed-out/rootK, or qed/rootK beside BASIS (their unions as they join, k ascending, near-dependent
+    functions dropped (current.union), each a row of the
     convergence table; split at the grid's largest k, the last basis's)."""
     from ..level.qed import of_level
 
     if args.qed:
         responses, split = [load_basis(basis_file(name))[0] for name in args.qed], None
     else:
-        from ..basis import Basis
-        from ..optimise.current import SIZE, current_bases, grid
+        from ..optimise.current import SIZE, current_bases, grid, union
 
         out = Path(args.qed_out or Path(args.basis).parent / "qed") / f"root{root}"
         ks = grid(basis, args.qed_k)
         parts = current_bases(basis, root, ks, args.qed_size or SIZE, out, threshold, progress=not args.json)
-        responses, split = [Basis.concat(parts[:j + 1]) for j in range(len(parts))], ks[-1]
+        responses, split = [union(parts[:j + 1]) for j in range(len(parts))], ks[-1]
     return of_level(basis, responses, root, threshold=threshold, K=split)
 
 

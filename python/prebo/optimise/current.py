@@ -25,6 +25,7 @@ import numpy as np
 from .. import eigen
 from ..basis import Basis
 from ..errors import InputError, OutputError
+from ..integrals import laboratory
 from ..level.bethe import SPLIT, kinetic_scale
 from ..system import State, System, reduced_mass
 from .checkpoint import CHECKPOINT
@@ -39,6 +40,12 @@ LOWEST, PER_DECADE = 0.1, 1
 
 #: the default number of functions of each k's basis
 SIZE = 30
+
+#: the smallest part of a function orthogonal to those before it in a union of the bases, relative
+#: to its norm (`union`): bases optimised at neighbouring k share directions, and their union's
+#: overlap has eigenvalues at the elements' rounding (−1e-12 relative for hydrogen's), where its
+#: pseudostates would be noise
+UNION_NORM = 1e-5
 
 
 def reached(system: System) -> System:
@@ -106,6 +113,24 @@ def current_bases(ground: Basis, root: int = 0, k=None, size: int = SIZE, out: P
             basis = optimise(system, settings, out=where, progress=progress, response=source)
         bases.append(basis)
     return bases
+
+
+def union(bases: list[Basis], min_norm: float = UNION_NORM) -> Basis:
+    """The functions of `bases` in order, each kept only if its part orthogonal to those kept before
+    it is at least `min_norm` of its norm (a Cholesky factorisation of the scaled overlap, grown a
+    function at a time): a union whose overlap the elements resolve."""
+    joined = Basis.concat(bases)
+    S = laboratory(joined.system).matrices(joined)["S"]
+    d = 1.0 / np.sqrt(np.diag(S))
+    S = S * np.outer(d, d)
+    kept, L = [], np.zeros((0, 0))
+    for n in range(len(S)):
+        x = np.linalg.solve(L, S[kept, n]) if kept else np.zeros(0)
+        nu = S[n, n] - x @ x
+        if nu >= min_norm**2:
+            L = np.block([[L, np.zeros((len(kept), 1))], [x[None, :], np.array([[np.sqrt(nu)]])]])
+            kept.append(n)
+    return joined.subset(kept)
 
 
 def require_same(where: Path, source: Source) -> None:
