@@ -100,6 +100,7 @@ def test_bad_input_gets_one_line(tmp_path, capsys):
     assert "--qed-k" in cli_error(capsys, "properties", g, "--qed", "--qed-k", "-1")
     assert "only with --qed and no RESPONSE" in cli_error(capsys, "properties", g, "--qed", r, "--qed-size", "4")
     assert "only with --qed and no RESPONSE" in cli_error(capsys, "properties", g, "--qed-k", "1")
+    assert "--qed-budget" in cli_error(capsys, "properties", g, "--qed", "--qed-budget", "0")
     assert "the response basis is of N = 0" in cli_error(capsys, "properties", g, "--qed", g)
     # the bases' folder where a file stands
     (tmp_path / "file").write_text("")

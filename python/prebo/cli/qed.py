@@ -6,11 +6,11 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..io.load import basis_file, load_basis
-from .arguments import distance, positive_integer
+from .arguments import distance, positive_integer, seconds
 from .tables import show
 
 #: the options that shape the bases the optimiser builds (--qed without files)
-BUILDING = ("qed_out", "qed_k", "qed_size")
+BUILDING = ("qed_out", "qed_k", "qed_size", "qed_budget")
 
 
 def add_arguments(p) -> None:
@@ -28,6 +28,9 @@ def add_arguments(p) -> None:
                         "Coulomb scale to the Bethe logarithm's split point; optimise/current.py grid)")
     p.add_argument("--qed-size", type=positive_integer, metavar="N",
                    help="with --qed and no RESPONSE: functions per photon energy (default: optimise/current.py SIZE)")
+    p.add_argument("--qed-budget", type=seconds, metavar="S",
+                   help="with --qed and no RESPONSE: seconds of each photon energy's run (default: until it converges; "
+                        "a run stopped by its budget is resumed with a larger one)")
 
 
 def check(args) -> None:
@@ -48,11 +51,13 @@ def qed(basis, args, threshold: float, root: int) -> dict:
     if args.qed:
         responses, split = [load_basis(basis_file(name))[0] for name in args.qed], None
     else:
+        from ..optimise import Optimiser
         from ..optimise.current import SIZE, current_bases, grid, union
 
         out = Path(args.qed_out or Path(args.basis).parent / "qed") / f"root{root}"
         ks = grid(basis, args.qed_k)
-        parts = current_bases(basis, root, ks, args.qed_size or SIZE, out, threshold, progress=not args.json)
+        opts = Optimiser(budget=args.qed_budget)
+        parts = current_bases(basis, root, ks, args.qed_size or SIZE, out, threshold, opts, progress=not args.json)
         responses, split = [union(parts[:j + 1]) for j in range(len(parts))], ks[-1]
     return of_level(basis, responses, root, threshold=threshold, K=split)
 

@@ -90,7 +90,8 @@ def current_bases(ground: Basis, root: int = 0, k=None, size: int = SIZE, out: P
     """The N = 1 bases of the current's first-order functions of the level `root` of `ground`, one
     per photon energy of `grid(ground, k)` (ascending), each of `size` functions optimised by the
     driver on Hylleraas' functional at ω = −k (`opts` its other settings), its run in
-    `folder_of(out, k)`: read back if it is there (resumed to its end), else run. InputError as
+    `folder_of(out, k)`: read back if it is there (resumed to its end, with `opts.budget` if given),
+    else run. InputError as
     `grid` and response.Source raise it, or for a folder holding another run (`require_same`);
     OutputError for a folder that cannot be made."""
     ks = grid(ground, k)
@@ -103,7 +104,7 @@ def current_bases(ground: Basis, root: int = 0, k=None, size: int = SIZE, out: P
         where = None if out is None else folder_of(out, x)
         if where is not None and (where / CHECKPOINT).exists():
             require_same(where, source)
-            basis, _ = resume_from(where, progress=progress)
+            basis, _ = resume_from(where, progress=progress, budget=settings.budget)
         else:
             if where is not None:
                 try:
