@@ -7,8 +7,9 @@ Hylleraas' functional ⟨ψ₁|H − E₀ + k|ψ₁⟩ + 2⟨ψ₁|J'_z|ψ₀⟩
 the other parity), shrinks from the size of the level to r ~ (2μk)^(−1/2). One basis optimised at
 one k resolves f near that k only; as Korobov (arXiv:1203.1404) and Pachucki & Komasa (Li, Be with
 ECGs) do, each k of a grid gets its own basis, optimised on its functional at ω = −k by
-driver.optimise (optimise/response.py, operator "velocity"). bethe.py takes their union, whose
-pseudostates resolve f at every k of the grid and between.
+driver.optimise (optimise/response.py, operator "velocity"). bethe.py takes their union (`union`:
+without the functions it cannot resolve), whose pseudostates resolve f at every k of the grid and
+between.
 
 Each run's folder is folder/k=<k> (the checkpoint basis.json): a finished run is read back and
 its basis reused, an unfinished one (a killed run) resumed where it stopped, so `prebo properties
@@ -91,9 +92,8 @@ def current_bases(ground: Basis, root: int = 0, k=None, size: int = SIZE, out: P
     per photon energy of `grid(ground, k)` (ascending), each of `size` functions optimised by the
     driver on Hylleraas' functional at ω = −k (`opts` its other settings), its run in
     `folder_of(out, k)`: read back if it is there (resumed to its end, with `opts.budget` if given),
-    else run. InputError as
-    `grid` and response.Source raise it, or for a folder holding another run (`require_same`);
-    OutputError for a folder that cannot be made."""
+    else run. InputError as `grid` and response.Source raise it, or for a folder holding another
+    run (`require_same`); OutputError for a folder that cannot be made."""
     ks = grid(ground, k)
     system = reached(ground.system)
     settings = replace(opts or Optimiser(), size=size)
