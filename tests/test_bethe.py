@@ -45,7 +45,7 @@ def test_the_integral_representation_is_the_pseudostate_sum_on_a_small_basis(roo
     # too tight for it, whose 2p pseudostate lies 2e-3 Eh below it: the sum counts it with ln|ΔE|,
     # the integral adds its term (6e-6 of ln k₀) and keeps its pole off the path
     ground, response = hydrogen(0, even(0.03, 300.0, 2.5)), hydrogen(1, even(0.01, 500.0, 2.2))
-    r = bethe_logarithm(ground, response, root=root, k=[0.1, 1.0, 10.0])
+    r = bethe_logarithm(ground, response, root=root, k=[0.1, 1.0, 10.0], K=100.0)
     assert abs(r["own"] - r["pseudostate"]) < 1e-8
     if root == 0:  # f(k), minus Hylleraas' minimum in the basis's matrices, against g: k f(k) = A − g(k)
         for x in r["spectrum"]:
@@ -115,8 +115,8 @@ def test_a_convergence_table_follows_the_response_bases():
 
 def test_the_unit_converts_by_its_logarithm():
     ground, response = hydrogen(0, even(0.01, 300.0, 2.5)), hydrogen(1, even(0.02, 500.0, 2.2))
-    a = bethe_logarithm(ground, response)
-    b = bethe_logarithm(ground, response, rydberg=reduced_rydberg(ground.system))
+    a = bethe_logarithm(ground, response, K=100.0)
+    b = bethe_logarithm(ground, response, rydberg=reduced_rydberg(ground.system), K=100.0)
     assert a["rydberg"] == 0.5
     assert b["pseudostate"] == pytest.approx(a["pseudostate"] - math.log(MU), abs=1e-12)
     assert b["ln_k0"] - a["ln_k0"] == pytest.approx(-math.log(MU), abs=1e-9)

@@ -24,8 +24,8 @@ def add_arguments(p) -> None:
                    help="with --qed and no RESPONSE: the folder of the first-order bases, DIR/rootK/k=<k> for root K "
                         "(default: BASIS's folder/qed)")
     p.add_argument("--qed-k", type=distance, nargs="+", metavar="K",
-                   help="with --qed and no RESPONSE: the photon energies in Eh (default: one per decade from 0.1 × the "
-                        "Coulomb scale to the Bethe logarithm's split point; optimise/current.py grid)")
+                   help="with --qed and no RESPONSE: the photon energies in Eh (default: one per decade from 0.3 × the "
+                        "Coulomb scale to 3 × the Bethe logarithm's split point; optimise/current.py grid)")
     p.add_argument("--qed-size", type=positive_integer, metavar="N",
                    help="with --qed and no RESPONSE: functions per photon energy (default: optimise/current.py SIZE)")
     p.add_argument("--qed-budget", type=seconds, metavar="S",
@@ -45,21 +45,23 @@ def qed(basis, args, threshold: float, root: int) -> dict:
     bases (split at bethe.py's default K), or from those optimise/current.py builds and keeps in
     --qed-out/rootK, or qed/rootK beside BASIS (their unions as they join, k ascending, near-dependent
     functions dropped (current.union), each a row of the
-    convergence table; split at the grid's largest k, the last basis's)."""
+    convergence table; split at bethe.split's point, at most the grid's largest k over
+    current.BEYOND)."""
     from ..level.qed import of_level
 
     if args.qed:
-        responses, split = [load_basis(basis_file(name))[0] for name in args.qed], None
+        responses, K = [load_basis(basis_file(name))[0] for name in args.qed], None
     else:
         from ..optimise import Optimiser
-        from ..optimise.current import SIZE, current_bases, grid, union
+        from ..level.bethe import split
+        from ..optimise.current import BEYOND, SIZE, current_bases, grid, union
 
         out = Path(args.qed_out or Path(args.basis).parent / "qed") / f"root{root}"
         ks = grid(basis, args.qed_k)
         opts = Optimiser(budget=args.qed_budget)
         parts = current_bases(basis, root, ks, args.qed_size or SIZE, out, threshold, opts, progress=not args.json)
-        responses, split = [union(parts[:j + 1]) for j in range(len(parts))], ks[-1]
-    return of_level(basis, responses, root, threshold=threshold, K=split)
+        responses, K = [union(parts[:j + 1]) for j in range(len(parts))], min(split(basis), ks[-1] / BEYOND)
+    return of_level(basis, responses, root, threshold=threshold, K=K)
 
 
 def print_qed(q: dict) -> None:

@@ -82,8 +82,9 @@ whose poles lie π off the real x axis) on [0, K], and on [K, ∞) the expansion
                                 − b/K − (2/3) e K^(−3/2).
 
 K must lie where the bases still resolve f (the ground basis's cusp and the N = 1 basis's
-functions at r ~ (2μk)^(−1/2)): by default 1e-5 of the smaller of the ground basis's largest
-diagonal kinetic energy and the N = 1 basis's largest ΔE_n (`SPLIT`). D is taken from ⟨δ³(r_ab)⟩,
+functions at r ~ (2μk)^(−1/2)) and where the expansion holds: by default (`split`) 1e-2 of the
+ground basis's largest diagonal kinetic energy or 1e5 × the Coulomb scale (Zμ)², whichever is less,
+and never below 1e2 × that scale (InputError). D is taken from ⟨δ³(r_ab)⟩,
 Drachmann's regularised value where `regularised` (drachmann.py; the direct one misses the cusp):
 its error enters ln k₀ as (ln(K/R) − ln k₀) δD/D, 9 δD/D at K = 1e5 Eh in hydrogen. With the basis's own D and A₊
 (D_b = Σ s_nΔE_n) and K far above every ΔE_n, the integral is the pseudostate sum ("own": the
@@ -112,8 +113,14 @@ from .transitions import dipole_vectors
 #: the Rydberg at infinite mass in Eh, R_∞ = α²m_ec²/2h = ½ E_h: the default unit of ln k₀
 R_INFINITY = 0.5
 
-#: the default split point K, this fraction of the bases' largest kinetic energy scale (module docstring)
-SPLIT = 1e-5
+#: the default split point K (module docstring): GROUND_REACH of the ground basis's largest diagonal
+#: kinetic energy (its f(k) stops mattering below ~1e-2 of it in hydrogen) and at most TOP × the
+#: Coulomb scale (1e5 Eh for hydrogen; the expansion alone errs 1.5e-6 at 1e4, 1e-7 at 3e4); refused
+#: below BOTTOM × the scale, where the expansion does not hold (benchmarks/record/bethe-logarithm.md).
+#: The N = 1 basis must resolve f up to K: a union of driver-optimised bases errs in g(k) 4e-5
+#: relative at 1/39 of its largest ΔE_n and 3.8e-4 at 1/3.9 (the same record; optimise/current.py
+#: grows its grid to 3 K)
+GROUND_REACH, TOP, BOTTOM = 1e-2, 1e5, 1e2
 
 #: the Gauss–Legendre panels of the quadrature on [0, K]: width in x = ln(1 + k/k₀), points per panel
 PANEL, ORDER = 0.5, 12
@@ -262,9 +269,24 @@ def check(ground, responses, R, K, k, window) -> None:
 
 def kinetic_scale(basis: Basis) -> float:
     """The largest diagonal kinetic energy ⟨φ_I|T|φ_I⟩/⟨φ_I|φ_I⟩ of `basis` (Eh): the shortest distance
-    it resolves; SPLIT of it is where the ground basis's f(k) stops being trusted."""
+    it resolves; GROUND_REACH of it is where the ground basis's f(k) stops being trusted."""
     m = laboratory(basis.system).matrices(basis)
     return float(np.max(np.diag(m["T_ti"]) / np.diag(m["S"])))
+
+
+def coulomb_scale(system) -> float:
+    """max (q_a q_b)² μ_ab over `system`'s attracting pairs (Eh; 1 for hydrogen at infinite mass,
+    twice its binding energy; every charged pair if none attract): the unit of TOP and BOTTOM."""
+    q, m = system.charges, system.masses
+    pairs = [(q[a] * q[b], reduced_mass(m[a], m[b])) for a in range(system.n) for b in range(a) if q[a] * q[b]]
+    attract = [(qq, mu) for qq, mu in pairs if qq < 0] or pairs
+    return float(max(qq**2 * mu for qq, mu in attract))
+
+
+def split(ground: Basis) -> float:
+    """The default split point K (Eh): the lesser of GROUND_REACH × `kinetic_scale(ground)` and TOP ×
+    `coulomb_scale`."""
+    return min(GROUND_REACH * kinetic_scale(ground), TOP * coulomb_scale(ground.system))
 
 
 def bethe_logarithm(ground: Basis, response, root: int = 0, rydberg: float = R_INFINITY, K: float | None = None,
@@ -273,7 +295,7 @@ def bethe_logarithm(ground: Basis, response, root: int = 0, rydberg: float = R_I
     """ln k₀ of the level `root` of the N = 0 basis `ground`, with its current's first-order functions
     in the N = 1 basis `response` (one, or a list of growing ones for a convergence table; the last
     gives the result), in the unit `rydberg` (Eh; module docstring), the integral split at K (Eh;
-    default SPLIT of the bases' scale), the O(k⁻²) terms fitted on [K/window, K]; `k`, photon
+    default `split`), the O(k⁻²) terms fitted on [K/window, K]; `k`, photon
     energies (Eh) at which to tabulate f, g and the expansion; `regularised`, Drachmann's ⟨δ³⟩ in D
     (None: where cheap, `drachmann.CLOSED_FORM`).
 
@@ -284,7 +306,8 @@ def bethe_logarithm(ground: Basis, response, root: int = 0, rydberg: float = R_I
     "log": {class: λ}, "delta": {class: ⟨δ³⟩ used}, "regularised", "lower": [{de, s}] of the levels
     of N = 1 at or below, "energy", "root", "rydberg", "convergence": [{n_basis, K, pseudostate,
     ln_k0, J2_response, D_response}] per response basis, and with `k` "spectrum": [{k, f, g,
-    asymptotic}]}. InputError as `check` raises it, or for a level that is not bound."""
+    asymptotic}]}. InputError as `check` raises it, for a level that is not bound, or for a split
+    point below BOTTOM × the Coulomb scale."""
     responses = list(response) if isinstance(response, (list, tuple)) else [response]
     if not responses:
         raise InputError("bethe_logarithm: response = []: give at least one basis of N = 1")
@@ -305,18 +328,24 @@ def bethe_logarithm(ground: Basis, response, root: int = 0, rydberg: float = R_I
     rep = laboratory(ground.system)
     _, wv = dipole_vectors(ground.system)
     J2 = float(c0 @ rep.operator("p2", ground, wv[None], (True,))[0] @ c0)
-    scale = kinetic_scale(ground)
+    low = BOTTOM * coulomb_scale(ground.system)
     rows = []
     for basis in responses:
         sp = Spectrum.of(problem(ground, basis, E0, c0, threshold, "velocity"))
-        split = K if K is not None else SPLIT * min(scale, float(np.max(sp.de)))
+        at = K if K is not None else split(ground)
+        if at < low:
+            why = "give a larger K" if K is not None else (
+                f"the bases do not reach far enough (ground: kinetic scale {kinetic_scale(ground):.3g} Eh; response: "
+                f"largest ΔE {float(np.max(sp.de)):.3g} Eh)")
+            raise InputError(f"bethe_logarithm: the split point K = {at:.4g} Eh lies below {low:.4g} Eh ({BOTTOM:g} × "
+                             f"the Coulomb scale), where the large-k expansion does not hold: {why}")
         lower = sp.lower(R)
-        part = integral(sp, pairs, R, split, window)
+        part = integral(sp, pairs, R, at, window)
         own = integral(sp, None, R, BEYOND * max(float(np.max(sp.de)), R), window)
         D_b = float(np.sum(sp.s * sp.de))
         rows.append({"n_basis": len(basis), "pseudostate": sp.pseudostate(R),
                      "ln_k0": (part["numerator"] + lower) / pairs.D, "own": (own["numerator"] + lower) / D_b,
-                     "J2_response": float(np.sum(sp.s)), "D_response": D_b, "integral": part, "K": split,
+                     "J2_response": float(np.sum(sp.s)), "D_response": D_b, "integral": part, "K": at,
                      "spectrum": sp})
     last = rows[-1]
     part, sp = last["integral"], last["spectrum"]
