@@ -61,7 +61,10 @@ def test_the_driver_builds_the_bases_on_a_k_grid_and_reuses_them(tmp_path, capsy
     argv = (g, "--qed", "--qed-k", *ks, "--qed-size", "8", "--qed-out", tmp_path / "qed")
     q = properties(capsys, *argv)["qed"]
     assert 10 * abs(q["ln_k0"] - LN_K0) < abs(q["bethe"]["pseudostate"] - LN_K0) and abs(q["ln_k0"] - LN_K0) < 5e-3
-    assert [row["n_basis"] for row in q["bethe"]["convergence"]] == [8, 16, 24]
+    # each union keeps what its overlap resolves (current.union): a function near the cut goes or
+    # stays with the machine's rounding (Haswell's OpenBLAS kernels kept 23 of the 24)
+    ns = [row["n_basis"] for row in q["bethe"]["convergence"]]
+    assert ns[0] == 8 and 8 < ns[1] <= 16 < ns[2] <= 24, ns
     runs = [folder_of(tmp_path / "qed" / "root0", float(k)) / "basis.json" for k in ks]
     stamps = [p.stat().st_mtime_ns for p in runs]
     assert properties(capsys, *argv)["qed"] == q
