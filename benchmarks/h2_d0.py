@@ -26,7 +26,7 @@ from prebo.level import budget
 from prebo.level.evaluate import evaluate
 from prebo.level.properties import reported
 from prebo.level.qed import of_level
-from prebo.optimise.current import SIZE, current_bases, grid
+from prebo.optimise.current import SIZE, responses
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -45,13 +45,9 @@ def parts_of(name: str, roots: int, args, qed: bool) -> tuple[list[dict], float]
     for v in levels:
         q = None
         if qed:
-            ks = grid(basis, args.k)
-            bases = current_bases(basis, v["root"], ks, args.size, args.qed_out / Path(name).name / f"root{v['root']}",
-                                  threshold, progress=False)
-            from prebo.basis import Basis
-
-            q = of_level(basis, [Basis.concat(bases[:j + 1]) for j in range(len(bases))], v["root"],
-                         threshold=threshold, K=ks[-1])
+            bases, K = responses(basis, v["root"], args.k, args.size,
+                                 args.qed_out / Path(name).name / f"root{v['root']}", threshold)
+            q = of_level(basis, bases, v["root"], threshold=threshold, K=K)
         out.append(budget.of_level(basis, v, q))
     return out, time.perf_counter() - t
 

@@ -43,24 +43,19 @@ def check(args) -> None:
 def qed(basis, args, threshold: float, root: int) -> dict:
     """E⁽³⁾ of level `root` of `basis` (level/qed.py `of_level`) with its Bethe logarithm from the --qed
     bases (split at bethe.py's default K), or from those optimise/current.py builds and keeps in
-    --qed-out/rootK, or qed/rootK beside BASIS (their unions as they join, k ascending, near-dependent
-    functions dropped (current.union), each a row of the
-    convergence table; split at bethe.split's point, at most the grid's largest k over
-    current.BEYOND)."""
+    --qed-out/rootK, or qed/rootK beside BASIS (current.responses: their unions as they join, each a
+    row of the convergence table, and its split point)."""
     from ..level.qed import of_level
 
     if args.qed:
         responses, K = [load_basis(basis_file(name))[0] for name in args.qed], None
     else:
         from ..optimise import Optimiser
-        from ..level.bethe import split
-        from ..optimise.current import BEYOND, SIZE, current_bases, grid, union
+        from ..optimise.current import SIZE, responses as built
 
         out = Path(args.qed_out or Path(args.basis).parent / "qed") / f"root{root}"
-        ks = grid(basis, args.qed_k)
-        opts = Optimiser(budget=args.qed_budget)
-        parts = current_bases(basis, root, ks, args.qed_size or SIZE, out, threshold, opts, progress=not args.json)
-        responses, K = [union(parts[:j + 1]) for j in range(len(parts))], min(split(basis), ks[-1] / BEYOND)
+        responses, K = built(basis, root, args.qed_k, args.qed_size or SIZE, out, threshold,
+                             Optimiser(budget=args.qed_budget), progress=not args.json)
     return of_level(basis, responses, root, threshold=threshold, K=K)
 
 

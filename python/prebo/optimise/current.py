@@ -109,6 +109,17 @@ def current_bases(ground: Basis, root: int = 0, k=None, size: int = SIZE, out: P
     return bases
 
 
+def responses(ground: Basis, root: int = 0, k=None, size: int = SIZE, out: Path | None = None,
+              threshold: float = eigen.THRESHOLD, opts: Optimiser | None = None,
+              progress: bool = False) -> tuple[list[Basis], float]:
+    """The Bethe logarithm's N = 1 bases of the level `root` of `ground` from `current_bases` (the
+    same arguments), as its convergence table takes them: their unions as they join, k ascending
+    (`union`); and the split point K, bethe.split(ground), at most the grid's largest k over BEYOND."""
+    ks = grid(ground, k)
+    parts = current_bases(ground, root, ks, size, out, threshold, opts, progress)
+    return [union(parts[:j + 1]) for j in range(len(parts))], min(split(ground), ks[-1] / BEYOND)
+
+
 def union(bases: list[Basis], min_norm: float = UNION_NORM) -> Basis:
     """The functions of `bases` in order, each kept only if its part orthogonal to those kept before
     it is at least `min_norm` of its norm (a Cholesky factorisation of the scaled overlap, grown a
